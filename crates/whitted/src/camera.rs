@@ -1,0 +1,150 @@
+//! The pinhole camera.
+//!
+//! Scene syntax (`[camera]`): `eye`, `look_at`, `up` (points and a vector) and
+//! `fov`, the vertical field of view in degrees from the top edge of the
+//! image to the bottom edge. Primary rays start at the eye and pass through
+//! pixel centres: pixel `(column, row)` is centred at `(column + 0.5,
+//! row + 0.5)` in image coordinates, row 0 at the top.
+
+use crate::math::{Ray, Vec3};
+
+/// Why a camera could not be built.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum CameraError {
+    /// `eye` and `look_at` are the same point.
+    #[error("the camera's eye and look_at are the same point")]
+    NoViewDirection,
+    /// `up` is zero or parallel to the view direction.
+    #[error("the camera's up vector is zero or parallel to the view direction")]
+    BadUp,
+    /// The field of view is not inside (0°, 180°).
+    #[error("the field of view must be between 0 and 180 degrees, got {0}")]
+    BadFov(f64),
+    /// A value that is not a finite number.
+    #[error("the camera has a value that is not a finite number")]
+    NotFinite,
+}
+
+/// A pinhole camera.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    eye: Vec3,
+    look_at: Vec3,
+    up: Vec3,
+    fov_degrees: f64,
+    forward: Vec3,
+    right: Vec3,
+    true_up: Vec3,
+    tan_half_fov: f64,
+}
+
+impl Camera {
+    /// A camera at `eye` looking at `look_at`, with `up` pointing up on the
+    /// image and a vertical field of view of `fov_degrees`.
+    pub fn new(eye: Vec3, look_at: Vec3, up: Vec3, fov_degrees: f64) -> Result<Self, CameraError> {
+        if !(eye.is_finite() && look_at.is_finite() && up.is_finite() && fov_degrees.is_finite()) {
+            return Err(CameraError::NotFinite);
+        }
+        if !(fov_degrees > 0.0 && fov_degrees < 180.0) {
+            return Err(CameraError::BadFov(fov_degrees));
+        }
+        let forward = (look_at - eye)
+            .try_normalize()
+            .ok_or(CameraError::NoViewDirection)?;
+        let right = forward
+            .cross(up)
+            .try_normalize()
+            .filter(|_| forward.cross(up.normalize_or_zero()).length() > 1e-9)
+            .ok_or(CameraError::BadUp)?;
+        let true_up = right.cross(forward);
+        Ok(Self {
+            eye,
+            look_at,
+            up,
+            fov_degrees,
+            forward,
+            right,
+            true_up,
+            tan_half_fov: (0.5 * fov_degrees).to_radians().tan(),
+        })
+    }
+
+    /// The eye position.
+    pub fn eye(&self) -> Vec3 {
+        self.eye
+    }
+
+    /// The point looked at.
+    pub fn look_at(&self) -> Vec3 {
+        self.look_at
+    }
+
+    /// The up vector as given.
+    pub fn up(&self) -> Vec3 {
+        self.up
+    }
+
+    /// The vertical field of view in degrees.
+    pub fn fov_degrees(&self) -> f64 {
+        self.fov_degrees
+    }
+
+    /// The unit-length primary ray through image position `(x, y)` of a
+    /// `width` × `height` image, in pixel units from the top-left corner.
+    #[inline]
+    pub fn ray(&self, width: u32, height: u32, x: f64, y: f64) -> Ray {
+        let aspect = f64::from(width) / f64::from(height);
+        let sx = (2.0 * x / f64::from(width) - 1.0) * aspect * self.tan_half_fov;
+        let sy = (1.0 - 2.0 * y / f64::from(height)) * self.tan_half_fov;
+        let dir = (self.forward + sx * self.right + sy * self.true_up).normalize();
+        Ray::new(self.eye, dir)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera() -> Camera {
+        Camera::new(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 90.0).unwrap()
+    }
+
+    #[test]
+    fn centre_of_an_odd_image_looks_straight_ahead() {
+        let r = camera().ray(3, 3, 1.5, 1.5);
+        assert!((r.dir - -Vec3::Z).length() < 1e-15);
+        assert_eq!(r.origin, Vec3::new(0.0, 0.0, 5.0));
+    }
+
+    #[test]
+    fn row_zero_is_the_top_and_column_zero_the_left() {
+        let c = camera();
+        let top_left = c.ray(100, 100, 0.0, 0.0).dir;
+        assert!(top_left.y > 0.0 && top_left.x < 0.0);
+        // A 90° field of view reaches 45° at the top edge.
+        let top = c.ray(100, 100, 50.0, 0.0).dir;
+        assert!((top.y - (-top.z)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn wide_images_widen_the_horizontal_view() {
+        let right = camera().ray(200, 100, 200.0, 50.0).dir;
+        assert!((right.x / -right.z - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_cameras_are_refused() {
+        assert_eq!(
+            Camera::new(Vec3::ONE, Vec3::ONE, Vec3::Y, 45.0),
+            Err(CameraError::NoViewDirection)
+        );
+        assert_eq!(
+            Camera::new(Vec3::ZERO, Vec3::Y, Vec3::Y, 45.0),
+            Err(CameraError::BadUp)
+        );
+        assert_eq!(
+            Camera::new(Vec3::ZERO, Vec3::Z, Vec3::Y, 180.0),
+            Err(CameraError::BadFov(180.0))
+        );
+    }
+}

@@ -1,0 +1,213 @@
+//! Light sources: point, directional and spot lights.
+//!
+//! Distance attenuation is `f_att = 1 / (constant + linear·d + quadratic·d²)`
+//! (not clamped: `[1, 0, 0]`, the default, means no fall-off). A spot light
+//! (Warn's model) scales its intensity by `cos(α)^falloff` for directions at
+//! angle `α` from its axis, and is dark beyond its cut-off angle.
+
+use crate::math::{Color, Vec3};
+
+/// Distance fall-off coefficients.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Attenuation {
+    /// Constant term.
+    pub constant: f64,
+    /// Linear term.
+    pub linear: f64,
+    /// Quadratic term.
+    pub quadratic: f64,
+}
+
+impl Default for Attenuation {
+    fn default() -> Self {
+        Self::NONE
+    }
+}
+
+impl Attenuation {
+    /// No fall-off with distance.
+    pub const NONE: Self = Self {
+        constant: 1.0,
+        linear: 0.0,
+        quadratic: 0.0,
+    };
+
+    /// The factor at distance `d`.
+    #[inline]
+    pub fn factor(&self, d: f64) -> f64 {
+        let denominator = self.constant + d * (self.linear + d * self.quadratic);
+        if denominator > 0.0 {
+            1.0 / denominator
+        } else {
+            0.0
+        }
+    }
+}
+
+/// A light source.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Light {
+    /// Light from a point, in all directions.
+    Point {
+        /// Where the light is.
+        position: Vec3,
+        /// Its colour and strength.
+        intensity: Color,
+        /// How it falls off with distance.
+        attenuation: Attenuation,
+    },
+    /// Parallel light from infinitely far away.
+    Directional {
+        /// The unit direction the light travels in.
+        direction: Vec3,
+        /// Its colour and strength.
+        intensity: Color,
+    },
+    /// Light from a point, in a cone.
+    Spot {
+        /// Where the light is.
+        position: Vec3,
+        /// The unit direction of the cone's axis.
+        direction: Vec3,
+        /// Its colour and strength on the axis.
+        intensity: Color,
+        /// Cosine of the cone's half-angle; darker beyond.
+        cos_cutoff: f64,
+        /// Warn exponent: how fast it dims away from the axis.
+        falloff: f64,
+        /// How it falls off with distance.
+        attenuation: Attenuation,
+    },
+}
+
+/// What a light delivers to one point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightSample {
+    /// Unit vector from the point towards the light.
+    pub to_light: Vec3,
+    /// Distance to the light (infinite for directional lights).
+    pub distance: f64,
+    /// Arriving intensity, with attenuation and spot fall-off applied.
+    pub intensity: Color,
+}
+
+impl Light {
+    /// The light arriving at `p`, or `None` when none can (outside a spot's
+    /// cone, or at the light's own position).
+    #[inline]
+    pub fn sample(&self, p: Vec3) -> Option<LightSample> {
+        match self {
+            Light::Point {
+                position,
+                intensity,
+                attenuation,
+            } => {
+                let (to_light, distance) = direction_to(*position, p)?;
+                Some(LightSample {
+                    to_light,
+                    distance,
+                    intensity: *intensity * attenuation.factor(distance),
+                })
+            }
+            Light::Directional {
+                direction,
+                intensity,
+            } => Some(LightSample {
+                to_light: -*direction,
+                distance: f64::INFINITY,
+                intensity: *intensity,
+            }),
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                cos_cutoff,
+                falloff,
+                attenuation,
+            } => {
+                let (to_light, distance) = direction_to(*position, p)?;
+                let cos_axis = -to_light.dot(*direction);
+                if cos_axis < *cos_cutoff || cos_axis <= 0.0 {
+                    return None;
+                }
+                let cone = if *falloff == 0.0 {
+                    1.0
+                } else {
+                    cos_axis.powf(*falloff)
+                };
+                Some(LightSample {
+                    to_light,
+                    distance,
+                    intensity: *intensity * (cone * attenuation.factor(distance)),
+                })
+            }
+        }
+    }
+}
+
+fn direction_to(position: Vec3, p: Vec3) -> Option<(Vec3, f64)> {
+    let delta = position - p;
+    let distance = delta.length();
+    (distance > 0.0 && distance.is_finite()).then(|| (delta / distance, distance))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn point_light_attenuates_with_distance() {
+        let light = Light::Point {
+            position: Vec3::new(0.0, 2.0, 0.0),
+            intensity: Color::ONE,
+            attenuation: Attenuation {
+                constant: 0.0,
+                linear: 0.0,
+                quadratic: 1.0,
+            },
+        };
+        let s = light.sample(Vec3::ZERO).unwrap();
+        assert_eq!(s.to_light, Vec3::Y);
+        assert_eq!(s.distance, 2.0);
+        assert_eq!(s.intensity, Color::splat(0.25));
+    }
+
+    #[test]
+    fn spot_light_is_dark_outside_its_cone_and_dims_towards_the_edge() {
+        let light = Light::Spot {
+            position: Vec3::new(0.0, 1.0, 0.0),
+            direction: -Vec3::Y,
+            intensity: Color::ONE,
+            cos_cutoff: 45f64.to_radians().cos(),
+            falloff: 2.0,
+            attenuation: Attenuation::NONE,
+        };
+        let on_axis = light.sample(Vec3::ZERO).unwrap();
+        assert_eq!(on_axis.intensity, Color::ONE);
+        let inside = light.sample(Vec3::new(0.5, 0.0, 0.0)).unwrap();
+        let cos = 1.0 / 1.25f64.sqrt();
+        assert!((inside.intensity.x - cos * cos).abs() < 1e-12);
+        assert!(light.sample(Vec3::new(1.5, 0.0, 0.0)).is_none());
+    }
+
+    #[test]
+    fn directional_light_comes_from_against_its_direction() {
+        let light = Light::Directional {
+            direction: -Vec3::Y,
+            intensity: Color::ONE,
+        };
+        let s = light.sample(Vec3::new(5.0, 5.0, 5.0)).unwrap();
+        assert_eq!(s.to_light, Vec3::Y);
+        assert!(s.distance.is_infinite());
+    }
+
+    #[test]
+    fn zero_denominator_attenuation_gives_no_light_instead_of_infinity() {
+        let a = Attenuation {
+            constant: 0.0,
+            linear: 0.0,
+            quadratic: 0.0,
+        };
+        assert_eq!(a.factor(3.0), 0.0);
+    }
+}

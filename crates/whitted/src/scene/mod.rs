@@ -1,0 +1,111 @@
+//! The scene: what to render, independent of the file format it came from.
+//!
+//! Every reader (our TOML format today, NFF and OBJ later) produces the same
+//! [`Scene`]; the renderer only ever sees this.
+
+use crate::camera::Camera;
+use crate::light::Light;
+use crate::material::{Material, MaterialId};
+use crate::math::{Color, Transform};
+use crate::shape::Shape;
+
+/// Index of a transform in [`Scene::transforms`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct TransformId(pub u32);
+
+/// A shape placed in the world with a material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Primitive {
+    /// The geometry, in object space.
+    pub shape: Shape,
+    /// What its surface is made of.
+    pub material: MaterialId,
+    /// Where object space sits in the world; `None` means they coincide.
+    pub transform: Option<TransformId>,
+}
+
+/// How to render: image size, sampling and recursion limits.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Samples per pixel (1 means exactly the pixel centre).
+    pub samples_per_pixel: u32,
+    /// Deepest reflection/refraction recursion; 0 traces primary rays only.
+    pub max_depth: u32,
+    /// A branch whose weight on the pixel falls below this stops early
+    /// (adaptive depth control, Hall and Greenberg 1983).
+    pub min_weight: f64,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            width: 640,
+            height: 480,
+            samples_per_pixel: 1,
+            max_depth: 8,
+            min_weight: 1e-3,
+        }
+    }
+}
+
+/// Everything needed to render one picture.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// The viewpoint.
+    pub camera: Camera,
+    /// Image size and quality.
+    pub settings: RenderSettings,
+    /// Colour of rays that hit nothing.
+    pub background: Color,
+    /// Global ambient light `Ia`.
+    pub ambient: Color,
+    /// Materials, indexed by [`MaterialId`].
+    pub materials: Vec<Material>,
+    /// Light sources.
+    pub lights: Vec<Light>,
+    /// Object-to-world transforms, indexed by [`TransformId`].
+    pub transforms: Vec<Transform>,
+    /// The objects.
+    pub primitives: Vec<Primitive>,
+}
+
+impl Scene {
+    /// An empty scene seen by `camera`, with default settings, a black
+    /// background and no ambient light.
+    pub fn new(camera: Camera) -> Self {
+        Self {
+            camera,
+            settings: RenderSettings::default(),
+            background: Color::ZERO,
+            ambient: Color::ZERO,
+            materials: Vec::new(),
+            lights: Vec::new(),
+            transforms: Vec::new(),
+            primitives: Vec::new(),
+        }
+    }
+
+    /// Adds a material and returns its id.
+    pub fn add_material(&mut self, material: Material) -> MaterialId {
+        self.materials.push(material);
+        MaterialId((self.materials.len() - 1) as u32)
+    }
+
+    /// Adds a shape with a material and an object-to-world transform (the
+    /// identity is stored as no transform at all).
+    pub fn add_primitive(&mut self, shape: Shape, material: MaterialId, transform: Transform) {
+        let transform = (!transform.is_identity()).then(|| {
+            self.transforms.push(transform);
+            TransformId((self.transforms.len() - 1) as u32)
+        });
+        self.primitives.push(Primitive {
+            shape,
+            material,
+            transform,
+        });
+    }
+}

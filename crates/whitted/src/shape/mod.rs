@@ -1,0 +1,168 @@
+//! The primitives: one closed `enum` of shapes, dispatched by `match`.
+//!
+//! Every shape answers four questions in its own (object) space:
+//! - [`Shape::intersect`]: the closest hit in the ray's interval, as a small
+//!   [`ShapeHit`] (the parameter `t` and whatever the shape needs to finish
+//!   the job later);
+//! - [`Shape::occluded`]: is there any hit at all (for shadow rays);
+//! - [`Shape::surface`]: for the final hit only, the point with its
+//!   floating-point error bound, the unit geometric normal, the texture
+//!   coordinates (u, v) from the shape's parametric form and the tangent
+//!   `dpdu`;
+//! - [`Shape::bounds`]: the object-space bounding box.
+//!
+//! Normals point "outward": away from the inside of closed shapes, and along
+//! the orientation given by the vertex order or the stated normal for flat
+//! ones. Intersection is two-sided; shading turns normals towards the viewer.
+//!
+//! Degenerate shapes (a zero radius, collinear vertices, a zero-area polygon)
+//! are refused by the constructors with a [`ShapeError`]; no test ever
+//! produces NaN.
+
+mod quadratic;
+mod sphere;
+
+pub use sphere::Sphere;
+
+use crate::math::{Aabb, DVec2, Ray, Vec3};
+
+/// A hit found during traversal: kept small, everything else is computed once
+/// for the final hit by [`Shape::surface`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShapeHit {
+    /// The ray parameter of the hit.
+    pub t: f64,
+    /// Shape-specific data (barycentric coordinates for a triangle, for
+    /// instance); meaningful only to the shape that wrote it.
+    pub u: f64,
+    /// Shape-specific data, like `u`.
+    pub v: f64,
+    /// Which part of a compound shape was hit (side or cap, box face).
+    pub part: u32,
+}
+
+impl ShapeHit {
+    /// A hit at `t` with no extra data.
+    pub fn at(t: f64) -> Self {
+        Self {
+            t,
+            u: 0.0,
+            v: 0.0,
+            part: 0,
+        }
+    }
+}
+
+/// The surface at a hit, in the shape's object space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LocalSurface {
+    /// The hit point, reprojected onto the surface.
+    pub point: Vec3,
+    /// Absolute bound on the error of `point`, per axis.
+    pub point_error: Vec3,
+    /// Unit geometric normal, outward.
+    pub normal: Vec3,
+    /// Texture coordinates from the shape's parametric form.
+    pub uv: DVec2,
+    /// Derivative of the point along u (a tangent; not normalised, may be
+    /// zero at a pole).
+    pub dpdu: Vec3,
+}
+
+/// Why a shape could not be built.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ShapeError {
+    /// A length that must be positive was not.
+    #[error("{what} must be a positive number, got {value}")]
+    NotPositive {
+        /// What was wrong ("radius", "height" ...).
+        what: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// A coordinate or length that is NaN or infinite.
+    #[error("{what} must be a finite number")]
+    NotFinite {
+        /// Which value.
+        what: &'static str,
+    },
+    /// The shape has no area (collinear vertices, zero edges ...).
+    #[error("degenerate {shape}: {why}")]
+    Degenerate {
+        /// The kind of shape.
+        shape: &'static str,
+        /// What makes it degenerate.
+        why: &'static str,
+    },
+}
+
+/// Checks that `value` is finite and positive.
+pub(crate) fn positive(what: &'static str, value: f64) -> Result<f64, ShapeError> {
+    if !value.is_finite() {
+        Err(ShapeError::NotFinite { what })
+    } else if value <= 0.0 {
+        Err(ShapeError::NotPositive { what, value })
+    } else {
+        Ok(value)
+    }
+}
+
+/// Checks that every component of `v` is finite.
+pub(crate) fn finite(what: &'static str, v: Vec3) -> Result<Vec3, ShapeError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(ShapeError::NotFinite { what })
+    }
+}
+
+/// Every primitive whitted knows.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    /// A sphere.
+    Sphere(Sphere),
+}
+
+const _: () = assert!(std::mem::size_of::<Shape>() <= 80);
+
+macro_rules! dispatch {
+    ($self:expr, $s:ident => $body:expr) => {
+        match $self {
+            Shape::Sphere($s) => $body,
+        }
+    };
+}
+
+impl Shape {
+    /// The closest hit with `t` in the ray's open interval.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+        dispatch!(self, s => s.intersect(ray))
+    }
+
+    /// True when the ray meets the shape anywhere in its open interval.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        dispatch!(self, s => s.occluded(ray))
+    }
+
+    /// The surface at a hit this shape returned for `ray`.
+    pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> LocalSurface {
+        dispatch!(self, s => s.surface(ray, hit))
+    }
+
+    /// The object-space bounds ([`Aabb::INFINITE`] for the plane).
+    pub fn bounds(&self) -> Aabb {
+        dispatch!(self, s => s.bounds())
+    }
+
+    /// The name used in scene files and messages.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Shape::Sphere(_) => "sphere",
+        }
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod testing;

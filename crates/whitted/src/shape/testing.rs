@@ -1,0 +1,91 @@
+//! Property checks shared by the tests of every shape: seeded random rays
+//! aimed at the shape, and the invariants each hit must keep.
+
+use super::Shape;
+use crate::math::{Aabb, Ray, Vec3, offset_ray_origin};
+use crate::random::Rng;
+
+/// The region random rays aim at: the shape's bounds, or a box around the
+/// origin for unbounded shapes.
+fn region(shape: &Shape) -> Aabb {
+    let b = shape.bounds();
+    if b.is_finite() {
+        b
+    } else {
+        Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0))
+    }
+}
+
+/// Random rays from outside the region aimed at a point inside it.
+fn random_rays(shape: &Shape, seed: u64, count: usize) -> impl Iterator<Item = Ray> {
+    let region = region(shape);
+    let size = region.extent().length().max(f64::MIN_POSITIVE);
+    let center = region.centroid();
+    let mut rng = Rng::new(seed);
+    (0..count).map(move |_| {
+        let origin = center + 2.0 * size * rng.unit_vector();
+        let target = rng.point_in(region.min, region.max);
+        Ray::new(origin, target - origin)
+    })
+}
+
+/// Rays leaving every hit point in random directions, from the offset origin,
+/// never meet the surface again within a distance no legitimate second hit
+/// could have (1e-7 of the shape's size).
+pub(crate) fn assert_no_self_intersection(shape: &Shape, seed: u64) {
+    let size = region(shape).extent().length();
+    let mut rng = Rng::new(seed ^ 0xabcdef);
+    let mut hits = 0;
+    for ray in random_rays(shape, seed, 2000) {
+        let Some(hit) = shape.intersect(&ray) else {
+            continue;
+        };
+        hits += 1;
+        let s = shape.surface(&ray, &hit);
+        for _ in 0..4 {
+            let w = rng.unit_vector();
+            let origin = offset_ray_origin(s.point, s.point_error, s.normal, w);
+            let next = Ray::new(origin, w);
+            if let Some(again) = shape.intersect(&next) {
+                assert!(
+                    again.t > 1e-7 * size,
+                    "{}: ray from {origin:?} along {w:?} hit its own surface again at t = {}",
+                    shape.kind(),
+                    again.t
+                );
+            }
+        }
+    }
+    assert!(
+        hits > 100,
+        "{}: too few random rays hit ({hits})",
+        shape.kind()
+    );
+}
+
+/// Every hit of a random ray has a finite unit normal, finite texture
+/// coordinates, a point on the ray (within a tight tolerance of the shape's
+/// size) and an `occluded` answer that agrees with `intersect`.
+pub(crate) fn assert_surface_is_sane(shape: &Shape, seed: u64) {
+    let size = region(shape).extent().length();
+    for ray in random_rays(shape, seed, 2000) {
+        let hit = shape.intersect(&ray);
+        assert_eq!(hit.is_some(), shape.occluded(&ray), "{}", shape.kind());
+        let Some(hit) = hit else { continue };
+        assert!(ray.contains(hit.t));
+        let s = shape.surface(&ray, &hit);
+        assert!(
+            (s.normal.length() - 1.0).abs() < 1e-9,
+            "{}: normal {:?}",
+            shape.kind(),
+            s.normal
+        );
+        assert!(s.uv.is_finite() && s.dpdu.is_finite() && s.point_error.is_finite());
+        let distance = (s.point - ray.at(hit.t)).length();
+        assert!(
+            distance <= 1e-9 * size.max(ray.origin.length()),
+            "{}: reprojected point moved by {distance}",
+            shape.kind()
+        );
+    }
+}
