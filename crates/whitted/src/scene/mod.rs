@@ -3,6 +3,10 @@
 //! Every reader (our TOML format today, NFF and OBJ later) produces the same
 //! [`Scene`]; the renderer only ever sees this.
 
+mod diagnostic;
+
+pub use diagnostic::{Diagnostic, SceneError};
+
 use crate::camera::Camera;
 use crate::light::Light;
 use crate::material::{Material, MaterialId};

@@ -1,0 +1,215 @@
+//! Errors from reading a scene, split by whose fault they are, and located in
+//! the file: `path:line:column`, the offending line, and a caret under the
+//! offending span.
+//!
+//! ```text
+//! scenes/bad.toml:12:10: error: expected a number for `radius`, found a string
+//!    |
+//! 12 | radius = "big"
+//!    |          ^^^^^
+//! ```
+//!
+//! Nothing here depends on the file format: any reader that knows the byte
+//! range of a problem can build a [`Diagnostic`].
+
+use std::fmt;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+/// Why a scene could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read (missing, unreadable, not UTF-8).
+    #[error("cannot read scene file `{}`: {source}", path.display())]
+    Io {
+        /// The file that could not be read.
+        path: PathBuf,
+        /// What the operating system said.
+        source: std::io::Error,
+    },
+    /// The file was read but what it says is wrong: every problem found, in
+    /// the order they appear in the file.
+    #[error("{}", summary(diagnostics))]
+    Invalid {
+        /// One entry per problem.
+        diagnostics: Vec<Diagnostic>,
+    },
+}
+
+/// Every diagnostic, a blank line between them, then the count.
+fn summary(diagnostics: &[Diagnostic]) -> String {
+    let mut text = String::new();
+    for diagnostic in diagnostics {
+        text.push_str(&diagnostic.to_string());
+        text.push_str("\n\n");
+    }
+    let count = diagnostics.len();
+    text.push_str(&format!(
+        "{count} error{}",
+        if count == 1 { "" } else { "s" }
+    ));
+    text
+}
+
+/// One problem in a scene file, with where it is.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Diagnostic {
+    /// The file, as it was named to the reader.
+    pub path: PathBuf,
+    /// Line of the problem, from 1.
+    pub line: usize,
+    /// Column of the problem, from 1, counted in characters.
+    pub column: usize,
+    /// What is wrong, and what was expected.
+    pub message: String,
+    /// The text of the offending line (without its line break).
+    pub source_line: String,
+    /// How many characters of the line the problem covers (at least 1; a span
+    /// running over several lines is cut at the end of its first line).
+    pub width: usize,
+}
+
+impl Diagnostic {
+    /// The diagnostic for the bytes `span` of `source`, read from `path`.
+    ///
+    /// Spans past the end, reversed or splitting a character are tolerated:
+    /// the caret lands on the nearest sensible place. A problem at the very
+    /// end of a file that ends with a line break is shown at the end of the
+    /// last line rather than on an empty line after it.
+    pub fn new(path: &Path, source: &str, span: Range<usize>, message: impl Into<String>) -> Self {
+        let mut start = span.start.min(source.len());
+        if start == source.len() && source.ends_with('\n') {
+            start -= 1;
+        }
+        while !source.is_char_boundary(start) {
+            start -= 1;
+        }
+        let line_start = source[..start].rfind('\n').map_or(0, |i| i + 1);
+        let line_end = source[start..]
+            .find('\n')
+            .map_or(source.len(), |i| start + i);
+        let mut end = span.end.clamp(start, line_end);
+        while !source.is_char_boundary(end) {
+            end += 1;
+        }
+        Self {
+            path: path.to_path_buf(),
+            line: source[..line_start].matches('\n').count() + 1,
+            column: source[line_start..start].chars().count() + 1,
+            message: message.into(),
+            source_line: source[line_start..line_end]
+                .trim_end_matches('\r')
+                .to_string(),
+            width: source[start..end].chars().count().max(1),
+        }
+    }
+}
+
+impl fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let number = self.line.to_string();
+        let gutter = " ".repeat(number.len());
+        // Tabs before the caret are kept so it lines up under the text.
+        let indent: String = self
+            .source_line
+            .chars()
+            .take(self.column.saturating_sub(1))
+            .map(|c| if c == '\t' { '\t' } else { ' ' })
+            .collect();
+        writeln!(
+            f,
+            "{}:{}:{}: error: {}",
+            self.path.display(),
+            self.line,
+            self.column,
+            self.message
+        )?;
+        writeln!(f, "{gutter} |")?;
+        if self.source_line.is_empty() {
+            writeln!(f, "{number} |")?;
+        } else {
+            writeln!(f, "{number} | {}", self.source_line)?;
+        }
+        write!(f, "{gutter} | {indent}{}", "^".repeat(self.width))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at(source: &str, span: Range<usize>) -> Diagnostic {
+        Diagnostic::new(Path::new("scenes/bad.toml"), source, span, "oops")
+    }
+
+    #[test]
+    fn shows_the_line_with_a_caret_under_the_span() {
+        let source = "a = 1\n".repeat(11) + "radius = \"big\"\n";
+        let start = source.find('"').unwrap();
+        let d = Diagnostic::new(
+            Path::new("scenes/bad.toml"),
+            &source,
+            start..start + 5,
+            "expected a number for `radius`, found a string",
+        );
+        assert_eq!((d.line, d.column, d.width), (12, 10, 5));
+        assert_eq!(
+            d.to_string(),
+            "scenes/bad.toml:12:10: error: expected a number for `radius`, found a string\n   \
+             |\n12 | radius = \"big\"\n   |          ^^^^^"
+        );
+    }
+
+    #[test]
+    fn a_span_over_several_lines_is_cut_at_the_first_line_end() {
+        let d = at("[camera]\neye = 1\n", 0..16);
+        assert_eq!((d.line, d.column, d.width), (1, 1, 8));
+        assert_eq!(d.source_line, "[camera]");
+    }
+
+    #[test]
+    fn an_error_at_the_end_of_the_file_points_after_the_last_line() {
+        let d = at("a = [1, 2\n", 10..13);
+        assert_eq!((d.line, d.column, d.width), (1, 10, 1));
+        assert_eq!(d.source_line, "a = [1, 2");
+        let d = at("", 0..0);
+        assert_eq!((d.line, d.column, d.width), (1, 1, 1));
+        assert!(d.to_string().ends_with("1 |\n  | ^"));
+    }
+
+    #[test]
+    fn reversed_spans_and_wide_characters_are_tolerated() {
+        let d = at("a = 1.\n", Range { start: 6, end: 5 });
+        assert_eq!((d.line, d.column, d.width), (1, 7, 1));
+        let d = at("name = \"é\" # ü\nx", 8..10);
+        assert_eq!((d.column, d.width), (9, 1));
+        let d = at("é", 1..1);
+        assert_eq!(d.column, 1);
+    }
+
+    #[test]
+    fn tabs_before_the_caret_are_kept() {
+        let d = at("\tx = 1", 1..2);
+        assert!(d.to_string().ends_with(" | \t^"));
+    }
+
+    #[test]
+    fn crlf_line_ends_are_not_shown() {
+        let d = at("a = 1\r\nb = x\r\n", 11..12);
+        assert_eq!((d.line, d.column), (2, 5));
+        assert_eq!(d.source_line, "b = x");
+    }
+
+    #[test]
+    fn invalid_lists_every_diagnostic_then_the_count() {
+        let one = at("a = 1", 0..1);
+        let error = SceneError::Invalid {
+            diagnostics: vec![one.clone(), one.clone()],
+        };
+        assert_eq!(error.to_string(), format!("{one}\n\n{one}\n\n2 errors"));
+        let error = SceneError::Invalid {
+            diagnostics: vec![one.clone()],
+        };
+        assert_eq!(error.to_string(), format!("{one}\n\n1 error"));
+    }
+}
