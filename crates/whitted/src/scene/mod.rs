@@ -4,8 +4,10 @@
 //! [`Scene`]; the renderer only ever sees this.
 
 mod diagnostic;
+mod toml_format;
 
 pub use diagnostic::{Diagnostic, SceneError};
+pub use toml_format::{load_scene, parse_scene};
 
 use crate::camera::Camera;
 use crate::light::Light;

@@ -1,0 +1,221 @@
+//! Materials: one table per material under `[materials]`, named by its key.
+//!
+//! ```toml
+//! [materials.floor]
+//! diffuse = { checker = { even = [1, 0, 0], odd = [1, 1, 0], size = 0.5 } }
+//!
+//! [materials.glass]
+//! diffuse = 0.05                  # colour slots: [r, g, b], a grey, or a checker
+//! specular = 0.8
+//! shininess = 200
+//! transmission = 0.9
+//! ior = 1.5
+//! fresnel = true
+//! ```
+//!
+//! `diffuse` defaults to a 0.8 grey and `ambient` to the diffuse value; the
+//! other colour slots default to black, `shininess` to 32, `ior` to 1 and
+//! `fresnel` to false. A checker's `size` defaults to 1.
+
+use toml_span::value::Value;
+
+use super::reader::{Parsed, Reader, all};
+use crate::material::Material;
+use crate::math::Color;
+use crate::texture::{Checker, Texture};
+
+/// The keys of a material.
+const KEYS: &[&str] = &[
+    "ambient",
+    "diffuse",
+    "specular",
+    "reflection",
+    "transmission",
+    "emission",
+    "shininess",
+    "ior",
+    "fresnel",
+];
+
+/// Reads the `[materials]` table, if any, in the order of the file.
+pub(super) fn read_materials(
+    r: &mut Reader<'_>,
+    value: Option<&Value<'_>>,
+) -> Parsed<Vec<Material>> {
+    let Some(value) = value else {
+        return Ok(Vec::new());
+    };
+    let table = r.table(value, "materials", "[materials]")?;
+    all(table
+        .entries_in_file_order()
+        .iter()
+        .map(|(key, value)| read_material(r, value, &key.name)))
+}
+
+fn read_material(r: &mut Reader<'_>, value: &Value<'_>, name: &str) -> Parsed<Material> {
+    let f = r.table(value, name, format!("material `{name}`"))?;
+    let keys = r.check_keys(&f, KEYS);
+    let ambient = r.optional(&f, "ambient", texture);
+    let diffuse = r.or_default(&f, "diffuse", Texture::Constant(Color::splat(0.8)), texture);
+    let specular = r.or_default(&f, "specular", Texture::default(), texture);
+    let reflection = r.or_default(&f, "reflection", Texture::default(), texture);
+    let transmission = r.or_default(&f, "transmission", Texture::default(), texture);
+    let emission = r.or_default(&f, "emission", Texture::default(), texture);
+    let shininess = r.or_default(&f, "shininess", 32.0, Reader::non_negative);
+    let ior = r.or_default(&f, "ior", 1.0, Reader::positive);
+    let fresnel = r.or_default(&f, "fresnel", false, Reader::boolean);
+    keys?;
+    let diffuse = diffuse?;
+    Ok(Material {
+        ambient: ambient?.unwrap_or_else(|| diffuse.clone()),
+        diffuse,
+        specular: specular?,
+        shininess: shininess?,
+        reflection: reflection?,
+        transmission: transmission?,
+        emission: emission?,
+        ior: ior?,
+        fresnel: fresnel?,
+    })
+}
+
+/// A colour slot: a colour, or `{ checker = { even, odd, size } }`.
+fn texture(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Texture> {
+    if value.as_table().is_none() {
+        if value.as_str().is_some() || value.as_bool().is_some() {
+            return Err(r.wrong_type(
+                value,
+                key,
+                "a colour ([r, g, b], a number or { checker = { ... } })",
+            ));
+        }
+        return r.color(value, key).map(Texture::Constant);
+    }
+    let f = r.table(value, key, format!("`{key}`"))?;
+    let keys = r.check_keys(&f, &["checker"]);
+    let checker = r.require(&f, "checker", checker);
+    keys?;
+    checker
+}
+
+/// `{ even = colour, odd = colour, size = s }`.
+fn checker(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Texture> {
+    let f = r.table(value, key, "checker")?;
+    let keys = r.check_keys(&f, &["even", "odd", "size"]);
+    let even = r.require(&f, "even", Reader::color);
+    let odd = r.require(&f, "odd", Reader::color);
+    let size = r.or_default(&f, "size", 1.0, Reader::positive);
+    keys?;
+    Ok(Texture::Checker(Checker {
+        even: even?,
+        odd: odd?,
+        size: size?,
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{CAMERA, errors, scene};
+    use super::*;
+
+    #[test]
+    fn defaults_are_a_matte_grey_with_ambient_following_diffuse() {
+        let s = scene(&format!("{CAMERA}[materials.plain]\n"));
+        assert_eq!(s.materials, [Material::default()]);
+        let s = scene(&format!("{CAMERA}[materials.red]\ndiffuse = [1, 0, 0]\n"));
+        assert_eq!(s.materials[0].ambient, Texture::Constant(Color::X));
+    }
+
+    #[test]
+    fn every_slot_is_read() {
+        let s = scene(&format!(
+            "{CAMERA}[materials.all]\nambient = 0.1\ndiffuse = [0.2, 0.3, 0.4]\nspecular = 0.5\n\
+             reflection = 0.6\ntransmission = 0.7\nemission = [1, 2, 3]\nshininess = 100\n\
+             ior = 1.33\nfresnel = true\n"
+        ));
+        assert_eq!(
+            s.materials,
+            [Material {
+                ambient: Texture::Constant(Color::splat(0.1)),
+                diffuse: Texture::Constant(Color::new(0.2, 0.3, 0.4)),
+                specular: Texture::Constant(Color::splat(0.5)),
+                shininess: 100.0,
+                reflection: Texture::Constant(Color::splat(0.6)),
+                transmission: Texture::Constant(Color::splat(0.7)),
+                emission: Texture::Constant(Color::new(1.0, 2.0, 3.0)),
+                ior: 1.33,
+                fresnel: true,
+            }]
+        );
+    }
+
+    #[test]
+    fn checker_slots_are_read_with_a_default_size() {
+        let s = scene(&format!(
+            "{CAMERA}[materials.floor]\n\
+             diffuse = {{ checker = {{ even = [1, 0, 0], odd = 1 }} }}\n\
+             [materials.floor.reflection.checker]\neven = 0\nodd = 0.5\nsize = 0.25\n"
+        ));
+        let m = &s.materials[0];
+        assert_eq!(
+            m.diffuse,
+            Texture::Checker(Checker {
+                even: Color::X,
+                odd: Color::ONE,
+                size: 1.0,
+            })
+        );
+        assert_eq!(m.ambient, m.diffuse);
+        assert_eq!(
+            m.reflection,
+            Texture::Checker(Checker {
+                even: Color::ZERO,
+                odd: Color::splat(0.5),
+                size: 0.25,
+            })
+        );
+    }
+
+    #[test]
+    fn materials_keep_the_order_of_the_file() {
+        let s = scene(&format!(
+            "{CAMERA}[materials.zinc]\nior = 2\n[materials.amber]\nior = 3\n"
+        ));
+        let iors: Vec<f64> = s.materials.iter().map(|m| m.ior).collect();
+        assert_eq!(iors, [2.0, 3.0]);
+    }
+
+    #[test]
+    fn every_material_error_is_reported() {
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[materials.bad]\ndiffuse = 'red'\nspecular = [1, 2]\nshininess = -1\n\
+                 ior = 0\nfresnel = 1\nglow = 2\n\
+                 [materials.worse]\nambient = {{ chequer = 1 }}\n\
+                 emission = {{ checker = {{ even = 1, size = -2 }} }}\n"
+            )),
+            [
+                "expected a colour ([r, g, b], a number or { checker = { ... } }) for \
+                 `diffuse`, found a string",
+                "expected 3 numbers for `specular`, found 2",
+                "`shininess` must not be negative, got -1",
+                "`ior` must be greater than 0, got 0",
+                "expected `true` or `false` for `fresnel`, found an integer",
+                "unknown key `glow` in material `bad`; expected one of: ambient, diffuse, \
+                 specular, reflection, transmission, emission, shininess, ior, fresnel",
+                "missing required key `checker` in `ambient`",
+                "unknown key `chequer` in `ambient`; expected one of: checker",
+                "missing required key `odd` in checker",
+                "`size` must be greater than 0, got -2",
+            ]
+        );
+        assert_eq!(
+            errors(&format!("materials = [1]\n{CAMERA}")),
+            ["expected a table for `materials`, found an array"]
+        );
+        assert_eq!(
+            errors(&format!("{CAMERA}[materials]\nglass = 1.5\n")),
+            ["expected a table for `glass`, found a float"]
+        );
+    }
+}

@@ -1,0 +1,327 @@
+//! whitted's own scene format, in TOML. The full reference with an example
+//! per section is `docs/scene-format.md`; in short:
+//!
+//! ```toml
+//! [render]                        # optional
+//! width = 640
+//! height = 480
+//! background = [0.1, 0.2, 0.5]
+//!
+//! [camera]                        # required
+//! eye = [0, 1, -5]
+//! look_at = [0, 0, 0]
+//!
+//! [materials.glass]               # any number, named by their key
+//! transmission = 0.9
+//! ior = 1.5
+//!
+//! [[lights]]                      # any number
+//! type = "point"
+//! position = [5, 5, -5]
+//!
+//! ```
+//!
+//! The document is parsed by `toml-span`, which keeps the byte span of every
+//! key and value, so each error points at what is wrong. A syntax error stops
+//! the parser and gives one error; past that, the whole document is walked and
+//! every error is reported: unknown keys, wrong types, missing keys, values
+//! out of range, unknown names, and shapes, transforms or cameras their
+//! constructors refuse.
+
+mod light;
+mod material;
+mod reader;
+
+use std::path::Path;
+
+use toml_span::Span;
+use toml_span::value::Value;
+
+use self::reader::{Parsed, Reader};
+use crate::camera::{Camera, CameraError};
+use crate::math::{Color, Vec3};
+use crate::scene::{Diagnostic, RenderSettings, Scene, SceneError};
+
+/// Reads a scene from the text of a scene file; `path` is only used in
+/// messages.
+pub fn parse_scene(source: &str, path: &Path) -> Result<Scene, SceneError> {
+    let root = toml_span::parse(source).map_err(|error| SceneError::Invalid {
+        diagnostics: vec![Diagnostic::new(
+            path,
+            source,
+            error.span.start..error.span.end,
+            format!("invalid TOML: {error}"),
+        )],
+    })?;
+    let mut reader = Reader::new(source, path);
+    let scene = read_document(&mut reader, &root);
+    reader.finish(scene)
+}
+
+/// Reads a scene file.
+pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
+    let source = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse_scene(&source, path)
+}
+
+/// The keys allowed at the top level.
+const SECTIONS: &[&str] = &["render", "camera", "materials", "lights"];
+
+/// Walks the whole document.
+fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
+    let top = r.table(root, "the scene", "the top level")?;
+    let keys = r.check_keys(&top, SECTIONS);
+    let render = match top.get("render") {
+        Some(value) => read_render(r, value),
+        None => Ok(Render::default()),
+    };
+    let camera = match top.get("camera") {
+        Some(value) => read_camera(r, value),
+        None => Err(r.error(Span::new(0, 0), "missing required table `[camera]`")),
+    };
+    let materials = material::read_materials(r, top.get("materials"));
+    let lights = light::read_lights(r, top.get("lights"));
+    keys?;
+    let render = render?;
+    let mut scene = Scene::new(camera?);
+    scene.settings = render.settings;
+    scene.background = render.background;
+    scene.ambient = render.ambient;
+    scene.lights = lights?;
+    scene.materials = materials?;
+    Ok(scene)
+}
+
+/// The `[render]` table.
+#[derive(Debug, Default, PartialEq)]
+struct Render {
+    settings: RenderSettings,
+    background: Color,
+    ambient: Color,
+}
+
+/// The keys of `[render]`.
+const RENDER_KEYS: &[&str] = &[
+    "width",
+    "height",
+    "samples",
+    "max_depth",
+    "min_weight",
+    "background",
+    "ambient",
+];
+
+fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
+    let f = r.table(value, "render", "[render]")?;
+    let keys = r.check_keys(&f, RENDER_KEYS);
+    let d = RenderSettings::default();
+    let width = r.or_default(&f, "width", d.width, |r, v, k| r.count(v, k, 1));
+    let height = r.or_default(&f, "height", d.height, |r, v, k| r.count(v, k, 1));
+    let samples = r.or_default(&f, "samples", d.samples_per_pixel, |r, v, k| {
+        r.count(v, k, 1)
+    });
+    let max_depth = r.or_default(&f, "max_depth", d.max_depth, |r, v, k| r.count(v, k, 0));
+    let min_weight = r.or_default(&f, "min_weight", d.min_weight, Reader::non_negative);
+    let background = r.or_default(&f, "background", Color::ZERO, Reader::color);
+    let ambient = r.or_default(&f, "ambient", Color::ZERO, Reader::color);
+    keys?;
+    Ok(Render {
+        settings: RenderSettings {
+            width: width?,
+            height: height?,
+            samples_per_pixel: samples?,
+            max_depth: max_depth?,
+            min_weight: min_weight?,
+        },
+        background: background?,
+        ambient: ambient?,
+    })
+}
+
+/// The keys of `[camera]`.
+const CAMERA_KEYS: &[&str] = &["eye", "look_at", "up", "fov"];
+
+fn read_camera(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Camera> {
+    let f = r.table(value, "camera", "[camera]")?;
+    let keys = r.check_keys(&f, CAMERA_KEYS);
+    let eye = r.require(&f, "eye", Reader::vec3);
+    let look_at = r.require(&f, "look_at", Reader::vec3);
+    let up = r.or_default(&f, "up", Vec3::Y, Reader::vec3);
+    let fov = r.or_default(&f, "fov", 45.0, Reader::number);
+    let camera = Camera::new(eye?, look_at?, up?, fov?);
+    keys?;
+    camera.map_err(|error| {
+        let key = match error {
+            CameraError::NoViewDirection => Some("look_at"),
+            CameraError::BadUp => Some("up"),
+            CameraError::BadFov(_) => Some("fov"),
+            CameraError::NotFinite => None,
+        };
+        let span = key.map_or(f.span(), |key| r.value_span(&f, key));
+        r.error(span, error.to_string())
+    })
+}
+
+#[cfg(test)]
+pub(super) mod tests {
+    use super::*;
+
+    /// The scene in `source`, which must be valid.
+    pub(crate) fn scene(source: &str) -> Scene {
+        match parse_scene(source, Path::new("test.toml")) {
+            Ok(scene) => scene,
+            Err(error) => panic!("{error}"),
+        }
+    }
+
+    /// The messages of the errors in `source`, which must be invalid.
+    pub(crate) fn errors(source: &str) -> Vec<String> {
+        match parse_scene(source, Path::new("test.toml")) {
+            Ok(_) => panic!("no error in:\n{source}"),
+            Err(SceneError::Invalid { diagnostics }) => {
+                diagnostics.into_iter().map(|d| d.message).collect()
+            }
+            Err(error) => panic!("{error}"),
+        }
+    }
+
+    /// A valid camera table, to put in front of a test's own sections.
+    pub(crate) const CAMERA: &str = "[camera]\neye = [0, 0, -5]\nlook_at = [0, 0, 0]\n";
+
+    #[test]
+    fn a_camera_alone_is_a_scene_with_every_default() {
+        let s = scene(CAMERA);
+        assert_eq!(s.settings, RenderSettings::default());
+        assert_eq!((s.background, s.ambient), (Color::ZERO, Color::ZERO));
+        assert_eq!(s.camera.up(), Vec3::Y);
+        assert_eq!(s.camera.fov_degrees(), 45.0);
+        assert!(s.materials.is_empty() && s.lights.is_empty() && s.primitives.is_empty());
+    }
+
+    #[test]
+    fn render_settings_are_read() {
+        let s = scene(&format!(
+            "{CAMERA}[render]\nwidth = 32\nheight = 24\nsamples = 4\nmax_depth = 0\n\
+             min_weight = 0\nbackground = [0.1, 0.2, 0.3]\nambient = 0.5\n"
+        ));
+        assert_eq!(
+            s.settings,
+            RenderSettings {
+                width: 32,
+                height: 24,
+                samples_per_pixel: 4,
+                max_depth: 0,
+                min_weight: 0.0,
+            }
+        );
+        assert_eq!(s.background, Color::new(0.1, 0.2, 0.3));
+        assert_eq!(s.ambient, Color::splat(0.5));
+    }
+
+    #[test]
+    fn camera_is_read() {
+        let s = scene("[camera]\neye = [1, 2, 3]\nlook_at = [0, 1, 0]\nup = [0, 0, 1]\nfov = 30.5");
+        assert_eq!(s.camera.eye(), Vec3::new(1.0, 2.0, 3.0));
+        assert_eq!(s.camera.look_at(), Vec3::Y);
+        assert_eq!(s.camera.up(), Vec3::Z);
+        assert_eq!(s.camera.fov_degrees(), 30.5);
+    }
+
+    #[test]
+    fn every_render_error_is_reported_at_once() {
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[render]\nwidth = 0\nheight = 1.5\nsamples = '4'\nmax_depth = -1\n\
+                 min_weight = -0.5\nbackground = [1, 1]\nambient = -1\nsize = 3\n"
+            )),
+            [
+                "`width` must be at least 1, got 0",
+                "expected an integer for `height`, found a float",
+                "expected an integer for `samples`, found a string",
+                "`max_depth` must be at least 0, got -1",
+                "`min_weight` must not be negative, got -0.5",
+                "expected 3 numbers for `background`, found 2",
+                "`ambient` must not be negative, got -1",
+                "unknown key `size` in [render]; expected one of: width, height, samples, \
+                 max_depth, min_weight, background, ambient",
+            ]
+        );
+    }
+
+    #[test]
+    fn camera_errors_point_at_the_culprit() {
+        assert_eq!(
+            errors("[render]\nwidth = 3\n"),
+            ["missing required table `[camera]`"]
+        );
+        assert_eq!(
+            errors("[camera]\nlook_at = [0, 0, 0]\nfov = 'wide'\nzoom = 2\n"),
+            [
+                "missing required key `eye` in [camera]",
+                "expected a number for `fov`, found a string",
+                "unknown key `zoom` in [camera]; expected one of: eye, look_at, up, fov",
+            ]
+        );
+        assert_eq!(
+            errors("[camera]\neye = [0, 0, 0]\nlook_at = [0, 0, 0]\n"),
+            ["the camera's eye and look_at are the same point"]
+        );
+        assert_eq!(
+            errors(&format!("{CAMERA}up = [0, 0, 2]\n")),
+            ["the camera's up vector is zero or parallel to the view direction"]
+        );
+        assert_eq!(
+            errors(&format!("{CAMERA}fov = 180\n")),
+            ["the field of view must be between 0 and 180 degrees, got 180"]
+        );
+        assert_eq!(
+            errors("camera = 3"),
+            ["expected a table for `camera`, found an integer"]
+        );
+    }
+
+    #[test]
+    fn unknown_top_level_keys_are_errors() {
+        assert_eq!(
+            errors(&format!("title = 'x'\n{CAMERA}")),
+            [
+                "unknown key `title` in the top level; expected one of: render, camera, \
+              materials, lights"
+            ]
+        );
+    }
+
+    #[test]
+    fn a_syntax_error_gives_one_error_at_its_place() {
+        let Err(SceneError::Invalid { diagnostics }) =
+            parse_scene("[camera]\neye = [0, 0\n", Path::new("s.toml"))
+        else {
+            panic!("expected a syntax error");
+        };
+        assert_eq!(diagnostics.len(), 1);
+        assert!(diagnostics[0].message.starts_with("invalid TOML: "));
+        assert_eq!(diagnostics[0].line, 2);
+    }
+
+    #[test]
+    fn errors_are_sorted_by_their_place_in_the_file() {
+        let Err(SceneError::Invalid { diagnostics }) = parse_scene(
+            "[render]\nwidth = 0\n[camera]\neye = 1\nlook_at = 1\n",
+            Path::new("s.toml"),
+        ) else {
+            panic!("expected errors");
+        };
+        let lines: Vec<usize> = diagnostics.iter().map(|d| d.line).collect();
+        assert_eq!(lines, [2, 4, 5]);
+    }
+
+    #[test]
+    fn a_missing_file_is_an_io_error_naming_it() {
+        let error = load_scene(Path::new("/nonexistent/scene.toml")).unwrap_err();
+        assert!(matches!(error, SceneError::Io { .. }));
+        assert!(error.to_string().contains("/nonexistent/scene.toml"));
+    }
+}
