@@ -37,19 +37,42 @@ const KEYS: &[&str] = &[
     "fresnel",
 ];
 
-/// Reads the `[materials]` table, if any, in the order of the file.
-pub(super) fn read_materials(
-    r: &mut Reader<'_>,
-    value: Option<&Value<'_>>,
-) -> Parsed<Vec<Material>> {
+/// The materials of a scene, in the order they appear in the file.
+pub(super) struct Materials {
+    /// Every name, even of a material with errors, so that objects naming
+    /// it are not reported as well.
+    pub(super) names: Vec<String>,
+    /// The materials, in the order of `names`.
+    pub(super) list: Parsed<Vec<Material>>,
+}
+
+/// Reads the `[materials]` table, if any.
+pub(super) fn read_materials(r: &mut Reader<'_>, value: Option<&Value<'_>>) -> Materials {
     let Some(value) = value else {
-        return Ok(Vec::new());
+        return Materials {
+            names: Vec::new(),
+            list: Ok(Vec::new()),
+        };
     };
-    let table = r.table(value, "materials", "[materials]")?;
-    all(table
-        .entries_in_file_order()
-        .iter()
-        .map(|(key, value)| read_material(r, value, &key.name)))
+    let table = match r.table(value, "materials", "[materials]") {
+        Ok(table) => table,
+        Err(reported) => {
+            return Materials {
+                names: Vec::new(),
+                list: Err(reported),
+            };
+        }
+    };
+    let entries = table.entries_in_file_order();
+    Materials {
+        names: entries
+            .iter()
+            .map(|(key, _)| key.name.to_string())
+            .collect(),
+        list: all(entries
+            .iter()
+            .map(|(key, value)| read_material(r, value, &key.name))),
+    }
 }
 
 fn read_material(r: &mut Reader<'_>, value: &Value<'_>, name: &str) -> Parsed<Material> {

@@ -19,6 +19,11 @@
 //! type = "point"
 //! position = [5, 5, -5]
 //!
+//! [[objects]]                     # any number
+//! shape = "sphere"
+//! radius = 1
+//! material = "glass"
+//! transform = [{ translate = [0, 1, 0] }]
 //! ```
 //!
 //! The document is parsed by `toml-span`, which keeps the byte span of every
@@ -30,7 +35,9 @@
 
 mod light;
 mod material;
+mod object;
 mod reader;
+mod shapes;
 
 use std::path::Path;
 
@@ -39,6 +46,7 @@ use toml_span::value::Value;
 
 use self::reader::{Parsed, Reader};
 use crate::camera::{Camera, CameraError};
+use crate::material::{Material, MaterialId};
 use crate::math::{Color, Vec3};
 use crate::scene::{Diagnostic, RenderSettings, Scene, SceneError};
 
@@ -68,7 +76,7 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
 }
 
 /// The keys allowed at the top level.
-const SECTIONS: &[&str] = &["render", "camera", "materials", "lights"];
+const SECTIONS: &[&str] = &["render", "camera", "materials", "lights", "objects"];
 
 /// Walks the whole document.
 fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
@@ -84,6 +92,7 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
     };
     let materials = material::read_materials(r, top.get("materials"));
     let lights = light::read_lights(r, top.get("lights"));
+    let objects = object::read_objects(r, top.get("objects"), &materials.names);
     keys?;
     let render = render?;
     let mut scene = Scene::new(camera?);
@@ -91,7 +100,20 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
     scene.background = render.background;
     scene.ambient = render.ambient;
     scene.lights = lights?;
-    scene.materials = materials?;
+    for material in materials.list? {
+        scene.add_material(material);
+    }
+    let objects = objects?;
+    let default_material = MaterialId(scene.materials.len() as u32);
+    if objects.iter().any(|object| object.material.is_none()) {
+        scene.add_material(Material::default());
+    }
+    for object in objects {
+        let material = object
+            .material
+            .map_or(default_material, |index| MaterialId(index as u32));
+        scene.add_primitive(object.shape, material, object.transform);
+    }
     Ok(scene)
 }
 
@@ -289,7 +311,7 @@ pub(super) mod tests {
             errors(&format!("title = 'x'\n{CAMERA}")),
             [
                 "unknown key `title` in the top level; expected one of: render, camera, \
-              materials, lights"
+              materials, lights, objects"
             ]
         );
     }

@@ -1,0 +1,120 @@
+//! The shape kinds of `[[objects]]`: for each, its name, its own keys and
+//! one small function that reads them and calls the shape's constructor.
+//! Adding a kind is one entry in [`SHAPE_KINDS`] and one function.
+//!
+//! ```toml
+//! [[objects]]
+//! shape = "sphere"
+//! center = [0, 1, 0]              # default [0, 0, 0]
+//! radius = 1
+//! ```
+//!
+//! Shapes whose constructor is canonical (a disk, cylinder or cone standing
+//! on the origin along +z) return a placement transform that puts them where
+//! the file says; the object's own `transform` steps act after it.
+
+use toml_span::Span;
+
+use super::reader::{Fields, Parsed, Reader, Reported};
+use crate::math::{Transform, Vec3};
+use crate::shape::{Shape, ShapeError, Sphere};
+
+/// A shape in its object space and where that space sits before the
+/// object's own transform.
+pub(super) struct Placed {
+    pub(super) shape: Shape,
+    pub(super) placement: Transform,
+}
+
+impl Placed {
+    /// A shape whose constructor already put it in place.
+    fn in_place(shape: Shape) -> Self {
+        Self {
+            shape,
+            placement: Transform::IDENTITY,
+        }
+    }
+}
+
+/// Reads the keys of one kind of shape. The span is that of the `shape`
+/// value, for errors that concern no key in particular.
+type Build = fn(&mut Reader<'_>, &Fields<'_, '_>, Span) -> Parsed<Placed>;
+
+/// One kind of shape in the scene format.
+pub(super) struct ShapeKind {
+    /// The value of `shape`.
+    pub(super) name: &'static str,
+    /// Its own keys, besides `shape`, `material` and `transform`.
+    pub(super) keys: &'static [&'static str],
+    build: Build,
+}
+
+/// Every kind of shape the format knows.
+pub(super) const SHAPE_KINDS: &[ShapeKind] = &[ShapeKind {
+    name: "sphere",
+    keys: &["center", "radius"],
+    build: sphere,
+}];
+
+/// Reads an object's shape keys as `kind`.
+pub(super) fn build(
+    kind: &ShapeKind,
+    r: &mut Reader<'_>,
+    f: &Fields<'_, '_>,
+    kind_span: Span,
+) -> Parsed<Placed> {
+    (kind.build)(r, f, kind_span)
+}
+
+/// Records a constructor's refusal at the value it names (`radius` ...), or
+/// else at `fallback`.
+fn refused(r: &mut Reader<'_>, f: &Fields<'_, '_>, fallback: Span, error: ShapeError) -> Reported {
+    let named = match &error {
+        ShapeError::NotPositive { what, .. } | ShapeError::NotFinite { what } => f.get(what),
+        ShapeError::Degenerate { .. } => None,
+    };
+    let span = named.map_or(fallback, |value| r.span_of(value));
+    r.error(span, error.to_string())
+}
+
+fn sphere(r: &mut Reader<'_>, f: &Fields<'_, '_>, at: Span) -> Parsed<Placed> {
+    let center = r.or_default(f, "center", Vec3::ZERO, Reader::vec3);
+    let radius = r.require(f, "radius", Reader::number);
+    let sphere = Sphere::new(center?, radius?).map_err(|e| refused(r, f, at, e))?;
+    Ok(Placed::in_place(Shape::Sphere(sphere)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{CAMERA, errors, scene};
+    use super::*;
+
+    /// The shape of the only object in `keys`.
+    fn shape(keys: &str) -> Shape {
+        let mut s = scene(&format!("{CAMERA}[[objects]]\n{keys}\n"));
+        assert_eq!(s.primitives.len(), 1);
+        s.primitives.remove(0).shape
+    }
+
+    #[test]
+    fn spheres_are_read_with_a_default_center() {
+        assert_eq!(
+            shape("shape = 'sphere'\nradius = 2"),
+            Shape::Sphere(Sphere::new(Vec3::ZERO, 2.0).unwrap())
+        );
+        assert_eq!(
+            shape("shape = 'sphere'\ncenter = [1, 2, 3]\nradius = 0.5"),
+            Shape::Sphere(Sphere::new(Vec3::new(1.0, 2.0, 3.0), 0.5).unwrap())
+        );
+    }
+
+    #[test]
+    fn a_refused_sphere_is_reported_at_its_radius() {
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[[objects]]\nshape = 'sphere'\nradius = -1\n"
+            )),
+            ["radius must be a positive number, got -1"]
+        );
+    }
+}
