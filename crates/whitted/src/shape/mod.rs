@@ -19,10 +19,14 @@
 //! are refused by the constructors with a [`ShapeError`]; no test ever
 //! produces NaN.
 
+mod plane;
 mod quadratic;
 mod sphere;
+mod triangle;
 
+pub use plane::Plane;
 pub use sphere::Sphere;
+pub use triangle::Triangle;
 
 use crate::math::{Aabb, DVec2, Ray, Vec3};
 
@@ -107,6 +111,19 @@ pub(crate) fn positive(what: &'static str, value: f64) -> Result<f64, ShapeError
     }
 }
 
+/// `v` scaled to unit length, or `None` when it is zero or not finite.
+///
+/// Scales by the largest component first, so vectors whose squared length
+/// would underflow or overflow (a normal of length 1e-200 or 1e200) still
+/// normalise.
+pub(crate) fn unit(v: Vec3) -> Option<Vec3> {
+    let largest = v.abs().max_element();
+    if !(largest.is_finite() && largest > 0.0) {
+        return None;
+    }
+    (v / largest).try_normalize()
+}
+
 /// Checks that every component of `v` is finite.
 pub(crate) fn finite(what: &'static str, v: Vec3) -> Result<Vec3, ShapeError> {
     if v.is_finite() {
@@ -121,6 +138,10 @@ pub(crate) fn finite(what: &'static str, v: Vec3) -> Result<Vec3, ShapeError> {
 pub enum Shape {
     /// A sphere.
     Sphere(Sphere),
+    /// An infinite plane.
+    Plane(Plane),
+    /// A single triangle.
+    Triangle(Triangle),
 }
 
 const _: () = assert!(std::mem::size_of::<Shape>() <= 80);
@@ -129,6 +150,8 @@ macro_rules! dispatch {
     ($self:expr, $s:ident => $body:expr) => {
         match $self {
             Shape::Sphere($s) => $body,
+            Shape::Plane($s) => $body,
+            Shape::Triangle($s) => $body,
         }
     };
 }
@@ -160,6 +183,8 @@ impl Shape {
     pub fn kind(&self) -> &'static str {
         match self {
             Shape::Sphere(_) => "sphere",
+            Shape::Plane(_) => "plane",
+            Shape::Triangle(_) => "triangle",
         }
     }
 }

@@ -1,0 +1,363 @@
+//! A single triangle given by its three vertices.
+//!
+//! Scene syntax: `shape = "triangle"`,
+//! `vertices = [[x0, y0, z0], [x1, y1, z1], [x2, y2, z2]]`.
+//!
+//! The front faces the viewer who sees the vertices counter-clockwise: the
+//! normal is `normalize((p1 - p0) × (p2 - p0))`. Texture coordinates are the
+//! barycentric coordinates `(u, v) = (b1, b2)` of the point
+//! `b0 p0 + b1 p1 + b2 p2`, so `p0` is at (0, 0), `p1` at (1, 0) and `p2` at
+//! (0, 1); `dpdu = p1 - p0`.
+//!
+//! Intersection is the watertight test of Woop, Benthin and Wald ("Watertight
+//! Ray/Triangle Intersection", JCGT 2013) with the conservative bound on `t`
+//! of pbrt-v4 (`IntersectTriangle` in `src/pbrt/shapes.h`): a ray through an
+//! edge shared by two triangles hits at least one of them, and a ray leaving
+//! the surface is never taken to hit it again.
+
+use super::{LocalSurface, ShapeError, ShapeHit, finite};
+use crate::math::{Aabb, DVec2, Ray, Vec3, gamma};
+
+/// Vertices count as collinear when the sine of the angle at `p0` is below
+/// this: such a needle's normal would be rounding noise.
+const COLLINEAR: f64 = 1e-12;
+
+/// A triangle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    p0: Vec3,
+    p1: Vec3,
+    p2: Vec3,
+}
+
+impl Triangle {
+    /// The triangle `p0, p1, p2`; refused when the vertices are collinear or
+    /// two of them coincide.
+    pub fn new(p0: Vec3, p1: Vec3, p2: Vec3) -> Result<Self, ShapeError> {
+        let (p0, p1, p2) = (
+            finite("vertex", p0)?,
+            finite("vertex", p1)?,
+            finite("vertex", p2)?,
+        );
+        let (edge1, edge2) = (p1 - p0, p2 - p0);
+        let cross = edge1.cross(edge2);
+        let flat = cross.length() <= COLLINEAR * edge1.length() * edge2.length();
+        if flat || cross.try_normalize().is_none() {
+            return Err(ShapeError::Degenerate {
+                shape: "triangle",
+                why: "its vertices are collinear or coincide",
+            });
+        }
+        Ok(Self { p0, p1, p2 })
+    }
+
+    /// The three vertices, in the order given.
+    pub fn vertices(&self) -> [Vec3; 3] {
+        [self.p0, self.p1, self.p2]
+    }
+
+    /// The closest hit in the ray's interval, with the barycentric
+    /// coordinates `b1, b2` in `u, v`.
+    pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+        // Move to a space where the ray starts at the origin and runs along
+        // +z (a permutation, then a shear), so the test is 2D.
+        let kz = ray.dir.abs().max_position();
+        let kx = (kz + 1) % 3;
+        let ky = (kx + 1) % 3;
+        let permute = |v: Vec3| Vec3::new(v[kx], v[ky], v[kz]);
+        let d = permute(ray.dir);
+        let shear = Vec3::new(-d.x / d.z, -d.y / d.z, 1.0 / d.z);
+        let to_ray_space = |p: Vec3| {
+            let p = permute(p - ray.origin);
+            Vec3::new(p.x + shear.x * p.z, p.y + shear.y * p.z, p.z)
+        };
+        let (mut a, mut b, mut c) = (
+            to_ray_space(self.p0),
+            to_ray_space(self.p1),
+            to_ray_space(self.p2),
+        );
+
+        // Edge functions: twice the signed areas opposite each vertex. An
+        // edge shared with a neighbour gives the same value, negated, there.
+        let e0 = b.x * c.y - b.y * c.x;
+        let e1 = c.x * a.y - c.y * a.x;
+        let e2 = a.x * b.y - a.y * b.x;
+        let negative = e0 < 0.0 || e1 < 0.0 || e2 < 0.0;
+        let positive = e0 > 0.0 || e1 > 0.0 || e2 > 0.0;
+        if negative && positive {
+            return None;
+        }
+        let det = e0 + e1 + e2;
+        if det == 0.0 {
+            return None;
+        }
+        a.z *= shear.z;
+        b.z *= shear.z;
+        c.z *= shear.z;
+        let t = (e0 * a.z + e1 * b.z + e2 * c.z) / det;
+        if !ray.contains(t) {
+            return None;
+        }
+
+        // Error bounds of pbrt-v4 (section 6.8.4): reject a `t` that is not
+        // conservatively positive, and edge functions that are all rounding
+        // noise (a ray lying in the triangle's plane).
+        let max_x = Vec3::new(a.x, b.x, c.x).abs().max_element();
+        let max_y = Vec3::new(a.y, b.y, c.y).abs().max_element();
+        let max_z = Vec3::new(a.z, b.z, c.z).abs().max_element();
+        let delta_x = gamma(5) * (max_x + max_z);
+        let delta_y = gamma(5) * (max_y + max_z);
+        let delta_z = gamma(3) * max_z;
+        let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+        if det.abs() <= 3.0 * delta_e {
+            return None;
+        }
+        let max_e = Vec3::new(e0, e1, e2).abs().max_element();
+        let delta_t =
+            3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) / det.abs();
+        if t <= delta_t {
+            return None;
+        }
+        Some(ShapeHit {
+            t,
+            u: e1 / det,
+            v: e2 / det,
+            part: 0,
+        })
+    }
+
+    /// True when the ray meets the triangle in its interval.
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.intersect(ray).is_some()
+    }
+
+    /// The surface at a hit: the point rebuilt from its barycentric
+    /// coordinates, which lies on the triangle up to the bound
+    /// `γ(7) (|b0 p0| + |b1 p1| + |b2 p2|)` (pbrt-v4 eq. 6.31).
+    pub fn surface(&self, _ray: &Ray, hit: &ShapeHit) -> LocalSurface {
+        let (b1, b2) = (hit.u, hit.v);
+        let b0 = 1.0 - b1 - b2;
+        let (w0, w1, w2) = (b0 * self.p0, b1 * self.p1, b2 * self.p2);
+        let edge = self.p1 - self.p0;
+        LocalSurface {
+            point: w0 + w1 + w2,
+            point_error: gamma(7) * (w0.abs() + w1.abs() + w2.abs()),
+            // Cannot fail: the constructor refused triangles whose cross
+            // product does not normalise.
+            normal: edge.cross(self.p2 - self.p0).normalize(),
+            uv: DVec2::new(b1, b2),
+            dpdu: edge,
+        }
+    }
+
+    /// The bounding box of the vertices.
+    pub fn bounds(&self) -> Aabb {
+        Aabb::from_points([self.p0, self.p1, self.p2])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::random::Rng;
+    use crate::shape::testing::{assert_no_self_intersection, assert_surface_is_sane};
+    use crate::shape::{Shape, ShapeError};
+
+    fn unit() -> Triangle {
+        Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y).unwrap()
+    }
+
+    #[test]
+    fn ray_in_front_hits_with_exact_t_barycentrics_and_normal() {
+        let ray = Ray::new(Vec3::new(0.25, 0.5, 2.0), Vec3::new(0.0, 0.0, -4.0));
+        let hit = unit().intersect(&ray).unwrap();
+        assert_eq!(hit.t, 0.5);
+        assert_eq!((hit.u, hit.v), (0.25, 0.5));
+        let s = unit().surface(&ray, &hit);
+        assert_eq!(s.normal, Vec3::Z);
+        assert_eq!(s.point, Vec3::new(0.25, 0.5, 0.0));
+    }
+
+    #[test]
+    fn back_side_is_hit_and_keeps_the_counter_clockwise_normal() {
+        let ray = Ray::new(Vec3::new(0.25, 0.25, -1.0), Vec3::Z);
+        let hit = unit().intersect(&ray).unwrap();
+        assert_eq!(hit.t, 1.0);
+        assert_eq!(unit().surface(&ray, &hit).normal, Vec3::Z);
+    }
+
+    #[test]
+    fn clockwise_vertices_face_the_other_way() {
+        let flipped = Triangle::new(Vec3::ZERO, Vec3::Y, Vec3::X).unwrap();
+        let ray = Ray::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z);
+        let hit = flipped.intersect(&ray).unwrap();
+        assert_eq!(flipped.surface(&ray, &hit).normal, -Vec3::Z);
+    }
+
+    #[test]
+    fn triangle_behind_the_ray_is_missed() {
+        let ray = Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::Z);
+        assert_eq!(unit().intersect(&ray), None);
+        assert!(!unit().occluded(&ray));
+    }
+
+    #[test]
+    fn ray_passing_beside_the_hypotenuse_is_missed() {
+        let ray = Ray::new(Vec3::new(0.5 + 1e-9, 0.5, 1.0), -Vec3::Z);
+        assert_eq!(unit().intersect(&ray), None);
+        let inside = Ray::new(Vec3::new(0.5 - 1e-9, 0.5, 1.0), -Vec3::Z);
+        assert!(unit().intersect(&inside).is_some());
+    }
+
+    #[test]
+    fn rays_exactly_through_a_vertex_or_an_edge_hit_without_nan() {
+        let edges = [Vec3::new(0.5, 0.0, 0.0), Vec3::new(0.0, 0.5, 0.0)];
+        for target in [Vec3::X, Vec3::Y, Vec3::ZERO, Vec3::new(0.5, 0.5, 0.0)]
+            .iter()
+            .chain(&edges)
+        {
+            let ray = Ray::new(*target + Vec3::new(0.0, 0.0, 3.0), -Vec3::Z);
+            let hit = unit().intersect(&ray).unwrap();
+            let s = unit().surface(&ray, &hit);
+            assert_eq!(s.point, *target);
+            assert!(s.uv.is_finite() && s.normal == Vec3::Z);
+        }
+    }
+
+    #[test]
+    fn rays_in_the_plane_of_the_triangle_miss_without_nan() {
+        let tilted = Triangle::new(
+            Vec3::new(0.1, 0.2, 0.3),
+            Vec3::new(1.7, -0.4, 0.9),
+            Vec3::new(-0.3, 1.1, 2.0),
+        )
+        .unwrap();
+        let [p0, p1, p2] = tilted.vertices();
+        let centroid = (p0 + p1 + p2) / 3.0;
+        for (triangle, origin, dir) in [
+            (unit(), Vec3::new(-1.0, 0.25, 0.0), Vec3::X),
+            (unit(), Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0)),
+            (tilted, centroid - (p1 - p0), p1 - p0),
+            (tilted, centroid + (p2 - p1), p1 - p2),
+        ] {
+            let ray = Ray::new(origin, dir);
+            assert_eq!(triangle.intersect(&ray), None, "{origin} {dir}");
+            assert!(!triangle.occluded(&ray));
+        }
+    }
+
+    #[test]
+    fn ray_starting_on_the_triangle_does_not_hit_it() {
+        for dir in [Vec3::Z, -Vec3::Z, Vec3::new(1.0, 2.0, -0.5)] {
+            let ray = Ray::new(Vec3::new(0.25, 0.25, 0.0), dir);
+            assert_eq!(unit().intersect(&ray), None);
+        }
+    }
+
+    #[test]
+    fn ray_parallel_to_the_plane_above_it_is_missed() {
+        let ray = Ray::new(Vec3::new(-1.0, 0.2, 1e-9), Vec3::X);
+        assert_eq!(unit().intersect(&ray), None);
+    }
+
+    #[test]
+    fn hits_at_or_beyond_t_max_are_ignored() {
+        let ray = Ray::segment(Vec3::new(0.2, 0.2, 2.0), -Vec3::Z, 2.0);
+        assert_eq!(unit().intersect(&ray), None);
+    }
+
+    #[test]
+    fn direction_length_does_not_change_the_hit_point() {
+        for scale in [1e-3, 1.0, 1e4] {
+            let ray = Ray::new(Vec3::new(0.3, 0.3, 1.0), Vec3::new(0.0, 0.0, -scale));
+            let hit = unit().intersect(&ray).unwrap();
+            assert!((hit.t * scale - 1.0).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn collinear_or_coincident_vertices_are_refused() {
+        let degenerate = ShapeError::Degenerate {
+            shape: "triangle",
+            why: "its vertices are collinear or coincide",
+        };
+        let a = Vec3::new(0.1, 0.2, 0.3);
+        let b = Vec3::new(1.3, -0.7, 2.9);
+        assert_eq!(
+            Triangle::new(a, b, 0.25 * a + 0.75 * b),
+            Err(degenerate.clone())
+        );
+        assert_eq!(Triangle::new(a, a, b), Err(degenerate.clone()));
+        assert_eq!(Triangle::new(a, a, a), Err(degenerate));
+        assert_eq!(
+            Triangle::new(a, b, Vec3::new(0.0, f64::NAN, 0.0)),
+            Err(ShapeError::NotFinite { what: "vertex" })
+        );
+    }
+
+    #[test]
+    fn uv_are_the_barycentrics_and_dpdu_follows_the_first_edge() {
+        let (p0, p1, p2) = (
+            Vec3::new(1.0, 2.0, 3.0),
+            Vec3::new(4.0, 2.0, 1.0),
+            Vec3::new(0.0, 5.0, 2.0),
+        );
+        let triangle = Triangle::new(p0, p1, p2).unwrap();
+        let target = p0 + 0.2 * (p1 - p0) + 0.3 * (p2 - p0);
+        let normal = (p1 - p0).cross(p2 - p0).normalize();
+        let ray = Ray::new(target + 2.0 * normal, -normal);
+        let s = triangle.surface(&ray, &triangle.intersect(&ray).unwrap());
+        assert!((s.uv - DVec2::new(0.2, 0.3)).length() < 1e-12);
+        assert_eq!(s.dpdu, p1 - p0);
+        assert!((s.normal - normal).length() < 1e-15);
+    }
+
+    #[test]
+    fn rays_through_a_shared_edge_never_slip_between_two_triangles() {
+        let (a, b) = (Vec3::new(0.1, -0.3, 0.2), Vec3::new(0.9, 1.1, -0.4));
+        let left = Triangle::new(a, b, Vec3::new(-1.0, 0.8, 0.1)).unwrap();
+        let right = Triangle::new(b, a, Vec3::new(1.3, -0.9, 0.3)).unwrap();
+        let mut rng = Rng::new(17);
+        for _ in 0..10_000 {
+            let target = a + rng.uniform() * (b - a);
+            let origin = Vec3::new(0.3, 0.2, 3.0) + rng.unit_vector();
+            let ray = Ray::new(origin, target - origin);
+            assert!(
+                left.intersect(&ray).is_some() || right.intersect(&ray).is_some(),
+                "{origin} -> {target}"
+            );
+        }
+    }
+
+    #[test]
+    fn secondary_rays_never_hit_the_triangle_they_leave() {
+        let shapes = [
+            [Vec3::ZERO, Vec3::X, Vec3::Y],
+            [
+                Vec3::new(0.3, -1.2, 0.4),
+                Vec3::new(2.1, 0.7, -0.8),
+                Vec3::new(-0.6, 0.9, 1.5),
+            ],
+            [
+                Vec3::new(1e4, 1e4, -1e4),
+                Vec3::new(1e4 + 3.0, 1e4 - 1.0, -1e4 + 2.0),
+                Vec3::new(1e4 - 1.0, 1e4 + 2.5, -1e4 + 0.5),
+            ],
+            [
+                Vec3::ZERO,
+                Vec3::new(1e-3, 2e-4, 0.0),
+                Vec3::new(0.0, 1e-3, 1e-3),
+            ],
+            [
+                Vec3::ZERO,
+                Vec3::new(1e4, 0.0, 0.0),
+                Vec3::new(0.0, 5e3, 1e4),
+            ],
+        ];
+        for [p0, p1, p2] in shapes {
+            let shape = Shape::Triangle(Triangle::new(p0, p1, p2).unwrap());
+            assert_no_self_intersection(&shape, 13);
+            assert_surface_is_sane(&shape, 19);
+        }
+    }
+}
