@@ -192,6 +192,7 @@ fn build_step(r: &mut Reader<'_>, key: &str, value: &Value<'_>) -> Parsed<Transf
 #[cfg(test)]
 mod tests {
     use super::super::tests::{CAMERA, errors, scene};
+    use super::SHAPE_KINDS;
     use crate::material::{Material, MaterialId};
     use crate::math::{Transform, Vec3};
     use crate::scene::{Scene, TransformId};
@@ -261,6 +262,8 @@ mod tests {
 
     #[test]
     fn every_object_error_is_reported() {
+        let kinds: Vec<&str> = SHAPE_KINDS.iter().map(|kind| kind.name).collect();
+        let kinds = kinds.join(", ");
         assert_eq!(
             errors(&format!(
                 "{CAMERA}[materials.glass]\n\
@@ -271,7 +274,7 @@ mod tests {
             [
                 "missing required key `shape` in object",
                 "unknown material `glas`; the materials defined are: glass",
-                "unknown shape `blob`; expected one of: sphere",
+                &format!("unknown shape `blob`; expected one of: {kinds}"),
                 "missing required key `radius` in object",
                 "unknown key `radiuss` in object; expected one of: shape, material, transform, \
                  center, radius",

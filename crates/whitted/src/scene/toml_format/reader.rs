@@ -358,6 +358,12 @@ impl<'s> Reader<'s> {
             .map(Vec3::from_array)
     }
 
+    /// A list of points `[[x, y, z], ...]`.
+    pub(super) fn points(&mut self, value: &Value<'_>, key: &str) -> Parsed<Vec<Vec3>> {
+        let items = self.array(value, key, "a list of points [[x, y, z], ...]")?;
+        all(items.iter().map(|item| self.vec3(item, key)))
+    }
+
     /// A non-zero vector `[x, y, z]`, normalised.
     pub(super) fn direction(&mut self, value: &Value<'_>, key: &str) -> Parsed<Vec3> {
         let v = self.vec3(value, key)?;

@@ -17,7 +17,7 @@ use toml_span::Span;
 
 use super::reader::{Fields, Parsed, Reader, Reported};
 use crate::math::{Transform, Vec3};
-use crate::shape::{Shape, ShapeError, Sphere};
+use crate::shape::{Plane, Shape, ShapeError, Sphere, Triangle};
 
 /// A shape in its object space and where that space sits before the
 /// object's own transform.
@@ -50,11 +50,23 @@ pub(super) struct ShapeKind {
 }
 
 /// Every kind of shape the format knows.
-pub(super) const SHAPE_KINDS: &[ShapeKind] = &[ShapeKind {
-    name: "sphere",
-    keys: &["center", "radius"],
-    build: sphere,
-}];
+pub(super) const SHAPE_KINDS: &[ShapeKind] = &[
+    ShapeKind {
+        name: "sphere",
+        keys: &["center", "radius"],
+        build: sphere,
+    },
+    ShapeKind {
+        name: "plane",
+        keys: &["point", "normal"],
+        build: plane,
+    },
+    ShapeKind {
+        name: "triangle",
+        keys: &["vertices"],
+        build: triangle,
+    },
+];
 
 /// Reads an object's shape keys as `kind`.
 pub(super) fn build(
@@ -84,6 +96,29 @@ fn sphere(r: &mut Reader<'_>, f: &Fields<'_, '_>, at: Span) -> Parsed<Placed> {
     Ok(Placed::in_place(Shape::Sphere(sphere)))
 }
 
+fn plane(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Placed> {
+    let point = r.require(f, "point", Reader::vec3);
+    let normal = r.require(f, "normal", Reader::vec3);
+    let at = r.value_span(f, "normal");
+    let plane = Plane::new(point?, normal?).map_err(|e| refused(r, f, at, e))?;
+    Ok(Placed::in_place(Shape::Plane(plane)))
+}
+
+fn triangle(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Placed> {
+    let [p0, p1, p2] = r.require(f, "vertices", |r, value, key| {
+        let points = r.points(value, key)?;
+        <[Vec3; 3]>::try_from(points).map_err(|points| {
+            r.error(
+                value.span,
+                format!("expected 3 points for `{key}`, found {}", points.len()),
+            )
+        })
+    })?;
+    let at = r.value_span(f, "vertices");
+    let triangle = Triangle::new(p0, p1, p2).map_err(|e| refused(r, f, at, e))?;
+    Ok(Placed::in_place(Shape::Triangle(triangle)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::tests::{CAMERA, errors, scene};
@@ -105,6 +140,42 @@ mod tests {
         assert_eq!(
             shape("shape = 'sphere'\ncenter = [1, 2, 3]\nradius = 0.5"),
             Shape::Sphere(Sphere::new(Vec3::new(1.0, 2.0, 3.0), 0.5).unwrap())
+        );
+    }
+
+    #[test]
+    fn planes_are_read() {
+        assert_eq!(
+            shape("shape = 'plane'\npoint = [0, -1, 0]\nnormal = [0, 2, 0]"),
+            Shape::Plane(Plane::new(-Vec3::Y, Vec3::Y).unwrap())
+        );
+    }
+
+    #[test]
+    fn triangles_are_read() {
+        let [a, b, c] = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        assert_eq!(
+            shape("shape = 'triangle'\nvertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]"),
+            Shape::Triangle(Triangle::new(a, b, c).unwrap())
+        );
+    }
+
+    #[test]
+    fn refused_flat_shapes_are_reported_at_their_defining_values() {
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[[objects]]\nshape = 'plane'\npoint = [0, 0, 0]\nnormal = [0, 0, 0]\n\
+                 [[objects]]\nshape = 'triangle'\nvertices = [[0, 0, 0], [1, 1, 1], [2, 2, 2]]\n\
+                 [[objects]]\nshape = 'triangle'\nvertices = [[0, 0, 0], [1, 1, 1]]\n\
+                 [[objects]]\nshape = 'triangle'\nvertices = [[0, 0, 0], 1, [0, 0]]\n"
+            )),
+            [
+                "degenerate plane: the normal has zero length",
+                "degenerate triangle: its vertices are collinear or coincide",
+                "expected 3 points for `vertices`, found 2",
+                "expected an array of 3 numbers for `vertices`, found an integer",
+                "expected 3 numbers for `vertices`, found 2",
+            ]
         );
     }
 
