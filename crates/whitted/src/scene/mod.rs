@@ -79,7 +79,24 @@ pub struct Scene {
     pub primitives: Vec<Primitive>,
 }
 
+/// The text of the built-in scene, `scenes/whitted.toml`: a homage to
+/// Whitted's 1980 picture (a mirror and a glass sphere over a checkered
+/// floor).
+pub const DEFAULT_SCENE: &str = include_str!("../../../../scenes/whitted.toml");
+
 impl Scene {
+    /// The built-in scene, [`DEFAULT_SCENE`].
+    ///
+    /// # Panics
+    ///
+    /// Never in a released build: the text is compiled in and the test
+    /// `default_scene_parses` proves it valid, so a failure here can only be
+    /// a broken build.
+    pub fn default_scene() -> Self {
+        parse_scene(DEFAULT_SCENE, std::path::Path::new("scenes/whitted.toml"))
+            .unwrap_or_else(|error| panic!("the built-in scene is invalid:\n{error}"))
+    }
+
     /// An empty scene seen by `camera`, with default settings, a black
     /// background and no ambient light.
     pub fn new(camera: Camera) -> Self {
@@ -113,5 +130,18 @@ impl Scene {
             material,
             transform,
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_scene_parses() {
+        let scene = Scene::default_scene();
+        assert_eq!(scene.primitives.len(), 3);
+        assert_eq!(scene.lights.len(), 2);
+        assert_eq!((scene.settings.width, scene.settings.height), (640, 480));
     }
 }
