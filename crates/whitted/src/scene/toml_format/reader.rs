@@ -170,7 +170,8 @@ impl<'s> Reader<'s> {
         }
     }
 
-    /// The array `value`: `hint` says how to write one.
+    /// The array `value`; `expected` names what it should hold, for the
+    /// message when it is something else.
     pub(super) fn array<'t, 'd>(
         &mut self,
         value: &'t Value<'d>,
