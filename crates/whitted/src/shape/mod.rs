@@ -19,12 +19,16 @@
 //! are refused by the constructors with a [`ShapeError`]; no test ever
 //! produces NaN.
 
+mod parallelogram;
 mod plane;
+mod polygon;
 mod quadratic;
 mod sphere;
 mod triangle;
 
+pub use parallelogram::Parallelogram;
 pub use plane::Plane;
+pub use polygon::Polygon;
 pub use sphere::Sphere;
 pub use triangle::Triangle;
 
@@ -98,6 +102,19 @@ pub enum ShapeError {
         /// What makes it degenerate.
         why: &'static str,
     },
+    /// The vertices of a polygon are not in one plane.
+    #[error(
+        "the polygon is not planar: vertex {vertex} lies {deviation:e} off its plane \
+         (the tolerance is {tolerance:e})"
+    )]
+    NotPlanar {
+        /// Which vertex (counting from 0) is off the plane.
+        vertex: usize,
+        /// Its distance from the plane.
+        deviation: f64,
+        /// The largest distance allowed.
+        tolerance: f64,
+    },
 }
 
 /// Checks that `value` is finite and positive.
@@ -142,6 +159,10 @@ pub enum Shape {
     Plane(Plane),
     /// A single triangle.
     Triangle(Triangle),
+    /// A parallelogram (or rectangle).
+    Parallelogram(Parallelogram),
+    /// A planar polygon, convex or concave.
+    Polygon(Polygon),
 }
 
 const _: () = assert!(std::mem::size_of::<Shape>() <= 80);
@@ -152,6 +173,8 @@ macro_rules! dispatch {
             Shape::Sphere($s) => $body,
             Shape::Plane($s) => $body,
             Shape::Triangle($s) => $body,
+            Shape::Parallelogram($s) => $body,
+            Shape::Polygon($s) => $body,
         }
     };
 }
@@ -185,6 +208,8 @@ impl Shape {
             Shape::Sphere(_) => "sphere",
             Shape::Plane(_) => "plane",
             Shape::Triangle(_) => "triangle",
+            Shape::Parallelogram(_) => "parallelogram",
+            Shape::Polygon(_) => "polygon",
         }
     }
 }
