@@ -17,7 +17,7 @@ use toml_span::Span;
 
 use super::reader::{Fields, Parsed, Reader, Reported};
 use crate::math::{Transform, Vec3};
-use crate::shape::{Plane, Shape, ShapeError, Sphere, Triangle};
+use crate::shape::{Parallelogram, Plane, Polygon, Shape, ShapeError, Sphere, Triangle};
 
 /// A shape in its object space and where that space sits before the
 /// object's own transform.
@@ -66,6 +66,16 @@ pub(super) const SHAPE_KINDS: &[ShapeKind] = &[
         keys: &["vertices"],
         build: triangle,
     },
+    ShapeKind {
+        name: "polygon",
+        keys: &["vertices"],
+        build: polygon,
+    },
+    ShapeKind {
+        name: "parallelogram",
+        keys: &["origin", "edge_u", "edge_v"],
+        build: parallelogram,
+    },
 ];
 
 /// Reads an object's shape keys as `kind`.
@@ -83,7 +93,7 @@ pub(super) fn build(
 fn refused(r: &mut Reader<'_>, f: &Fields<'_, '_>, fallback: Span, error: ShapeError) -> Reported {
     let named = match &error {
         ShapeError::NotPositive { what, .. } | ShapeError::NotFinite { what } => f.get(what),
-        ShapeError::Degenerate { .. } => None,
+        ShapeError::Degenerate { .. } | ShapeError::NotPlanar { .. } => None,
     };
     let span = named.map_or(fallback, |value| r.span_of(value));
     r.error(span, error.to_string())
@@ -117,6 +127,31 @@ fn triangle(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Placed> {
     let at = r.value_span(f, "vertices");
     let triangle = Triangle::new(p0, p1, p2).map_err(|e| refused(r, f, at, e))?;
     Ok(Placed::in_place(Shape::Triangle(triangle)))
+}
+
+fn polygon(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Placed> {
+    let vertices = r.require(f, "vertices", Reader::points)?;
+    let polygon = Polygon::new(vertices).map_err(|e| {
+        let mut at = r.value_span(f, "vertices");
+        if let ShapeError::NotPlanar { vertex, .. } = e {
+            let off_plane = f
+                .get("vertices")
+                .and_then(|list| list.as_array())
+                .and_then(|list| list.get(vertex));
+            at = off_plane.map_or(at, |value| value.span);
+        }
+        refused(r, f, at, e)
+    })?;
+    Ok(Placed::in_place(Shape::Polygon(polygon)))
+}
+
+fn parallelogram(r: &mut Reader<'_>, f: &Fields<'_, '_>, at: Span) -> Parsed<Placed> {
+    let origin = r.require(f, "origin", Reader::vec3);
+    let edge_u = r.require(f, "edge_u", Reader::vec3);
+    let edge_v = r.require(f, "edge_v", Reader::vec3);
+    let parallelogram =
+        Parallelogram::new(origin?, edge_u?, edge_v?).map_err(|e| refused(r, f, at, e))?;
+    Ok(Placed::in_place(Shape::Parallelogram(parallelogram)))
 }
 
 #[cfg(test)]
@@ -161,13 +196,39 @@ mod tests {
     }
 
     #[test]
+    fn polygons_are_read() {
+        let square = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]];
+        let points = square.map(|[x, y, z]| Vec3::new(x.into(), y.into(), z.into()));
+        assert_eq!(
+            shape(&format!("shape = 'polygon'\nvertices = {square:?}")),
+            Shape::Polygon(Polygon::new(points.to_vec()).unwrap())
+        );
+    }
+
+    #[test]
+    fn parallelograms_are_read() {
+        assert_eq!(
+            shape(
+                "shape = 'parallelogram'\norigin = [1, 0, 0]\nedge_u = [0, 0, 2]\nedge_v = [3, 0, 0]"
+            ),
+            Shape::Parallelogram(
+                Parallelogram::new(Vec3::X, Vec3::new(0.0, 0.0, 2.0), Vec3::new(3.0, 0.0, 0.0))
+                    .unwrap()
+            )
+        );
+    }
+
+    #[test]
     fn refused_flat_shapes_are_reported_at_their_defining_values() {
         assert_eq!(
             errors(&format!(
                 "{CAMERA}[[objects]]\nshape = 'plane'\npoint = [0, 0, 0]\nnormal = [0, 0, 0]\n\
                  [[objects]]\nshape = 'triangle'\nvertices = [[0, 0, 0], [1, 1, 1], [2, 2, 2]]\n\
                  [[objects]]\nshape = 'triangle'\nvertices = [[0, 0, 0], [1, 1, 1]]\n\
-                 [[objects]]\nshape = 'triangle'\nvertices = [[0, 0, 0], 1, [0, 0]]\n"
+                 [[objects]]\nshape = 'triangle'\nvertices = [[0, 0, 0], 1, [0, 0]]\n\
+                 [[objects]]\nshape = 'polygon'\nvertices = [[0, 0, 0], [1, 0, 0]]\n\
+                 [[objects]]\nshape = 'parallelogram'\norigin = [0, 0, 0]\n\
+                 edge_u = [1, 0, 0]\nedge_v = [2, 0, 0]\n"
             )),
             [
                 "degenerate plane: the normal has zero length",
@@ -175,8 +236,35 @@ mod tests {
                 "expected 3 points for `vertices`, found 2",
                 "expected an array of 3 numbers for `vertices`, found an integer",
                 "expected 3 numbers for `vertices`, found 2",
+                "degenerate polygon: it needs at least three vertices",
+                "degenerate parallelogram: its edges are parallel or of zero length",
             ]
         );
+    }
+
+    #[test]
+    fn a_polygon_off_its_plane_is_reported_at_the_stray_vertex() {
+        let source = format!(
+            "{CAMERA}[[objects]]\nshape = 'polygon'\n\
+             vertices = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 1.5, 1]]\n"
+        );
+        let Err(crate::scene::SceneError::Invalid { diagnostics }) =
+            crate::scene::parse_scene(&source, std::path::Path::new("t.toml"))
+        else {
+            panic!("the polygon was accepted");
+        };
+        let [d] = diagnostics.as_slice() else {
+            panic!("{diagnostics:?}");
+        };
+        assert!(d.message.starts_with("the polygon is not planar: vertex "));
+        let vertex: usize = d.message["the polygon is not planar: vertex ".len()..]
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        let starts = [13, 24, 35, 46, 57];
+        assert_eq!(d.column, starts[vertex], "{d}");
     }
 
     #[test]
