@@ -21,7 +21,7 @@
 use toml_span::value::Value;
 
 use super::reader::{Parsed, Reader, all, list};
-use super::shapes::{self, SHAPE_KINDS};
+use super::shapes;
 use crate::math::{Transform, TransformError, Vec3};
 use crate::shape::Shape;
 
@@ -58,18 +58,7 @@ fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> P
     let f = r.table(value, "objects", "object")?;
     let kind = r
         .require(&f, "shape", Reader::string)
-        .and_then(
-            |(name, span)| match SHAPE_KINDS.iter().find(|kind| kind.name == name) {
-                Some(kind) => Ok((kind, span)),
-                None => Err(r.error(
-                    span,
-                    format!(
-                        "unknown shape `{name}`; expected one of: {}",
-                        list(&SHAPE_KINDS.iter().map(|k| k.name).collect::<Vec<_>>())
-                    ),
-                )),
-            },
-        );
+        .and_then(|(name, span)| Ok((shapes::find(r, name, span)?, span)));
     let material = r.optional(&f, "material", |r, value, key| {
         let (name, span) = r.string(value, key)?;
         materials
@@ -192,7 +181,7 @@ fn build_step(r: &mut Reader<'_>, key: &str, value: &Value<'_>) -> Parsed<Transf
 #[cfg(test)]
 mod tests {
     use super::super::tests::{CAMERA, errors, scene};
-    use super::SHAPE_KINDS;
+    use super::shapes::SHAPE_KINDS;
     use crate::material::{Material, MaterialId};
     use crate::math::{Transform, Vec3};
     use crate::scene::{Scene, TransformId};

@@ -15,7 +15,7 @@
 
 use toml_span::Span;
 
-use super::reader::{Fields, Parsed, Reader, Reported};
+use super::reader::{Fields, Parsed, Reader, Reported, list};
 use crate::math::{Transform, Vec3};
 use crate::shape::{Parallelogram, Plane, Polygon, Shape, ShapeError, Sphere, Triangle};
 
@@ -77,6 +77,20 @@ pub(super) const SHAPE_KINDS: &[ShapeKind] = &[
         build: parallelogram,
     },
 ];
+
+/// The kind called `name`, written at `span`.
+pub(super) fn find(r: &mut Reader<'_>, name: &str, span: Span) -> Parsed<&'static ShapeKind> {
+    SHAPE_KINDS
+        .iter()
+        .find(|kind| kind.name == name)
+        .ok_or_else(|| {
+            let names: Vec<&str> = SHAPE_KINDS.iter().map(|kind| kind.name).collect();
+            r.error(
+                span,
+                format!("unknown shape `{name}`; expected one of: {}", list(&names)),
+            )
+        })
+}
 
 /// Reads an object's shape keys as `kind`.
 pub(super) fn build(
@@ -145,10 +159,11 @@ fn polygon(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Placed> {
     Ok(Placed::in_place(Shape::Polygon(polygon)))
 }
 
-fn parallelogram(r: &mut Reader<'_>, f: &Fields<'_, '_>, at: Span) -> Parsed<Placed> {
+fn parallelogram(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Placed> {
     let origin = r.require(f, "origin", Reader::vec3);
     let edge_u = r.require(f, "edge_u", Reader::vec3);
     let edge_v = r.require(f, "edge_v", Reader::vec3);
+    let at = r.value_span(f, "edge_v");
     let parallelogram =
         Parallelogram::new(origin?, edge_u?, edge_v?).map_err(|e| refused(r, f, at, e))?;
     Ok(Placed::in_place(Shape::Parallelogram(parallelogram)))
