@@ -40,7 +40,7 @@ pub(super) struct Fields<'t, 's> {
     table: &'t Table<'s>,
     /// Where the table starts: its `[header]` or its `{`.
     span: Span,
-    /// Its name in messages: "object", "[camera]", "material `glass`".
+    /// Its name in messages: `object`, `[camera]`, ``material `glass` ``.
     what: String,
 }
 
