@@ -203,7 +203,9 @@ mod tests {
 
     use super::*;
     use crate::random::Rng;
-    use crate::shape::testing::{assert_no_self_intersection, assert_surface_is_sane};
+    use crate::shape::testing::{
+        assert_convex_exits_cleanly, assert_no_self_intersection, assert_surface_is_sane,
+    };
     use crate::shape::{Shape, ShapeError};
 
     fn polygon(points: &[(f64, f64)]) -> Polygon {
@@ -463,6 +465,7 @@ mod tests {
             let shape = Shape::Polygon(polygon);
             assert_no_self_intersection(&shape, 31);
             assert_surface_is_sane(&shape, 37);
+            assert_convex_exits_cleanly(&shape, 39);
         }
     }
 }

@@ -63,6 +63,73 @@ pub(crate) fn assert_no_self_intersection(shape: &Shape, seed: u64) {
     );
 }
 
+/// Rays from random directions at `distance` aimed at each of `targets`,
+/// each target first nudged by a random amount in {0, 1e-15, 1e-12, 1e-9}
+/// times `distance`: for aiming at rims, edges and corners.
+pub(crate) fn rays_toward(targets: &[Vec3], distance: f64, seed: u64) -> Vec<Ray> {
+    let mut rng = Rng::new(seed);
+    targets
+        .iter()
+        .map(|&target| {
+            let nudge = [0.0, 1e-15, 1e-12, 1e-9][rng.below(4) as usize];
+            let target = target + nudge * distance * rng.unit_vector();
+            let origin = target + distance * rng.unit_vector();
+            Ray::new(origin, target - origin)
+        })
+        .collect()
+}
+
+/// Rays leaving a hit point on the outer side of the surface (the side the
+/// normal points to) never meet the shape again, at any distance: every
+/// shape is a piece of the boundary of a convex solid (or of a plane), so
+/// nothing of it lies outside a tangent plane. Hit points come from `rays`
+/// (so a test can aim at rims and edges); returns how many were checked.
+pub(crate) fn assert_outward_rays_escape(
+    shape: &Shape,
+    rays: impl IntoIterator<Item = Ray>,
+    seed: u64,
+) -> usize {
+    let mut rng = Rng::new(seed ^ 0x5eed);
+    let mut hits = 0;
+    for ray in rays {
+        let Some(hit) = shape.intersect(&ray) else {
+            continue;
+        };
+        hits += 1;
+        let s = shape.surface(&ray, &hit);
+        for _ in 0..4 {
+            let mut w = rng.unit_vector();
+            if w.dot(s.normal) < 0.0 {
+                w = -w;
+            }
+            let origin = offset_ray_origin(s.point, s.point_error, s.normal, w);
+            let next = Ray::new(origin, w);
+            if let Some(again) = shape.intersect(&next) {
+                panic!(
+                    "{}: outward ray from {origin:?} along {w:?} (normal {:?}, part {}) \
+                     hit the shape again at t = {} (part {})",
+                    shape.kind(),
+                    s.normal,
+                    hit.part,
+                    again.t,
+                    again.part
+                );
+            }
+        }
+    }
+    hits
+}
+
+/// [`assert_outward_rays_escape`] for random rays aimed at the shape.
+pub(crate) fn assert_convex_exits_cleanly(shape: &Shape, seed: u64) {
+    let hits = assert_outward_rays_escape(shape, random_rays(shape, seed, 2000), seed);
+    assert!(
+        hits > 100,
+        "{}: too few random rays hit ({hits})",
+        shape.kind()
+    );
+}
+
 /// Every hit of a random ray has a finite unit normal, finite texture
 /// coordinates, a point on the ray (within a tight tolerance of the shape's
 /// size) and an `occluded` answer that agrees with `intersect`.
