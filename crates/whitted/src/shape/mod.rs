@@ -19,6 +19,8 @@
 //! are refused by the constructors with a [`ShapeError`]; no test ever
 //! produces NaN.
 
+mod axis_box;
+mod cone;
 mod cylinder;
 mod disk;
 mod parallelogram;
@@ -28,6 +30,8 @@ mod quadratic;
 mod sphere;
 mod triangle;
 
+pub use axis_box::AxisBox;
+pub use cone::Cone;
 pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use parallelogram::Parallelogram;
@@ -190,6 +194,10 @@ pub enum Shape {
     Disk(Disk),
     /// A cylinder, open or capped (canonical: along +z from z = 0).
     Cylinder(Cylinder),
+    /// A truncated cone, open or capped (canonical: along +z from z = 0).
+    Cone(Cone),
+    /// A box aligned with the axes.
+    AxisBox(AxisBox),
 }
 
 const _: () = assert!(std::mem::size_of::<Shape>() <= 80);
@@ -204,6 +212,8 @@ macro_rules! dispatch {
             Shape::Polygon($s) => $body,
             Shape::Disk($s) => $body,
             Shape::Cylinder($s) => $body,
+            Shape::Cone($s) => $body,
+            Shape::AxisBox($s) => $body,
         }
     };
 }
@@ -241,6 +251,8 @@ impl Shape {
             Shape::Polygon(_) => "polygon",
             Shape::Disk(_) => "disk",
             Shape::Cylinder(_) => "cylinder",
+            Shape::Cone(_) => "cone",
+            Shape::AxisBox(_) => "box",
         }
     }
 }
