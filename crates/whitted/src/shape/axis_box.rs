@@ -133,8 +133,8 @@ impl AxisBox {
 mod tests {
     use super::*;
     use crate::shape::testing::{
-        assert_convex_exits_cleanly, assert_no_self_intersection, assert_outward_rays_escape,
-        assert_surface_is_sane, rays_toward,
+        assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
+        assert_outward_rays_escape, assert_surface_is_sane, rays_toward,
     };
     use crate::shape::{Shape, ShapeError};
 
@@ -328,6 +328,7 @@ mod tests {
             assert_no_self_intersection(&shape, 107);
             assert_surface_is_sane(&shape, 109);
             assert_convex_exits_cleanly(&shape, 113);
+            assert_no_nan_for_awkward_rays(&shape);
         }
     }
 }

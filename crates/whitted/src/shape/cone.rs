@@ -212,8 +212,8 @@ mod tests {
     use super::*;
     use crate::random::Rng;
     use crate::shape::testing::{
-        assert_convex_exits_cleanly, assert_no_self_intersection, assert_outward_rays_escape,
-        assert_surface_is_sane, rays_toward,
+        assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
+        assert_outward_rays_escape, assert_surface_is_sane, rays_toward,
     };
     use crate::shape::{Cylinder, Shape, ShapeError};
 
@@ -456,6 +456,7 @@ mod tests {
                 let shape = Shape::Cone(Cone::new(radius0, radius1, height, caps).unwrap());
                 assert_surface_is_sane(&shape, 127);
                 assert_convex_exits_cleanly(&shape, 131);
+                assert_no_nan_for_awkward_rays(&shape);
             }
         }
     }
@@ -477,6 +478,7 @@ mod tests {
                 assert_no_self_intersection(&shape, 83);
                 assert_surface_is_sane(&shape, 89);
                 assert_convex_exits_cleanly(&shape, 97);
+                assert_no_nan_for_awkward_rays(&shape);
             }
         }
     }

@@ -154,8 +154,8 @@ impl Cylinder {
 mod tests {
     use super::*;
     use crate::shape::testing::{
-        assert_convex_exits_cleanly, assert_no_self_intersection, assert_outward_rays_escape,
-        assert_surface_is_sane, rays_toward,
+        assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
+        assert_outward_rays_escape, assert_surface_is_sane, rays_toward,
     };
     use crate::shape::{Shape, ShapeError};
 
@@ -337,6 +337,7 @@ mod tests {
                 assert_no_self_intersection(&shape, 47);
                 assert_surface_is_sane(&shape, 53);
                 assert_convex_exits_cleanly(&shape, 55);
+                assert_no_nan_for_awkward_rays(&shape);
             }
         }
     }

@@ -130,7 +130,8 @@ pub(super) fn azimuth(x: f64, y: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::shape::testing::{
-        assert_convex_exits_cleanly, assert_no_self_intersection, assert_surface_is_sane,
+        assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
+        assert_surface_is_sane,
     };
     use crate::shape::{Shape, ShapeError};
 
@@ -263,6 +264,7 @@ mod tests {
             assert_no_self_intersection(&shape, 41);
             assert_surface_is_sane(&shape, 43);
             assert_convex_exits_cleanly(&shape, 45);
+            assert_no_nan_for_awkward_rays(&shape);
         }
     }
 }

@@ -118,7 +118,8 @@ impl Parallelogram {
 mod tests {
     use super::*;
     use crate::shape::testing::{
-        assert_convex_exits_cleanly, assert_no_self_intersection, assert_surface_is_sane,
+        assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
+        assert_surface_is_sane,
     };
     use crate::shape::{Shape, ShapeError};
 
@@ -276,6 +277,7 @@ mod tests {
             assert_no_self_intersection(&shape, 23);
             assert_surface_is_sane(&shape, 29);
             assert_convex_exits_cleanly(&shape, 31);
+            assert_no_nan_for_awkward_rays(&shape);
         }
     }
 }

@@ -102,7 +102,8 @@ impl Sphere {
 mod tests {
     use super::*;
     use crate::shape::testing::{
-        assert_convex_exits_cleanly, assert_no_self_intersection, assert_surface_is_sane,
+        assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
+        assert_surface_is_sane,
     };
     use crate::shape::{Shape, ShapeError};
 
@@ -193,6 +194,7 @@ mod tests {
             assert_no_self_intersection(&shape, 7);
             assert_surface_is_sane(&shape, 11);
             assert_convex_exits_cleanly(&shape, 13);
+            assert_no_nan_for_awkward_rays(&shape);
         }
     }
 }

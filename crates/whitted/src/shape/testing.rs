@@ -156,3 +156,48 @@ pub(crate) fn assert_surface_is_sane(shape: &Shape, seed: u64) {
         );
     }
 }
+
+/// Awkward rays give no NaN: origins at every combination of the bounds'
+/// minimum, centre and maximum per axis (corners, edge and face centres,
+/// points on the surface), directions along every combination of -1, 0 and
+/// 1 per axis (parallel to faces and axes, along diagonals), at lengths
+/// 1e-150, 1 and 1e150. Any hit has a finite `t` in the ray's interval and
+/// a finite surface with a unit normal, and `occluded` agrees.
+pub(crate) fn assert_no_nan_for_awkward_rays(shape: &Shape) {
+    let region = region(shape);
+    let levels = [region.min, region.centroid(), region.max];
+    let steps = [-1.0, 0.0, 1.0];
+    for i in 0..27 {
+        let origin = Vec3::new(levels[i % 3].x, levels[i / 3 % 3].y, levels[i / 9].z);
+        for j in 0..27 {
+            let dir = Vec3::new(steps[j % 3], steps[j / 3 % 3], steps[j / 9]);
+            if dir == Vec3::ZERO {
+                continue;
+            }
+            for length in [1e-150, 1.0, 1e150] {
+                let ray = Ray::new(origin, length * dir);
+                let hit = shape.intersect(&ray);
+                assert_eq!(hit.is_some(), shape.occluded(&ray), "{}", shape.kind());
+                let Some(hit) = hit else { continue };
+                assert!(
+                    hit.t.is_finite()
+                        && ray.contains(hit.t)
+                        && hit.u.is_finite()
+                        && hit.v.is_finite(),
+                    "{}: {hit:?} for {ray:?}",
+                    shape.kind()
+                );
+                let s = shape.surface(&ray, &hit);
+                assert!(
+                    s.point.is_finite()
+                        && s.point_error.is_finite()
+                        && s.uv.is_finite()
+                        && s.dpdu.is_finite()
+                        && (s.normal.length() - 1.0).abs() < 1e-9,
+                    "{}: {s:?} for {ray:?}",
+                    shape.kind()
+                );
+            }
+        }
+    }
+}

@@ -161,7 +161,8 @@ mod tests {
     use super::*;
     use crate::random::Rng;
     use crate::shape::testing::{
-        assert_convex_exits_cleanly, assert_no_self_intersection, assert_surface_is_sane,
+        assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
+        assert_surface_is_sane,
     };
     use crate::shape::{Shape, ShapeError};
 
@@ -361,6 +362,7 @@ mod tests {
             assert_no_self_intersection(&shape, 13);
             assert_surface_is_sane(&shape, 19);
             assert_convex_exits_cleanly(&shape, 17);
+            assert_no_nan_for_awkward_rays(&shape);
         }
     }
 }
