@@ -132,6 +132,7 @@ impl AxisBox {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::random::Rng;
     use crate::shape::testing::{
         assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
         assert_outward_rays_escape, assert_surface_is_sane, rays_toward,
@@ -283,6 +284,43 @@ mod tests {
             let s = shape.surface(&ray, &hit);
             assert_eq!(s.uv, DVec2::new(uv.0, uv.1));
             assert_eq!(s.dpdu, dpdu);
+        }
+    }
+
+    #[test]
+    fn rays_entering_through_an_edge_never_slip_between_faces() {
+        let mut rng = Rng::new(139);
+        for (min, max) in [
+            (Vec3::splat(-1.0), Vec3::ONE),
+            (Vec3::new(0.1, -0.3, 0.7), Vec3::new(0.4, 2.9, 0.8)),
+            (
+                Vec3::new(1e4, -2e4, 3e4),
+                Vec3::new(1e4 + 2.0, -2e4 + 0.5, 3e4 + 1.0),
+            ),
+        ] {
+            let shape = AxisBox::new(min, max).unwrap();
+            let mut entering = 0;
+            for _ in 0..20_000 {
+                // An edge runs along `axis`; it is where the faces across
+                // the two other axes meet.
+                let axis = rng.below(3) as usize;
+                let mut rim = rng.point_in(min, max);
+                let mut normals = [Vec3::ZERO; 2];
+                for (k, normal) in normals.iter_mut().enumerate() {
+                    let across = (axis + 1 + k) % 3;
+                    let high = rng.uniform() < 0.5;
+                    rim[across] = if high { max[across] } else { min[across] };
+                    normal[across] = if high { 1.0 } else { -1.0 };
+                }
+                let dir = rng.unit_vector();
+                if normals.iter().any(|n| dir.dot(*n) > -0.01) {
+                    continue;
+                }
+                entering += 1;
+                let ray = Ray::new(rim - 3.0 * (max - min).length() * dir, dir);
+                assert!(shape.intersect(&ray).is_some(), "{ray:?}");
+            }
+            assert!(entering > 2000, "{entering}");
         }
     }
 

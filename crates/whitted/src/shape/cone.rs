@@ -419,6 +419,38 @@ mod tests {
     }
 
     #[test]
+    fn rays_entering_through_a_rim_never_slip_between_side_and_cap() {
+        let mut rng = Rng::new(137);
+        for (radius0, radius1, height) in [(1.0, 0.3, 2.0), (0.4, 1.1, 0.5), (1e4, 3e3, 3e3)] {
+            let shape = Cone::new(radius0, radius1, height, true).unwrap();
+            let slant = height.hypot(radius0 - radius1);
+            let mut entering = 0;
+            for _ in 0..20_000 {
+                let phi = rng.range(0.0, TAU);
+                let (z, radius, cap_normal) = if rng.uniform() < 0.5 {
+                    (0.0, radius0, -Vec3::Z)
+                } else {
+                    (height, radius1, Vec3::Z)
+                };
+                let side_normal = Vec3::new(
+                    phi.cos() * height / slant,
+                    phi.sin() * height / slant,
+                    (radius0 - radius1) / slant,
+                );
+                let dir = rng.unit_vector();
+                if dir.dot(side_normal) > -0.01 || dir.dot(cap_normal) > -0.01 {
+                    continue;
+                }
+                entering += 1;
+                let rim = Vec3::new(radius * phi.cos(), radius * phi.sin(), z);
+                let ray = Ray::new(rim - 3.0 * slant * dir, dir);
+                assert!(shape.intersect(&ray).is_some(), "{ray:?}");
+            }
+            assert!(entering > 1000, "{entering}");
+        }
+    }
+
+    #[test]
     fn rays_leaving_points_near_the_rims_and_the_apex_escape() {
         for (radius0, radius1, height) in [
             (1.0, 0.0, 1.0),

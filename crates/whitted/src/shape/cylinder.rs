@@ -153,6 +153,7 @@ impl Cylinder {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::random::Rng;
     use crate::shape::testing::{
         assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
         assert_outward_rays_escape, assert_surface_is_sane, rays_toward,
@@ -307,6 +308,33 @@ mod tests {
                 "{origin}: {}",
                 s.uv
             );
+        }
+    }
+
+    #[test]
+    fn rays_entering_through_a_rim_never_slip_between_side_and_cap() {
+        let mut rng = Rng::new(67);
+        for (radius, height) in [(1.0, 2.0), (0.37, 1.3), (1e-3, 4e-3), (1e4, 3e3)] {
+            let shape = Cylinder::new(radius, height, true).unwrap();
+            let mut entering = 0;
+            for _ in 0..20_000 {
+                let phi = rng.range(0.0, TAU);
+                let (z, cap_normal) = if rng.uniform() < 0.5 {
+                    (0.0, -Vec3::Z)
+                } else {
+                    (height, Vec3::Z)
+                };
+                let side_normal = Vec3::new(phi.cos(), phi.sin(), 0.0);
+                let dir = rng.unit_vector();
+                if dir.dot(side_normal) > -0.01 || dir.dot(cap_normal) > -0.01 {
+                    continue;
+                }
+                entering += 1;
+                let rim = Vec3::new(radius * phi.cos(), radius * phi.sin(), z);
+                let ray = Ray::new(rim - 3.0 * radius * dir, dir);
+                assert!(shape.intersect(&ray).is_some(), "{ray:?}");
+            }
+            assert!(entering > 2000, "{entering}");
         }
     }
 
