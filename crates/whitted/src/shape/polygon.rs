@@ -141,7 +141,7 @@ impl Polygon {
     /// point, the other at or below), so a vertex level with the point is
     /// counted exactly once; the side test is computed from the edge's lower
     /// end whatever the vertex order, so a point on an edge shared by two
-    /// polygons is inside exactly one of them.
+    /// polygons of the same plane is inside exactly one of them.
     fn contains(&self, p: Vec3) -> bool {
         let [ax, ay] = self.axes.map(usize::from);
         let (px, py) = (p[ax], p[ay]);
