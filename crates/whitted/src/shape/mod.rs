@@ -19,6 +19,10 @@
 //! are refused by the constructors with a [`ShapeError`]; no test ever
 //! produces NaN.
 
+mod axis_box;
+mod cone;
+mod cylinder;
+mod disk;
 mod parallelogram;
 mod plane;
 mod polygon;
@@ -26,6 +30,10 @@ mod quadratic;
 mod sphere;
 mod triangle;
 
+pub use axis_box::AxisBox;
+pub use cone::Cone;
+pub use cylinder::Cylinder;
+pub use disk::Disk;
 pub use parallelogram::Parallelogram;
 pub use plane::Plane;
 pub use polygon::Polygon;
@@ -94,6 +102,14 @@ pub enum ShapeError {
         /// Which value.
         what: &'static str,
     },
+    /// A length that may be zero but was negative.
+    #[error("{what} must not be negative, got {value}")]
+    Negative {
+        /// What was wrong ("inner_radius", "radius0" ...).
+        what: &'static str,
+        /// The value given.
+        value: f64,
+    },
     /// The shape has no area (collinear vertices, zero edges ...).
     #[error("degenerate {shape}: {why}")]
     Degenerate {
@@ -123,6 +139,17 @@ pub(crate) fn positive(what: &'static str, value: f64) -> Result<f64, ShapeError
         Err(ShapeError::NotFinite { what })
     } else if value <= 0.0 {
         Err(ShapeError::NotPositive { what, value })
+    } else {
+        Ok(value)
+    }
+}
+
+/// Checks that `value` is finite and not negative.
+pub(crate) fn non_negative(what: &'static str, value: f64) -> Result<f64, ShapeError> {
+    if !value.is_finite() {
+        Err(ShapeError::NotFinite { what })
+    } else if value < 0.0 {
+        Err(ShapeError::Negative { what, value })
     } else {
         Ok(value)
     }
@@ -163,6 +190,14 @@ pub enum Shape {
     Parallelogram(Parallelogram),
     /// A planar polygon, convex or concave.
     Polygon(Polygon),
+    /// A disk or annulus (canonical: z = 0, facing +z).
+    Disk(Disk),
+    /// A cylinder, open or capped (canonical: along +z from z = 0).
+    Cylinder(Cylinder),
+    /// A truncated cone, open or capped (canonical: along +z from z = 0).
+    Cone(Cone),
+    /// A box aligned with the axes.
+    AxisBox(AxisBox),
 }
 
 const _: () = assert!(std::mem::size_of::<Shape>() <= 80);
@@ -175,6 +210,10 @@ macro_rules! dispatch {
             Shape::Triangle($s) => $body,
             Shape::Parallelogram($s) => $body,
             Shape::Polygon($s) => $body,
+            Shape::Disk($s) => $body,
+            Shape::Cylinder($s) => $body,
+            Shape::Cone($s) => $body,
+            Shape::AxisBox($s) => $body,
         }
     };
 }
@@ -210,6 +249,10 @@ impl Shape {
             Shape::Triangle(_) => "triangle",
             Shape::Parallelogram(_) => "parallelogram",
             Shape::Polygon(_) => "polygon",
+            Shape::Disk(_) => "disk",
+            Shape::Cylinder(_) => "cylinder",
+            Shape::Cone(_) => "cone",
+            Shape::AxisBox(_) => "box",
         }
     }
 }

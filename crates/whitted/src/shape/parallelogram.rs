@@ -117,7 +117,10 @@ impl Parallelogram {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shape::testing::{assert_no_self_intersection, assert_surface_is_sane};
+    use crate::shape::testing::{
+        assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
+        assert_surface_is_sane,
+    };
     use crate::shape::{Shape, ShapeError};
 
     /// The rectangle [0, 2] × [0, 3] in the plane z = 0, facing +z.
@@ -273,6 +276,8 @@ mod tests {
             let shape = Shape::Parallelogram(Parallelogram::new(origin, edge_u, edge_v).unwrap());
             assert_no_self_intersection(&shape, 23);
             assert_surface_is_sane(&shape, 29);
+            assert_convex_exits_cleanly(&shape, 31);
+            assert_no_nan_for_awkward_rays(&shape);
         }
     }
 }

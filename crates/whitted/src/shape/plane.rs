@@ -107,7 +107,10 @@ pub(super) fn onto_plane(point: Vec3, normal: Vec3, p: Vec3) -> (Vec3, Vec3) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shape::testing::{assert_no_self_intersection, assert_surface_is_sane};
+    use crate::shape::testing::{
+        assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
+        assert_surface_is_sane,
+    };
     use crate::shape::{Shape, ShapeError};
 
     fn floor() -> Plane {
@@ -235,6 +238,8 @@ mod tests {
             let shape = Shape::Plane(Plane::new(point, normal).unwrap());
             assert_no_self_intersection(&shape, 3);
             assert_surface_is_sane(&shape, 5);
+            assert_convex_exits_cleanly(&shape, 7);
+            assert_no_nan_for_awkward_rays(&shape);
         }
     }
 }

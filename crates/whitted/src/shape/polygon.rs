@@ -141,7 +141,7 @@ impl Polygon {
     /// point, the other at or below), so a vertex level with the point is
     /// counted exactly once; the side test is computed from the edge's lower
     /// end whatever the vertex order, so a point on an edge shared by two
-    /// polygons is inside exactly one of them.
+    /// polygons of the same plane is inside exactly one of them.
     fn contains(&self, p: Vec3) -> bool {
         let [ax, ay] = self.axes.map(usize::from);
         let (px, py) = (p[ax], p[ay]);
@@ -203,7 +203,10 @@ mod tests {
 
     use super::*;
     use crate::random::Rng;
-    use crate::shape::testing::{assert_no_self_intersection, assert_surface_is_sane};
+    use crate::shape::testing::{
+        assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
+        assert_surface_is_sane,
+    };
     use crate::shape::{Shape, ShapeError};
 
     fn polygon(points: &[(f64, f64)]) -> Polygon {
@@ -463,6 +466,8 @@ mod tests {
             let shape = Shape::Polygon(polygon);
             assert_no_self_intersection(&shape, 31);
             assert_surface_is_sane(&shape, 37);
+            assert_convex_exits_cleanly(&shape, 39);
+            assert_no_nan_for_awkward_rays(&shape);
         }
     }
 }

@@ -101,7 +101,10 @@ impl Sphere {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shape::testing::{assert_no_self_intersection, assert_surface_is_sane};
+    use crate::shape::testing::{
+        assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
+        assert_surface_is_sane,
+    };
     use crate::shape::{Shape, ShapeError};
 
     fn unit() -> Sphere {
@@ -190,6 +193,8 @@ mod tests {
             let shape = Shape::Sphere(Sphere::new(center, radius).unwrap());
             assert_no_self_intersection(&shape, 7);
             assert_surface_is_sane(&shape, 11);
+            assert_convex_exits_cleanly(&shape, 13);
+            assert_no_nan_for_awkward_rays(&shape);
         }
     }
 }

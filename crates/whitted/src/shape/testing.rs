@@ -63,6 +63,73 @@ pub(crate) fn assert_no_self_intersection(shape: &Shape, seed: u64) {
     );
 }
 
+/// Rays from random directions at `distance` aimed at each of `targets`,
+/// each target first nudged by a random amount in {0, 1e-15, 1e-12, 1e-9}
+/// times `distance`: for aiming at rims, edges and corners.
+pub(crate) fn rays_toward(targets: &[Vec3], distance: f64, seed: u64) -> Vec<Ray> {
+    let mut rng = Rng::new(seed);
+    targets
+        .iter()
+        .map(|&target| {
+            let nudge = [0.0, 1e-15, 1e-12, 1e-9][rng.below(4) as usize];
+            let target = target + nudge * distance * rng.unit_vector();
+            let origin = target + distance * rng.unit_vector();
+            Ray::new(origin, target - origin)
+        })
+        .collect()
+}
+
+/// Rays leaving a hit point on the outer side of the surface (the side the
+/// normal points to) never meet the shape again, at any distance: every
+/// shape is a piece of the boundary of a convex solid (or of a plane), so
+/// nothing of it lies outside a tangent plane. Hit points come from `rays`
+/// (so a test can aim at rims and edges); returns how many were checked.
+pub(crate) fn assert_outward_rays_escape(
+    shape: &Shape,
+    rays: impl IntoIterator<Item = Ray>,
+    seed: u64,
+) -> usize {
+    let mut rng = Rng::new(seed ^ 0x5eed);
+    let mut hits = 0;
+    for ray in rays {
+        let Some(hit) = shape.intersect(&ray) else {
+            continue;
+        };
+        hits += 1;
+        let s = shape.surface(&ray, &hit);
+        for _ in 0..4 {
+            let mut w = rng.unit_vector();
+            if w.dot(s.normal) < 0.0 {
+                w = -w;
+            }
+            let origin = offset_ray_origin(s.point, s.point_error, s.normal, w);
+            let next = Ray::new(origin, w);
+            if let Some(again) = shape.intersect(&next) {
+                panic!(
+                    "{}: outward ray from {origin:?} along {w:?} (normal {:?}, part {}) \
+                     hit the shape again at t = {} (part {})",
+                    shape.kind(),
+                    s.normal,
+                    hit.part,
+                    again.t,
+                    again.part
+                );
+            }
+        }
+    }
+    hits
+}
+
+/// [`assert_outward_rays_escape`] for random rays aimed at the shape.
+pub(crate) fn assert_convex_exits_cleanly(shape: &Shape, seed: u64) {
+    let hits = assert_outward_rays_escape(shape, random_rays(shape, seed, 2000), seed);
+    assert!(
+        hits > 100,
+        "{}: too few random rays hit ({hits})",
+        shape.kind()
+    );
+}
+
 /// Every hit of a random ray has a finite unit normal, finite texture
 /// coordinates, a point on the ray (within a tight tolerance of the shape's
 /// size) and an `occluded` answer that agrees with `intersect`.
@@ -87,5 +154,50 @@ pub(crate) fn assert_surface_is_sane(shape: &Shape, seed: u64) {
             "{}: reprojected point moved by {distance}",
             shape.kind()
         );
+    }
+}
+
+/// Awkward rays give no NaN: origins at every combination of the bounds'
+/// minimum, centre and maximum per axis (corners, edge and face centres,
+/// points on the surface), directions along every combination of -1, 0 and
+/// 1 per axis (parallel to faces and axes, along diagonals), at lengths
+/// 1e-150, 1 and 1e150. Any hit has a finite `t` in the ray's interval and
+/// a finite surface with a unit normal, and `occluded` agrees.
+pub(crate) fn assert_no_nan_for_awkward_rays(shape: &Shape) {
+    let region = region(shape);
+    let levels = [region.min, region.centroid(), region.max];
+    let steps = [-1.0, 0.0, 1.0];
+    for i in 0..27 {
+        let origin = Vec3::new(levels[i % 3].x, levels[i / 3 % 3].y, levels[i / 9].z);
+        for j in 0..27 {
+            let dir = Vec3::new(steps[j % 3], steps[j / 3 % 3], steps[j / 9]);
+            if dir == Vec3::ZERO {
+                continue;
+            }
+            for length in [1e-150, 1.0, 1e150] {
+                let ray = Ray::new(origin, length * dir);
+                let hit = shape.intersect(&ray);
+                assert_eq!(hit.is_some(), shape.occluded(&ray), "{}", shape.kind());
+                let Some(hit) = hit else { continue };
+                assert!(
+                    hit.t.is_finite()
+                        && ray.contains(hit.t)
+                        && hit.u.is_finite()
+                        && hit.v.is_finite(),
+                    "{}: {hit:?} for {ray:?}",
+                    shape.kind()
+                );
+                let s = shape.surface(&ray, &hit);
+                assert!(
+                    s.point.is_finite()
+                        && s.point_error.is_finite()
+                        && s.uv.is_finite()
+                        && s.dpdu.is_finite()
+                        && (s.normal.length() - 1.0).abs() < 1e-9,
+                    "{}: {s:?} for {ray:?}",
+                    shape.kind()
+                );
+            }
+        }
     }
 }

@@ -160,7 +160,10 @@ impl Triangle {
 mod tests {
     use super::*;
     use crate::random::Rng;
-    use crate::shape::testing::{assert_no_self_intersection, assert_surface_is_sane};
+    use crate::shape::testing::{
+        assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
+        assert_surface_is_sane,
+    };
     use crate::shape::{Shape, ShapeError};
 
     fn unit() -> Triangle {
@@ -358,6 +361,8 @@ mod tests {
             let shape = Shape::Triangle(Triangle::new(p0, p1, p2).unwrap());
             assert_no_self_intersection(&shape, 13);
             assert_surface_is_sane(&shape, 19);
+            assert_convex_exits_cleanly(&shape, 17);
+            assert_no_nan_for_awkward_rays(&shape);
         }
     }
 }
