@@ -17,7 +17,10 @@ use toml_span::Span;
 
 use super::reader::{Fields, Parsed, Reader, Reported, list};
 use crate::math::{Transform, Vec3};
-use crate::shape::{Parallelogram, Plane, Polygon, Shape, ShapeError, Sphere, Triangle};
+use crate::shape::{
+    AxisBox, Cone, Cylinder, Disk, Parallelogram, Plane, Polygon, Shape, ShapeError, Sphere,
+    Triangle,
+};
 
 /// A shape in its object space and where that space sits before the
 /// object's own transform.
@@ -76,6 +79,26 @@ pub(super) const SHAPE_KINDS: &[ShapeKind] = &[
         keys: &["origin", "edge_u", "edge_v"],
         build: parallelogram,
     },
+    ShapeKind {
+        name: "disk",
+        keys: &["center", "normal", "radius", "inner_radius"],
+        build: disk,
+    },
+    ShapeKind {
+        name: "cylinder",
+        keys: &["base", "top", "radius", "caps"],
+        build: cylinder,
+    },
+    ShapeKind {
+        name: "cone",
+        keys: &["base", "base_radius", "top", "top_radius", "caps"],
+        build: cone,
+    },
+    ShapeKind {
+        name: "box",
+        keys: &["min", "max"],
+        build: axis_box,
+    },
 ];
 
 /// The kind called `name`, written at `span`.
@@ -106,7 +129,9 @@ pub(super) fn build(
 /// else at `fallback`.
 fn refused(r: &mut Reader<'_>, f: &Fields<'_, '_>, fallback: Span, error: ShapeError) -> Reported {
     let named = match &error {
-        ShapeError::NotPositive { what, .. } | ShapeError::NotFinite { what } => f.get(what),
+        ShapeError::NotPositive { what, .. }
+        | ShapeError::Negative { what, .. }
+        | ShapeError::NotFinite { what } => f.get(what),
         ShapeError::Degenerate { .. } | ShapeError::NotPlanar { .. } => None,
     };
     let span = named.map_or(fallback, |value| r.span_of(value));
@@ -169,6 +194,81 @@ fn parallelogram(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Plac
     Ok(Placed::in_place(Shape::Parallelogram(parallelogram)))
 }
 
+fn disk(r: &mut Reader<'_>, f: &Fields<'_, '_>, at: Span) -> Parsed<Placed> {
+    let center = r.require(f, "center", Reader::vec3);
+    let normal = r.require(f, "normal", Reader::direction);
+    let radius = r.require(f, "radius", Reader::number);
+    let inner_radius = r.or_default(f, "inner_radius", 0.0, Reader::number);
+    let placement = frame(r, center?, normal?, at);
+    let too_wide = r.value_span(f, "inner_radius");
+    let disk = Disk::new(radius?, inner_radius?).map_err(|e| refused(r, f, too_wide, e))?;
+    Ok(Placed {
+        shape: Shape::Disk(disk),
+        placement: placement?,
+    })
+}
+
+fn cylinder(r: &mut Reader<'_>, f: &Fields<'_, '_>, at: Span) -> Parsed<Placed> {
+    let axis = axis(r, f);
+    let radius = r.require(f, "radius", Reader::number);
+    let caps = r.or_default(f, "caps", true, Reader::boolean);
+    let (base, axis) = axis?;
+    let placement = frame(r, base, axis, at);
+    let cylinder =
+        Cylinder::new(radius?, axis.length(), caps?).map_err(|e| refused(r, f, at, e))?;
+    Ok(Placed {
+        shape: Shape::Cylinder(cylinder),
+        placement: placement?,
+    })
+}
+
+fn cone(r: &mut Reader<'_>, f: &Fields<'_, '_>, at: Span) -> Parsed<Placed> {
+    let axis = axis(r, f);
+    let base_radius = r.require(f, "base_radius", Reader::non_negative);
+    let top_radius = r.require(f, "top_radius", Reader::non_negative);
+    let caps = r.or_default(f, "caps", true, Reader::boolean);
+    let (base, axis) = axis?;
+    let placement = frame(r, base, axis, at);
+    let pointless = r.value_span(f, "top_radius");
+    let cone = Cone::new(base_radius?, top_radius?, axis.length(), caps?)
+        .map_err(|e| refused(r, f, pointless, e))?;
+    Ok(Placed {
+        shape: Shape::Cone(cone),
+        placement: placement?,
+    })
+}
+
+fn axis_box(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Placed> {
+    let min = r.require(f, "min", Reader::vec3);
+    let max = r.require(f, "max", Reader::vec3);
+    let at = r.value_span(f, "max");
+    let axis_box = AxisBox::new(min?, max?).map_err(|e| refused(r, f, at, e))?;
+    Ok(Placed::in_place(Shape::AxisBox(axis_box)))
+}
+
+/// `base` and `top - base` of a cylinder or cone; an error at `top` when the
+/// two points coincide.
+fn axis(r: &mut Reader<'_>, f: &Fields<'_, '_>) -> Parsed<(Vec3, Vec3)> {
+    let base = r.require(f, "base", Reader::vec3);
+    let top = r.require(f, "top", Reader::vec3);
+    let (base, top) = (base?, top?);
+    let axis = top - base;
+    if axis == Vec3::ZERO || !axis.is_finite() {
+        let span = r.value_span(f, "top");
+        return Err(r.error(
+            span,
+            "`top` must differ from `base`: the shape has no height",
+        ));
+    }
+    Ok((base, axis))
+}
+
+/// The rigid placement of a canonical shape standing on `origin` along
+/// `axis`.
+fn frame(r: &mut Reader<'_>, origin: Vec3, axis: Vec3, at: Span) -> Parsed<Transform> {
+    Transform::frame(origin, axis).map_err(|e| r.error(at, e.to_string()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::tests::{CAMERA, errors, scene};
@@ -176,9 +276,23 @@ mod tests {
 
     /// The shape of the only object in `keys`.
     fn shape(keys: &str) -> Shape {
+        placed(keys).0
+    }
+
+    /// The shape of the only object in `keys`, and its object-to-world
+    /// transform.
+    fn placed(keys: &str) -> (Shape, Transform) {
         let mut s = scene(&format!("{CAMERA}[[objects]]\n{keys}\n"));
         assert_eq!(s.primitives.len(), 1);
-        s.primitives.remove(0).shape
+        let primitive = s.primitives.remove(0);
+        let transform = primitive
+            .transform
+            .map_or(Transform::IDENTITY, |id| s.transforms[id.0 as usize]);
+        (primitive.shape, transform)
+    }
+
+    fn close(a: Vec3, b: Vec3) {
+        assert!((a - b).length() < 1e-12, "{a} != {b}");
     }
 
     #[test]
@@ -230,6 +344,117 @@ mod tests {
                 Parallelogram::new(Vec3::X, Vec3::new(0.0, 0.0, 2.0), Vec3::new(3.0, 0.0, 0.0))
                     .unwrap()
             )
+        );
+    }
+
+    #[test]
+    fn disks_are_placed_at_their_center_facing_their_normal() {
+        let (disk, t) = placed(
+            "shape = 'disk'\ncenter = [1, 2, 3]\nnormal = [0, 2, 0]\nradius = 2\n\
+             inner_radius = 0.5",
+        );
+        assert_eq!(disk, Shape::Disk(Disk::new(2.0, 0.5).unwrap()));
+        close(t.point_to_world(Vec3::ZERO), Vec3::new(1.0, 2.0, 3.0));
+        close(t.vector_to_world(Vec3::Z), Vec3::Y);
+        let plain = shape("shape = 'disk'\ncenter = [0, 0, 0]\nnormal = [0, 0, 1]\nradius = 1");
+        assert_eq!(plain, Shape::Disk(Disk::new(1.0, 0.0).unwrap()));
+    }
+
+    #[test]
+    fn cylinders_stand_on_their_base_and_reach_their_top() {
+        let (cylinder, t) =
+            placed("shape = 'cylinder'\nbase = [0, 1, 0]\ntop = [0, 1, 3]\nradius = 0.5");
+        assert_eq!(
+            cylinder,
+            Shape::Cylinder(Cylinder::new(0.5, 3.0, true).unwrap())
+        );
+        close(t.point_to_world(Vec3::ZERO), Vec3::Y);
+        close(
+            t.point_to_world(Vec3::new(0.0, 0.0, 3.0)),
+            Vec3::new(0.0, 1.0, 3.0),
+        );
+        let open = shape(
+            "shape = 'cylinder'\nbase = [0, 0, 0]\ntop = [1, 0, 0]\nradius = 1\ncaps = false",
+        );
+        assert_eq!(
+            open,
+            Shape::Cylinder(Cylinder::new(1.0, 1.0, false).unwrap())
+        );
+    }
+
+    #[test]
+    fn cones_stand_on_their_base_and_reach_their_top() {
+        let (cone, t) = placed(
+            "shape = 'cone'\nbase = [1, 0, 0]\nbase_radius = 1\ntop = [1, 2, 0]\n\
+             top_radius = 0\ncaps = false",
+        );
+        assert_eq!(cone, Shape::Cone(Cone::new(1.0, 0.0, 2.0, false).unwrap()));
+        close(t.point_to_world(Vec3::ZERO), Vec3::X);
+        close(
+            t.point_to_world(Vec3::new(0.0, 0.0, 2.0)),
+            Vec3::new(1.0, 2.0, 0.0),
+        );
+        let closed = shape(
+            "shape = 'cone'\nbase = [0, 0, 0]\nbase_radius = 1\ntop = [0, 0, 1]\ntop_radius = 0.5",
+        );
+        assert_eq!(closed, Shape::Cone(Cone::new(1.0, 0.5, 1.0, true).unwrap()));
+    }
+
+    #[test]
+    fn boxes_are_read() {
+        assert_eq!(
+            shape("shape = 'box'\nmin = [-1, 0, -2]\nmax = [1, 3, 2]"),
+            Shape::AxisBox(
+                AxisBox::new(Vec3::new(-1.0, 0.0, -2.0), Vec3::new(1.0, 3.0, 2.0)).unwrap()
+            )
+        );
+    }
+
+    #[test]
+    fn the_objects_own_steps_act_after_the_placement() {
+        let (_, t) = placed(
+            "shape = 'cylinder'\nbase = [0, 0, 0]\ntop = [0, 2, 0]\nradius = 1\n\
+             transform = [{ scale = 2 }, { translate = [5, 0, 0] }]",
+        );
+        close(
+            t.point_to_world(Vec3::new(0.0, 0.0, 2.0)),
+            Vec3::new(5.0, 4.0, 0.0),
+        );
+    }
+
+    #[test]
+    fn refused_round_shapes_are_reported_at_the_culprit() {
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[[objects]]\nshape = 'disk'\ncenter = [0, 0, 0]\nnormal = [0, 0, 0]\n\
+                 radius = 1\n\
+                 [[objects]]\nshape = 'disk'\ncenter = [0, 0, 0]\nnormal = [0, 1, 0]\n\
+                 radius = 1\ninner_radius = 1\n\
+                 [[objects]]\nshape = 'disk'\ncenter = [0, 0, 0]\nnormal = [0, 1, 0]\n\
+                 radius = 1\ninner_radius = -1\n\
+                 [[objects]]\nshape = 'cylinder'\nbase = [0, 1, 0]\ntop = [0, 1, 0]\n\
+                 radius = 1\n\
+                 [[objects]]\nshape = 'cylinder'\nbase = [0, 0, 0]\ntop = [0, 1, 0]\n\
+                 radius = 0\n\
+                 [[objects]]\nshape = 'cylinder'\nbase = [0, 0, 0]\ntop = [0, 1, 0]\n\
+                 radius = 1\ncaps = 'yes'\n\
+                 [[objects]]\nshape = 'cone'\nbase = [0, 0, 0]\nbase_radius = -1\n\
+                 top = [0, 1, 0]\ntop_radius = 1\n\
+                 [[objects]]\nshape = 'cone'\nbase = [0, 0, 0]\nbase_radius = 0\n\
+                 top = [0, 1, 0]\ntop_radius = 0\n\
+                 [[objects]]\nshape = 'box'\nmin = [0, 0, 0]\nmax = [1, 0, 1]\n"
+            )),
+            [
+                "`normal` must not be the zero vector",
+                "degenerate disk: the inner radius is not smaller than the radius",
+                "inner_radius must not be negative, got -1",
+                "`top` must differ from `base`: the shape has no height",
+                "radius must be a positive number, got 0",
+                "expected `true` or `false` for `caps`, found a string",
+                "`base_radius` must not be negative, got -1",
+                "degenerate cone: both radii are zero",
+                "degenerate box: min must be below max on every axis",
+            ]
         );
     }
 
