@@ -3,15 +3,25 @@
 //! Adding a kind is one entry in [`SHAPE_KINDS`] and one function.
 //!
 //! ```toml
-//! [[objects]]
-//! shape = "sphere"
-//! center = [0, 1, 0]              # default [0, 0, 0]
-//! radius = 1
+//! shape = "sphere"         # center = [0, 0, 0] (default), radius
+//! shape = "plane"          # point, normal
+//! shape = "triangle"       # vertices = [[..], [..], [..]]
+//! shape = "polygon"        # vertices = [[..], ...], at least 3, in one plane
+//! shape = "parallelogram"  # origin, edge_u, edge_v
+//! shape = "disk"           # center, normal, radius, inner_radius = 0
+//! shape = "cylinder"       # base, top, radius, caps = true
+//! shape = "cone"           # base, base_radius, top, top_radius, caps = true
+//! shape = "box"            # min, max
 //! ```
 //!
-//! Shapes whose constructor is canonical (a disk, cylinder or cone standing
-//! on the origin along +z) return a placement transform that puts them where
-//! the file says; the object's own `transform` steps act after it.
+//! Disks, cylinders and cones are built in canonical position (standing on
+//! the origin along +z) and come with a placement, `Transform::frame` to
+//! their `center`/`base` and `normal`/`top - base`; the object's own
+//! `transform` steps act after it.
+//!
+//! A constructor's refusal is reported at the value it names (`radius` ...)
+//! or else at the value most to blame (the `normal` of a plane, the
+//! `vertices` of a triangle, the stray vertex of a polygon off its plane).
 
 use toml_span::Span;
 
