@@ -2,8 +2,8 @@
 //! z = 0 and `radius1` at z = height, open or closed by caps.
 //!
 //! Scene syntax: `shape = "cone"`, `base = [x, y, z]`, `base_radius = r0`,
-//! `top = [x, y, z]`, `top_radius = r1`, and optionally `caps = true`
-//! (default false), as in the NFF `c` primitive. The reader builds the
+//! `top = [x, y, z]`, `top_radius = r1`, and optionally `caps = false`
+//! (default true; the NFF `c` primitive is open). The reader builds the
 //! canonical cone of height `|top - base|` and places it with
 //! `Transform::frame(base, top - base)`.
 //!

@@ -2,8 +2,8 @@
 //! z = height, open or closed by two caps.
 //!
 //! Scene syntax: `shape = "cylinder"`, `base = [x, y, z]`,
-//! `top = [x, y, z]`, `radius = r`, and optionally `caps = true` (default
-//! false). The reader builds the canonical cylinder of height
+//! `top = [x, y, z]`, `radius = r`, and optionally `caps = false` (default
+//! true). The reader builds the canonical cylinder of height
 //! `|top - base|` and places it with `Transform::frame(base, top - base)`.
 //!
 //! Parts ([`ShapeHit::part`]): 0 the side, 1 the bottom cap (z = 0, facing

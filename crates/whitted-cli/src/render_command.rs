@@ -1,0 +1,164 @@
+//! `whitted render`: load a scene, render it, write the image and AOVs.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+use whitted::image::ImageFormat;
+use whitted::render::{Aov, RenderOptions, render};
+use whitted::scene::{Scene, load_scene};
+
+use crate::progress::ProgressReport;
+
+/// Render a scene to an image.
+///
+/// The output format follows the file name: .png (8-bit sRGB), .exr or
+/// .pfm (linear 32-bit float). Command-line settings override the scene
+/// file's [render] table.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// Scene file (.toml). Without one, the built-in scene is rendered.
+    scene: Option<PathBuf>,
+
+    /// Output image: .png, .exr or .pfm.
+    #[arg(short, long, value_name = "OUT", default_value = "whitted.png")]
+    output: PathBuf,
+
+    /// Image width in pixels.
+    #[arg(long, value_name = "W")]
+    width: Option<u32>,
+
+    /// Image height in pixels.
+    #[arg(long, value_name = "H")]
+    height: Option<u32>,
+
+    /// Samples per pixel, on a stratified seeded pattern (1 = pixel centre).
+    #[arg(long, value_name = "N")]
+    spp: Option<u32>,
+
+    /// Maximum reflection/refraction depth (0 = no secondary rays; default 8).
+    #[arg(long, value_name = "D")]
+    max_depth: Option<u32>,
+
+    /// Worker threads (default: all cores). The picture is the same for any
+    /// number.
+    #[arg(long, value_name = "T")]
+    threads: Option<usize>,
+
+    /// Also write per-pixel data, as NAME=FILE with FILE a .pfm or .exr.
+    /// NAME is depth (distance along the primary ray, +inf on a miss),
+    /// normal (world-space normal of the first hit, 0 on a miss) or id
+    /// (primitive index, -1 on a miss). Repeatable.
+    #[arg(long, value_name = "NAME=FILE")]
+    aov: Vec<String>,
+
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// Parses `NAME=FILE` into an AOV and its destination.
+fn parse_aov(spec: &str) -> Result<(Aov, PathBuf), String> {
+    let names = Aov::ALL.map(|a| a.name()).join(", ");
+    let (name, file) = spec
+        .split_once('=')
+        .ok_or_else(|| format!("--aov {spec}: expected NAME=FILE with NAME one of {names}"))?;
+    let aov = Aov::from_name(name)
+        .ok_or_else(|| format!("--aov {spec}: unknown AOV `{name}`; expected one of {names}"))?;
+    let path = PathBuf::from(file);
+    match ImageFormat::from_path(&path) {
+        Ok(ImageFormat::Exr | ImageFormat::Pfm) => Ok((aov, path)),
+        _ => Err(format!(
+            "--aov {spec}: AOVs are written as .pfm or .exr files"
+        )),
+    }
+}
+
+/// Runs the command.
+pub fn run(args: &RenderArgs) -> Result<(), String> {
+    let aov_outputs = args
+        .aov
+        .iter()
+        .map(|s| parse_aov(s))
+        .collect::<Result<Vec<_>, _>>()?;
+    ImageFormat::from_path(&args.output).map_err(|e| e.to_string())?;
+
+    let mut scene = match &args.scene {
+        Some(path) => load_scene(path).map_err(|e| e.to_string())?,
+        None => Scene::default_scene(),
+    };
+    let settings = &mut scene.settings;
+    settings.width = args.width.unwrap_or(settings.width);
+    settings.height = args.height.unwrap_or(settings.height);
+    settings.samples_per_pixel = args.spp.unwrap_or(settings.samples_per_pixel);
+    settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
+    if args.threads == Some(0) {
+        return Err("--threads must be at least 1".to_string());
+    }
+
+    let options = RenderOptions {
+        threads: args.threads,
+        aovs: aov_outputs.iter().map(|(a, _)| *a).collect(),
+    };
+    let total = u64::from(scene.settings.width) * u64::from(scene.settings.height);
+    let bar = ProgressReport::new(total, args.quiet);
+    let start = Instant::now();
+    let output = render(&scene, &options, &|p| bar.update(p));
+    bar.finish();
+    let output = output.map_err(|e| e.to_string())?;
+    let elapsed = start.elapsed().as_secs_f64();
+
+    output
+        .image
+        .write(&args.output)
+        .map_err(|e| e.to_string())?;
+    for ((_, film), (_, path)) in output.aovs.iter().zip(&aov_outputs) {
+        film.write(path).map_err(|e| e.to_string())?;
+    }
+
+    if !args.quiet {
+        let rays = output.rays;
+        eprintln!(
+            "{}: {}x{}, {} spp in {:.3} s; rays: {} primary, {} shadow, {} reflected, {} refracted; {:.2} Mrays/s",
+            args.output.display(),
+            scene.settings.width,
+            scene.settings.height,
+            scene.settings.samples_per_pixel,
+            elapsed,
+            rays.primary,
+            rays.shadow,
+            rays.reflected,
+            rays.refracted,
+            rays.total() as f64 / elapsed / 1e6,
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn aov_specs_name_a_known_aov_and_a_float_format() {
+        assert_eq!(
+            parse_aov("depth=d.pfm"),
+            Ok((Aov::Depth, PathBuf::from("d.pfm")))
+        );
+        assert_eq!(
+            parse_aov("normal=n.EXR"),
+            Ok((Aov::Normal, PathBuf::from("n.EXR")))
+        );
+        assert!(
+            parse_aov("depth")
+                .unwrap_err()
+                .contains("expected NAME=FILE")
+        );
+        assert!(
+            parse_aov("albedo=a.pfm")
+                .unwrap_err()
+                .contains("unknown AOV `albedo`")
+        );
+        assert!(parse_aov("id=i.png").unwrap_err().contains(".pfm or .exr"));
+    }
+}

@@ -1,0 +1,178 @@
+//! The scene's primitives made ready for ray queries: world-space bounds, an
+//! acceleration structure over the bounded ones, a short list of the
+//! unbounded ones, and the two queries every tracer needs — the closest hit
+//! and any hit — plus the full surface description of a final hit.
+
+use crate::accel::Linear;
+use crate::material::MaterialId;
+use crate::math::{DVec2, Ray, Transform, Vec3};
+use crate::scene::{Primitive, Scene};
+use crate::shape::{LocalSurface, ShapeHit};
+
+/// The closest hit found by [`Geometry::intersect`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Index of the primitive in [`Scene::primitives`].
+    pub primitive: u32,
+    /// What the shape recorded (its `t` is the ray parameter).
+    pub shape_hit: ShapeHit,
+}
+
+impl Hit {
+    /// The ray parameter of the hit.
+    pub fn t(&self) -> f64 {
+        self.shape_hit.t
+    }
+}
+
+/// The surface at a hit, in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Surface {
+    /// The hit point.
+    pub point: Vec3,
+    /// Absolute bound on the error of `point`, per axis.
+    pub point_error: Vec3,
+    /// Unit geometric normal, outward (not yet turned towards the ray).
+    pub normal: Vec3,
+    /// Texture coordinates.
+    pub uv: DVec2,
+    /// Tangent along u (not normalised).
+    pub dpdu: Vec3,
+    /// The surface's material.
+    pub material: MaterialId,
+}
+
+/// The scene's geometry, ready for ray queries.
+#[derive(Debug)]
+pub struct Geometry<'a> {
+    primitives: &'a [Primitive],
+    transforms: &'a [Transform],
+    accel: Linear,
+    bounded: Vec<u32>,
+    unbounded: Vec<u32>,
+}
+
+impl<'a> Geometry<'a> {
+    /// Prepares the scene's primitives.
+    pub fn new(scene: &'a Scene) -> Self {
+        let mut bounded = Vec::new();
+        let mut unbounded = Vec::new();
+        let mut boxes = Vec::new();
+        for (i, p) in scene.primitives.iter().enumerate() {
+            let local = p.shape.bounds();
+            if local.is_finite() {
+                let world = match p.transform {
+                    Some(id) => scene.transforms[id.0 as usize].bounds_to_world(&local),
+                    None => local,
+                };
+                boxes.push(world);
+                bounded.push(i as u32);
+            } else {
+                unbounded.push(i as u32);
+            }
+        }
+        Self {
+            primitives: &scene.primitives,
+            transforms: &scene.transforms,
+            accel: Linear::build(&boxes),
+            bounded,
+            unbounded,
+        }
+    }
+
+    fn transform(&self, p: &Primitive) -> Option<&Transform> {
+        p.transform.map(|id| &self.transforms[id.0 as usize])
+    }
+
+    /// Primitive `index` hit by the world-space `ray`, closer than `t_max`.
+    #[inline]
+    fn intersect_primitive(&self, index: u32, ray: &Ray, t_max: f64) -> Option<ShapeHit> {
+        let p = &self.primitives[index as usize];
+        let mut ray = *ray;
+        ray.t_max = t_max;
+        match self.transform(p) {
+            Some(t) => p.shape.intersect(&t.ray_to_object(&ray)),
+            None => p.shape.intersect(&ray),
+        }
+    }
+
+    #[inline]
+    fn occluded_by(&self, index: u32, ray: &Ray) -> bool {
+        let p = &self.primitives[index as usize];
+        match self.transform(p) {
+            Some(t) => p.shape.occluded(&t.ray_to_object(ray)),
+            None => p.shape.occluded(ray),
+        }
+    }
+
+    /// The closest hit in the ray's interval.
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        let mut t_max = ray.t_max;
+        for &i in &self.unbounded {
+            if let Some(h) = self.intersect_primitive(i, ray, t_max) {
+                t_max = h.t;
+                best = Some(Hit {
+                    primitive: i,
+                    shape_hit: h,
+                });
+            }
+        }
+        let mut clipped = *ray;
+        clipped.t_max = t_max;
+        self.accel.intersect(&clipped, |slot, t_max| {
+            let i = self.bounded[slot as usize];
+            let h = self.intersect_primitive(i, ray, t_max)?;
+            best = Some(Hit {
+                primitive: i,
+                shape_hit: h,
+            });
+            Some(h.t)
+        });
+        best
+    }
+
+    /// True when anything lies in the ray's interval.
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.unbounded.iter().any(|&i| self.occluded_by(i, ray))
+            || self.accel.occluded(ray, |slot| {
+                self.occluded_by(self.bounded[slot as usize], ray)
+            })
+    }
+
+    /// The world-space surface at a hit returned for `ray`.
+    pub fn surface(&self, ray: &Ray, hit: &Hit) -> Surface {
+        let p = &self.primitives[hit.primitive as usize];
+        match self.transform(p) {
+            None => {
+                let s = p.shape.surface(ray, &hit.shape_hit);
+                Surface::from_local(s, p.material)
+            }
+            Some(t) => {
+                let s = p.shape.surface(&t.ray_to_object(ray), &hit.shape_hit);
+                let (point, point_error) = t.point_with_error_to_world(s.point, s.point_error);
+                Surface {
+                    point,
+                    point_error,
+                    normal: t.normal_to_world(s.normal).normalize(),
+                    uv: s.uv,
+                    dpdu: t.vector_to_world(s.dpdu),
+                    material: p.material,
+                }
+            }
+        }
+    }
+}
+
+impl Surface {
+    fn from_local(s: LocalSurface, material: MaterialId) -> Self {
+        Self {
+            point: s.point,
+            point_error: s.point_error,
+            normal: s.normal,
+            uv: s.uv,
+            dpdu: s.dpdu,
+            material,
+        }
+    }
+}

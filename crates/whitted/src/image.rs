@@ -1,0 +1,353 @@
+//! The film (a grid of float pixels) and its writers: PNG (8-bit sRGB), EXR
+//! and PFM (linear float).
+//!
+//! Files are written whole or not at all: the bytes go to a temporary file
+//! in the destination folder, which is renamed over the destination only
+//! once complete.
+
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// A `width` × `height` grid of pixels with `channels` float values each,
+/// row 0 at the top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Film {
+    width: u32,
+    height: u32,
+    channels: usize,
+    data: Vec<f32>,
+}
+
+/// The image file formats whitted writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// 8-bit sRGB PNG (values clamped to [0, 1]).
+    Png,
+    /// OpenEXR, 32-bit linear float.
+    Exr,
+    /// Portable float map, 32-bit linear float.
+    Pfm,
+}
+
+/// Why an image could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum ImageError {
+    /// The file name's extension names no format whitted writes.
+    #[error("{path}: unknown image format; use a .png, .exr or .pfm file name")]
+    UnknownFormat {
+        /// The destination.
+        path: PathBuf,
+    },
+    /// The data can't be stored in that format.
+    #[error("{path}: {why}")]
+    Unsupported {
+        /// The destination.
+        path: PathBuf,
+        /// What is not possible.
+        why: String,
+    },
+    /// The file system refused.
+    #[error("{path}: {source}")]
+    Io {
+        /// The destination.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+}
+
+impl ImageFormat {
+    /// The format named by a path's extension (case-insensitive).
+    pub fn from_path(path: &Path) -> Result<Self, ImageError> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("png") => Ok(Self::Png),
+            Some("exr") => Ok(Self::Exr),
+            Some("pfm") => Ok(Self::Pfm),
+            _ => Err(ImageError::UnknownFormat {
+                path: path.to_path_buf(),
+            }),
+        }
+    }
+}
+
+impl Film {
+    /// A black film.
+    pub fn new(width: u32, height: u32, channels: usize) -> Self {
+        Self {
+            width,
+            height,
+            channels,
+            data: vec![0.0; width as usize * height as usize * channels],
+        }
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Values per pixel.
+    pub fn channels(&self) -> usize {
+        self.channels
+    }
+
+    /// All values, row by row from the top, pixel by pixel, channel by
+    /// channel.
+    pub fn data(&self) -> &[f32] {
+        &self.data
+    }
+
+    /// The values of pixel (`x`, `y`).
+    pub fn pixel(&self, x: u32, y: u32) -> &[f32] {
+        let i = (y as usize * self.width as usize + x as usize) * self.channels;
+        &self.data[i..i + self.channels]
+    }
+
+    /// Sets the values of pixel (`x`, `y`).
+    pub fn set_pixel(&mut self, x: u32, y: u32, values: &[f32]) {
+        let i = (y as usize * self.width as usize + x as usize) * self.channels;
+        self.data[i..i + self.channels].copy_from_slice(values);
+    }
+
+    /// Writes the film in the format its extension names.
+    pub fn write(&self, path: &Path) -> Result<(), ImageError> {
+        let format = ImageFormat::from_path(path)?;
+        if format == ImageFormat::Png && self.channels != 1 && self.channels != 3 {
+            return Err(ImageError::Unsupported {
+                path: path.to_path_buf(),
+                why: format!("PNG holds 1 or 3 channels, not {}", self.channels),
+            });
+        }
+        write_atomically(path, |out| match format {
+            ImageFormat::Png => self.encode_png(out),
+            ImageFormat::Pfm => self.encode_pfm(out),
+            ImageFormat::Exr => self.encode_exr(out),
+        })
+    }
+
+    fn encode_png(&self, out: &mut std::fs::File) -> std::io::Result<()> {
+        let mut encoder = png::Encoder::new(BufWriter::new(out), self.width, self.height);
+        encoder.set_color(if self.channels == 1 {
+            png::ColorType::Grayscale
+        } else {
+            png::ColorType::Rgb
+        });
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        let bytes: Vec<u8> = self.data.iter().map(|&v| encode_srgb8(v)).collect();
+        let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
+        writer
+            .write_image_data(&bytes)
+            .map_err(std::io::Error::other)?;
+        writer.finish().map_err(std::io::Error::other)
+    }
+
+    /// PFM: a text header, then little-endian floats, bottom row first.
+    fn encode_pfm(&self, out: &mut std::fs::File) -> std::io::Result<()> {
+        let mut out = BufWriter::new(out);
+        let (magic, channels) = match self.channels {
+            1 => ("Pf", 1),
+            _ => ("PF", 3),
+        };
+        write!(out, "{magic}\n{} {}\n-1.0\n", self.width, self.height)?;
+        for y in (0..self.height).rev() {
+            for x in 0..self.width {
+                let p = self.pixel(x, y);
+                for c in 0..channels {
+                    let v = p.get(c).copied().unwrap_or(0.0);
+                    out.write_all(&v.to_le_bytes())?;
+                }
+            }
+        }
+        out.flush()
+    }
+
+    fn encode_exr(&self, out: &mut std::fs::File) -> std::io::Result<()> {
+        use exr::prelude::*;
+        let names: &[&str] = match self.channels {
+            1 => &["Y"],
+            3 => &["R", "G", "B"],
+            _ => &["R", "G", "B", "A"],
+        };
+        let pixels = self.width as usize * self.height as usize;
+        let channels: Vec<AnyChannel<FlatSamples>> = names
+            .iter()
+            .enumerate()
+            .map(|(c, name)| {
+                let samples = (0..pixels)
+                    .map(|i| self.data.get(i * self.channels + c).copied().unwrap_or(0.0))
+                    .collect();
+                AnyChannel::new(*name, FlatSamples::F32(samples))
+            })
+            .collect();
+        let layer = Layer::new(
+            (self.width as usize, self.height as usize),
+            LayerAttributes::default(),
+            Encoding::FAST_LOSSLESS,
+            AnyChannels::sort(SmallVec::from_vec(channels)),
+        );
+        Image::from_layer(layer)
+            .write()
+            .non_parallel()
+            .to_buffered(BufWriter::new(out))
+            .map_err(std::io::Error::other)
+    }
+}
+
+/// A linear value as an 8-bit sRGB code (clamped; NaN becomes 0).
+pub fn encode_srgb8(linear: f32) -> u8 {
+    let v = if linear.is_nan() {
+        0.0
+    } else {
+        linear.clamp(0.0, 1.0)
+    };
+    let encoded = if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    };
+    (encoded * 255.0 + 0.5) as u8
+}
+
+/// Writes `path` through a temporary file in the same folder, renamed into
+/// place only when `encode` succeeded.
+fn write_atomically(
+    path: &Path,
+    encode: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
+) -> Result<(), ImageError> {
+    let io = |source| ImageError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".whitted-").suffix(".partial");
+    // Like any new file: readable as the umask allows, not private to the
+    // owner as temporary files are by default.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut temp = builder.tempfile_in(folder).map_err(io)?;
+    encode(temp.as_file_mut()).map_err(io)?;
+    temp.as_file().sync_all().map_err(io)?;
+    temp.persist(path).map_err(|e| io(e.error))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gradient() -> Film {
+        let mut f = Film::new(3, 2, 3);
+        for y in 0..2 {
+            for x in 0..3 {
+                f.set_pixel(x, y, &[x as f32 * 0.5, y as f32, 0.25]);
+            }
+        }
+        f
+    }
+
+    #[test]
+    fn srgb_encoding_matches_known_codes() {
+        assert_eq!(encode_srgb8(0.0), 0);
+        assert_eq!(encode_srgb8(1.0), 255);
+        assert_eq!(encode_srgb8(2.0), 255);
+        assert_eq!(encode_srgb8(-1.0), 0);
+        assert_eq!(encode_srgb8(f32::NAN), 0);
+        assert_eq!(encode_srgb8(0.5), 188);
+        assert_eq!(encode_srgb8(0.2159), 128);
+    }
+
+    #[test]
+    fn pfm_is_written_bottom_row_first_with_a_little_endian_scale() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("g.pfm");
+        gradient().write(&path).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let header = b"PF\n3 2\n-1.0\n";
+        assert_eq!(&bytes[..header.len()], header);
+        let floats: Vec<f32> = bytes[header.len()..]
+            .chunks(4)
+            .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+            .collect();
+        assert_eq!(floats.len(), 18);
+        // First stored pixel is the bottom-left one: (0, 1).
+        assert_eq!(&floats[..3], &[0.0, 1.0, 0.25]);
+    }
+
+    #[test]
+    fn png_and_exr_round_trip_through_their_decoders() {
+        let dir = tempfile::tempdir().unwrap();
+        let png_path = dir.path().join("g.png");
+        gradient().write(&png_path).unwrap();
+        let decoder = png::Decoder::new(std::io::BufReader::new(
+            std::fs::File::open(&png_path).unwrap(),
+        ));
+        let mut reader = decoder.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        assert_eq!((info.width, info.height), (3, 2));
+        assert_eq!(&buf[3..6], &[188, 0, 137]);
+
+        let exr_path = dir.path().join("g.exr");
+        gradient().write(&exr_path).unwrap();
+        let image = exr::prelude::read_first_flat_layer_from_file(&exr_path).unwrap();
+        assert_eq!(image.layer_data.size, exr::prelude::Vec2(3, 2));
+        assert_eq!(image.layer_data.channel_data.list.len(), 3);
+    }
+
+    #[test]
+    fn unknown_extensions_are_refused_and_nothing_is_left_behind() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("g.bmp");
+        assert!(matches!(
+            gradient().write(&path),
+            Err(ImageError::UnknownFormat { .. })
+        ));
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+
+    #[test]
+    fn a_failed_write_leaves_the_old_file_intact() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("g.png");
+        std::fs::write(&path, b"old").unwrap();
+        let four_channels = Film::new(2, 2, 4);
+        assert!(four_channels.write(&path).is_err());
+        assert_eq!(std::fs::read(&path).unwrap(), b"old");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn written_files_get_the_permissions_of_any_new_file() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let plain = dir.path().join("plain");
+        std::fs::write(&plain, b"x").unwrap();
+        let image = dir.path().join("g.png");
+        gradient().write(&image).unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&image), mode(&plain));
+    }
+
+    #[test]
+    fn writing_into_a_missing_folder_is_an_io_error() {
+        let err = gradient()
+            .write(Path::new("/nonexistent-folder/x.png"))
+            .unwrap_err();
+        assert!(matches!(err, ImageError::Io { .. }));
+        assert!(err.to_string().starts_with("/nonexistent-folder/x.png: "));
+    }
+}

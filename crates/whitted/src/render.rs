@@ -1,0 +1,277 @@
+//! Rendering a scene into a film: tiles spread over threads, each pixel's
+//! samples placed by a pattern seeded from the pixel's position, so the
+//! picture is identical bit for bit whatever the number of threads.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use rayon::prelude::*;
+
+use crate::image::Film;
+use crate::math::Color;
+use crate::random::hash64;
+use crate::sampling::pixel_sample;
+use crate::scene::{RenderSettings, Scene};
+use crate::trace::{RayCounts, Tracer};
+
+/// Side of the square tiles the image is cut into, in pixels.
+const TILE_SIZE: u32 = 16;
+
+/// Per-pixel data besides the colour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Aov {
+    /// Distance along the unit-length primary ray through the pixel centre
+    /// to the first hit; +∞ where nothing is hit.
+    Depth,
+    /// World-space shading normal at that hit (facing the camera); 0 for a
+    /// miss.
+    Normal,
+    /// Index of the primitive hit, as a float; -1 for a miss.
+    Id,
+}
+
+impl Aov {
+    /// Every AOV.
+    pub const ALL: [Aov; 3] = [Aov::Depth, Aov::Normal, Aov::Id];
+
+    /// The name used on the command line.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Aov::Depth => "depth",
+            Aov::Normal => "normal",
+            Aov::Id => "id",
+        }
+    }
+
+    /// The AOV called `name`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|a| a.name() == name)
+    }
+
+    /// Values per pixel.
+    pub fn channels(&self) -> usize {
+        match self {
+            Aov::Normal => 3,
+            Aov::Depth | Aov::Id => 1,
+        }
+    }
+}
+
+/// What to produce besides the settings in the scene.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RenderOptions {
+    /// Worker threads; `None` uses every core.
+    pub threads: Option<usize>,
+    /// Per-pixel data to produce alongside the colour.
+    pub aovs: Vec<Aov>,
+}
+
+/// How far a render has come.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    /// Pixels finished.
+    pub done: u64,
+    /// Pixels in the image.
+    pub total: u64,
+}
+
+/// A finished render.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderOutput {
+    /// The colour image (3 channels, linear).
+    pub image: Film,
+    /// The requested AOVs, in the order asked for.
+    pub aovs: Vec<(Aov, Film)>,
+    /// How many rays of each kind were traced.
+    pub rays: RayCounts,
+}
+
+/// Why a render could not start.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// Width or height is zero, or the image is too large to address.
+    #[error("the image size {width}x{height} is not valid: both sides must be between 1 and 65535")]
+    BadSize {
+        /// Requested width.
+        width: u32,
+        /// Requested height.
+        height: u32,
+    },
+    /// Zero samples per pixel.
+    #[error("samples per pixel must be at least 1")]
+    NoSamples,
+    /// The thread pool could not be created.
+    #[error("could not start {threads} worker threads: {message}")]
+    Threads {
+        /// Requested thread count.
+        threads: usize,
+        /// What the system said.
+        message: String,
+    },
+}
+
+/// One finished tile: its pixels and the rays it took.
+struct Tile {
+    x0: u32,
+    y0: u32,
+    width: u32,
+    height: u32,
+    color: Vec<f32>,
+    aovs: Vec<Vec<f32>>,
+    rays: RayCounts,
+}
+
+/// Renders `scene` with its settings; `progress` is called from worker
+/// threads as tiles finish.
+pub fn render(
+    scene: &Scene,
+    options: &RenderOptions,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<RenderOutput, RenderError> {
+    let settings = scene.settings.clone();
+    let (width, height) = (settings.width, settings.height);
+    if width == 0 || height == 0 || width > 65535 || height > 65535 {
+        return Err(RenderError::BadSize { width, height });
+    }
+    if settings.samples_per_pixel == 0 {
+        return Err(RenderError::NoSamples);
+    }
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(threads) = options.threads {
+        pool = pool.num_threads(threads);
+    }
+    let pool = pool.build().map_err(|e| RenderError::Threads {
+        threads: options.threads.unwrap_or(0),
+        message: e.to_string(),
+    })?;
+
+    let tracer = Tracer::new(scene, settings.clone());
+    let tiles_x = width.div_ceil(TILE_SIZE);
+    let tiles_y = height.div_ceil(TILE_SIZE);
+    let total = u64::from(width) * u64::from(height);
+    let done = AtomicU64::new(0);
+    let tiles: Vec<Tile> = pool.install(|| {
+        (0..tiles_x * tiles_y)
+            .into_par_iter()
+            .map(|index| {
+                let tile = render_tile(
+                    &tracer,
+                    &settings,
+                    options,
+                    index % tiles_x,
+                    index / tiles_x,
+                );
+                let pixels = u64::from(tile.width * tile.height);
+                let now = done.fetch_add(pixels, Ordering::Relaxed) + pixels;
+                progress(Progress { done: now, total });
+                tile
+            })
+            .collect()
+    });
+
+    let mut image = Film::new(width, height, 3);
+    let mut aovs: Vec<(Aov, Film)> = options
+        .aovs
+        .iter()
+        .map(|&a| (a, Film::new(width, height, a.channels())))
+        .collect();
+    let mut rays = RayCounts::default();
+    for tile in &tiles {
+        rays += tile.rays;
+        for dy in 0..tile.height {
+            for dx in 0..tile.width {
+                let i = (dy * tile.width + dx) as usize;
+                let (x, y) = (tile.x0 + dx, tile.y0 + dy);
+                image.set_pixel(x, y, &tile.color[3 * i..3 * i + 3]);
+                for ((aov, film), data) in aovs.iter_mut().zip(&tile.aovs) {
+                    let c = aov.channels();
+                    film.set_pixel(x, y, &data[c * i..c * i + c]);
+                }
+            }
+        }
+    }
+    Ok(RenderOutput { image, aovs, rays })
+}
+
+fn render_tile(
+    tracer: &Tracer,
+    settings: &RenderSettings,
+    options: &RenderOptions,
+    tile_x: u32,
+    tile_y: u32,
+) -> Tile {
+    let x0 = tile_x * TILE_SIZE;
+    let y0 = tile_y * TILE_SIZE;
+    let width = TILE_SIZE.min(settings.width - x0);
+    let height = TILE_SIZE.min(settings.height - y0);
+    let pixels = (width * height) as usize;
+    let mut tile = Tile {
+        x0,
+        y0,
+        width,
+        height,
+        color: Vec::with_capacity(3 * pixels),
+        aovs: options
+            .aovs
+            .iter()
+            .map(|a| Vec::with_capacity(a.channels() * pixels))
+            .collect(),
+        rays: RayCounts::default(),
+    };
+    let camera = &tracer.scene().camera;
+    let spp = settings.samples_per_pixel;
+    for y in y0..y0 + height {
+        for x in x0..x0 + width {
+            let pattern = hash64(u64::from(y) << 32 | u64::from(x)) as u32;
+            let mut sum = Color::ZERO;
+            let mut centre = None;
+            for s in 0..spp {
+                let offset = pixel_sample(s, spp, pattern);
+                let ray = camera.ray(
+                    settings.width,
+                    settings.height,
+                    f64::from(x) + offset.x,
+                    f64::from(y) + offset.y,
+                );
+                let sample = tracer.trace_primary(&ray, &mut tile.rays);
+                if spp == 1 {
+                    centre = Some((ray, sample.first_hit));
+                }
+                sum += sample.color;
+            }
+            let color = sum / f64::from(spp);
+            tile.color
+                .extend_from_slice(&[color.x as f32, color.y as f32, color.z as f32]);
+            if options.aovs.is_empty() {
+                continue;
+            }
+            let (ray, first_hit) = centre.unwrap_or_else(|| {
+                let ray = camera.ray(
+                    settings.width,
+                    settings.height,
+                    f64::from(x) + 0.5,
+                    f64::from(y) + 0.5,
+                );
+                let hit = tracer.first_hit(&ray);
+                (ray, hit)
+            });
+            for (aov, data) in options.aovs.iter().zip(&mut tile.aovs) {
+                match (aov, &first_hit) {
+                    (Aov::Depth, Some((hit, _))) => data.push(hit.t() as f32),
+                    (Aov::Depth, None) => data.push(f32::INFINITY),
+                    (Aov::Normal, Some((_, surface))) => {
+                        let n = if ray.dir.dot(surface.normal) < 0.0 {
+                            surface.normal
+                        } else {
+                            -surface.normal
+                        };
+                        data.extend_from_slice(&[n.x as f32, n.y as f32, n.z as f32]);
+                    }
+                    (Aov::Normal, None) => data.extend_from_slice(&[0.0; 3]),
+                    (Aov::Id, Some((hit, _))) => data.push(hit.primitive as f32),
+                    (Aov::Id, None) => data.push(-1.0),
+                }
+            }
+        }
+    }
+    tile
+}

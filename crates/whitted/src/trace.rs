@@ -1,0 +1,360 @@
+//! The recursive Whitted integrator.
+//!
+//! For the closest hit of a ray it sums emission, ambient, direct light from
+//! every light (Phong diffuse and specular, each light seen through one
+//! shadow ray), and the mirror-reflected and refracted rays, recursively.
+//! See [`crate::material`] for the formula and the Fresnel option.
+//!
+//! - Shading is two-sided: the normal is turned to face the incoming ray.
+//! - Shadow rays pass through transmissive surfaces, each crossing scaling
+//!   the light by that surface's `kt`; an opaque surface blocks it.
+//! - Refraction follows Snell's law with the index of the medium the ray is
+//!   in, tracked on a small stack of the objects it has entered; total
+//!   internal reflection moves the refracted weight onto the reflected ray.
+//! - Recursion stops at `max_depth`, and earlier when a branch's weight on
+//!   the pixel falls below `min_weight` (adaptive depth control).
+
+use crate::geometry::{Geometry, Hit, Surface};
+use crate::light::Light;
+use crate::material::{Material, MaterialId};
+use crate::math::{Color, Ray, Vec3, offset_ray_origin, reflect, refract, schlick_reflectance};
+use crate::scene::{RenderSettings, Scene};
+
+/// How many rays of each kind were traced.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayCounts {
+    /// Rays from the camera.
+    pub primary: u64,
+    /// Rays towards lights (one per light per shaded point, plus one per
+    /// transmissive surface crossed).
+    pub shadow: u64,
+    /// Mirror-reflected rays.
+    pub reflected: u64,
+    /// Refracted rays.
+    pub refracted: u64,
+}
+
+impl RayCounts {
+    /// All rays.
+    pub fn total(&self) -> u64 {
+        self.primary + self.shadow + self.reflected + self.refracted
+    }
+}
+
+impl std::ops::AddAssign for RayCounts {
+    fn add_assign(&mut self, o: Self) {
+        self.primary += o.primary;
+        self.shadow += o.shadow;
+        self.reflected += o.reflected;
+        self.refracted += o.refracted;
+    }
+}
+
+/// The objects a ray is inside, innermost last, with their indices of
+/// refraction. Fixed capacity: no allocation per ray.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct MediumStack {
+    entries: [(u32, f64); Self::CAPACITY],
+    len: usize,
+}
+
+impl MediumStack {
+    const CAPACITY: usize = 8;
+
+    /// The index of refraction the ray travels in (1 outside everything).
+    pub fn ior(&self) -> f64 {
+        if self.len == 0 {
+            1.0
+        } else {
+            self.entries[self.len - 1].1
+        }
+    }
+
+    /// The stack after entering an object of `material`.
+    pub fn entered(mut self, material: MaterialId, ior: f64) -> Self {
+        if self.len < Self::CAPACITY {
+            self.entries[self.len] = (material.0, ior);
+            self.len += 1;
+        }
+        self
+    }
+
+    /// The stack after leaving an object of `material` (its innermost
+    /// entry; unchanged if the ray was not known to be inside it).
+    pub fn left(mut self, material: MaterialId) -> Self {
+        if let Some(i) = self.entries[..self.len]
+            .iter()
+            .rposition(|&(m, _)| m == material.0)
+        {
+            self.entries.copy_within(i + 1..self.len, i);
+            self.len -= 1;
+        }
+        self
+    }
+}
+
+/// Longest chain of transmissive surfaces one shadow ray passes through.
+const MAX_SHADOW_CROSSINGS: usize = 64;
+
+/// Traces rays through a scene.
+#[derive(Debug)]
+pub struct Tracer<'a> {
+    scene: &'a Scene,
+    geometry: Geometry<'a>,
+    settings: RenderSettings,
+    any_transmissive: bool,
+}
+
+/// The result of tracing one primary ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PrimarySample {
+    /// The colour seen.
+    pub color: Color,
+    /// The first hit, if any, with its world-space surface.
+    pub first_hit: Option<(Hit, Surface)>,
+}
+
+impl<'a> Tracer<'a> {
+    /// Prepares `scene` for tracing with `settings`.
+    pub fn new(scene: &'a Scene, settings: RenderSettings) -> Self {
+        Self {
+            scene,
+            geometry: Geometry::new(scene),
+            settings,
+            any_transmissive: scene.materials.iter().any(Material::is_transmissive),
+        }
+    }
+
+    /// The prepared geometry.
+    pub fn geometry(&self) -> &Geometry<'a> {
+        &self.geometry
+    }
+
+    /// The scene being traced.
+    pub fn scene(&self) -> &'a Scene {
+        self.scene
+    }
+
+    /// The first hit along a ray and its surface, without shading.
+    pub fn first_hit(&self, ray: &Ray) -> Option<(Hit, Surface)> {
+        let hit = self.geometry.intersect(ray)?;
+        Some((hit, self.geometry.surface(ray, &hit)))
+    }
+
+    /// The colour seen along a camera ray (unit direction), and its first hit.
+    pub fn trace_primary(&self, ray: &Ray, counts: &mut RayCounts) -> PrimarySample {
+        counts.primary += 1;
+        match self.geometry.intersect(ray) {
+            None => PrimarySample {
+                color: self.scene.background,
+                first_hit: None,
+            },
+            Some(hit) => {
+                let surface = self.geometry.surface(ray, &hit);
+                let color = self.shade(ray, &surface, 0, 1.0, MediumStack::default(), counts);
+                PrimarySample {
+                    color,
+                    first_hit: Some((hit, surface)),
+                }
+            }
+        }
+    }
+
+    /// The colour seen along a secondary ray (unit direction).
+    fn trace(
+        &self,
+        ray: &Ray,
+        depth: u32,
+        weight: f64,
+        media: MediumStack,
+        counts: &mut RayCounts,
+    ) -> Color {
+        match self.geometry.intersect(ray) {
+            None => self.scene.background,
+            Some(hit) => {
+                let surface = self.geometry.surface(ray, &hit);
+                self.shade(ray, &surface, depth, weight, media, counts)
+            }
+        }
+    }
+
+    /// The colour leaving `s` back along `ray`. `weight` is the largest
+    /// factor by which this colour reaches the pixel.
+    fn shade(
+        &self,
+        ray: &Ray,
+        s: &Surface,
+        depth: u32,
+        weight: f64,
+        media: MediumStack,
+        counts: &mut RayCounts,
+    ) -> Color {
+        let m = &self.scene.materials[s.material.0 as usize];
+        let incident = ray.dir;
+        let view = -incident;
+        let entering = incident.dot(s.normal) < 0.0;
+        let n = if entering { s.normal } else { -s.normal };
+
+        let mut color = m.emission.at(s.uv) + m.ambient.at(s.uv) * self.scene.ambient;
+
+        let diffuse = m.diffuse.at(s.uv);
+        let specular = m.specular.at(s.uv);
+        if diffuse != Color::ZERO || specular != Color::ZERO {
+            for light in &self.scene.lights {
+                let Some(sample) = light.sample(s.point) else {
+                    continue;
+                };
+                let n_dot_l = n.dot(sample.to_light);
+                if n_dot_l <= 0.0 {
+                    continue;
+                }
+                let shadow = self.transmittance(s, light, sample.to_light, sample.distance, counts);
+                if shadow == Color::ZERO {
+                    continue;
+                }
+                let mut direct = diffuse * n_dot_l;
+                let r_dot_v = reflect(-sample.to_light, n).dot(view);
+                if r_dot_v > 0.0 && specular != Color::ZERO {
+                    direct += specular * r_dot_v.powf(m.shininess);
+                }
+                color += shadow * sample.intensity * direct;
+            }
+        }
+
+        if depth >= self.settings.max_depth {
+            return color;
+        }
+        let kr = m.reflection.at(s.uv);
+        let kt = m.transmission.at(s.uv);
+        if kr == Color::ZERO && kt == Color::ZERO {
+            return color;
+        }
+
+        let (n_from, n_to, inside_after) = if entering {
+            (media.ior(), m.ior, media.entered(s.material, m.ior))
+        } else {
+            let outside = media.left(s.material);
+            (m.ior, outside.ior(), outside)
+        };
+        let cos_i = view.dot(n).clamp(0.0, 1.0);
+        let (mut reflected_weight, mut transmitted_weight) = if m.fresnel && kt != Color::ZERO {
+            let f = schlick_reflectance(cos_i, n_from, n_to);
+            (kr + kt * f, kt * (1.0 - f))
+        } else {
+            (kr, kt)
+        };
+        let refracted = if transmitted_weight == Color::ZERO {
+            None
+        } else {
+            refract(incident, n, n_from / n_to)
+        };
+        if refracted.is_none() {
+            reflected_weight += transmitted_weight;
+            transmitted_weight = Color::ZERO;
+        }
+
+        let child = weight * reflected_weight.max_element();
+        if child >= self.settings.min_weight && reflected_weight != Color::ZERO {
+            counts.reflected += 1;
+            let dir = reflect(incident, n);
+            let origin = offset_ray_origin(s.point, s.point_error, s.normal, dir);
+            let c = self.trace(&Ray::new(origin, dir), depth + 1, child, media, counts);
+            color += reflected_weight * c;
+        }
+        if let Some(dir) = refracted {
+            let child = weight * transmitted_weight.max_element();
+            if child >= self.settings.min_weight {
+                counts.refracted += 1;
+                let dir = dir.normalize();
+                let origin = offset_ray_origin(s.point, s.point_error, s.normal, dir);
+                let c = self.trace(
+                    &Ray::new(origin, dir),
+                    depth + 1,
+                    child,
+                    inside_after,
+                    counts,
+                );
+                color += transmitted_weight * c;
+            }
+        }
+        color
+    }
+
+    /// How much of `light` reaches `s` along `to_light` (unit) over
+    /// `distance`: 0 behind an opaque surface, the product of the `kt` of
+    /// every transmissive surface crossed otherwise.
+    fn transmittance(
+        &self,
+        s: &Surface,
+        light: &Light,
+        to_light: Vec3,
+        distance: f64,
+        counts: &mut RayCounts,
+    ) -> Color {
+        counts.shadow += 1;
+        let origin = offset_ray_origin(s.point, s.point_error, s.normal, to_light);
+        let target = match light {
+            Light::Directional { .. } => None,
+            Light::Point { position, .. } | Light::Spot { position, .. } => Some(*position),
+        };
+        let segment = |origin: Vec3| {
+            let t_max = target.map_or(distance, |p| (p - origin).dot(to_light));
+            Ray::segment(origin, to_light, t_max)
+        };
+        let mut ray = segment(origin);
+        if !self.any_transmissive {
+            return if self.geometry.occluded(&ray) {
+                Color::ZERO
+            } else {
+                Color::ONE
+            };
+        }
+        let mut through = Color::ONE;
+        for _ in 0..MAX_SHADOW_CROSSINGS {
+            let Some(hit) = self.geometry.intersect(&ray) else {
+                return through;
+            };
+            let blocker = self.geometry.surface(&ray, &hit);
+            let m = &self.scene.materials[blocker.material.0 as usize];
+            through *= m.transmission.at(blocker.uv);
+            if through.max_element() <= 0.0 {
+                return Color::ZERO;
+            }
+            counts.shadow += 1;
+            let origin =
+                offset_ray_origin(blocker.point, blocker.point_error, blocker.normal, to_light);
+            ray = segment(origin);
+        }
+        Color::ZERO
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn medium_stack_tracks_nested_objects() {
+        let glass = MaterialId(1);
+        let water = MaterialId(2);
+        let s = MediumStack::default();
+        assert_eq!(s.ior(), 1.0);
+        let s = s.entered(glass, 1.5);
+        let s = s.entered(water, 1.33);
+        assert_eq!(s.ior(), 1.33);
+        let s = s.left(water);
+        assert_eq!(s.ior(), 1.5);
+        assert_eq!(s.left(MaterialId(9)).ior(), 1.5);
+        assert_eq!(s.left(glass).ior(), 1.0);
+    }
+
+    #[test]
+    fn medium_stack_leaving_an_outer_object_keeps_the_inner_one() {
+        let s = MediumStack::default()
+            .entered(MaterialId(1), 1.5)
+            .entered(MaterialId(2), 1.33)
+            .left(MaterialId(1));
+        assert_eq!(s.ior(), 1.33);
+        assert_eq!(s.left(MaterialId(2)).ior(), 1.0);
+    }
+}

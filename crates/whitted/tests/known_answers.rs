@@ -1,0 +1,290 @@
+//! Renders of analytic scenes whose correct pixel values are known exactly.
+
+use whitted::camera::Camera;
+use whitted::image::Film;
+use whitted::light::{Attenuation, Light};
+use whitted::material::Material;
+use whitted::math::{Color, Transform, Vec3};
+use whitted::render::{RenderOptions, render};
+use whitted::scene::Scene;
+use whitted::shape::{Plane, Shape, Sphere};
+use whitted::texture::Texture;
+
+fn black() -> Material {
+    Material {
+        ambient: Texture::default(),
+        diffuse: Texture::default(),
+        ..Material::default()
+    }
+}
+
+fn scene_looking_down_z(width: u32, height: u32, fov: f64) -> Scene {
+    let camera = Camera::new(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, fov).unwrap();
+    let mut scene = Scene::new(camera);
+    scene.settings.width = width;
+    scene.settings.height = height;
+    scene
+}
+
+fn rendered(scene: &Scene) -> Film {
+    render(scene, &RenderOptions::default(), &|_| {})
+        .unwrap()
+        .image
+}
+
+fn pixel(film: &Film, x: u32, y: u32) -> Color {
+    let p = film.pixel(x, y);
+    Color::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
+}
+
+fn assert_close(actual: Color, expected: Color, tolerance: f64) {
+    assert!(
+        (actual - expected).abs().max_element() <= tolerance,
+        "got {actual:?}, expected {expected:?}"
+    );
+}
+
+#[test]
+fn diffuse_plane_lit_head_on_is_kd_times_intensity_in_every_pixel() {
+    let mut scene = scene_looking_down_z(17, 11, 60.0);
+    let kd = Color::new(0.5, 0.25, 0.75);
+    let intensity = Color::new(0.8, 1.0, 0.6);
+    let material = scene.add_material(Material {
+        diffuse: kd.into(),
+        ..black()
+    });
+    scene.add_primitive(
+        Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Z).unwrap()),
+        material,
+        Transform::IDENTITY,
+    );
+    scene.lights.push(Light::Directional {
+        direction: -Vec3::Z,
+        intensity,
+    });
+    let film = rendered(&scene);
+    let expected = (kd * intensity).as_vec3();
+    for y in 0..11 {
+        for x in 0..17 {
+            assert_eq!(
+                film.pixel(x, y),
+                expected.to_array().as_slice(),
+                "({x}, {y})"
+            );
+        }
+    }
+}
+
+#[test]
+fn point_light_follows_the_cosine_and_inverse_square_laws() {
+    let mut scene = scene_looking_down_z(3, 3, 60.0);
+    let material = scene.add_material(Material {
+        diffuse: Color::ONE.into(),
+        ..black()
+    });
+    scene.add_primitive(
+        Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Z).unwrap()),
+        material,
+        Transform::IDENTITY,
+    );
+    // Light 2 units above the point the centre pixel sees, off to the side
+    // by 2: distance √8, cos θ = 2 / √8.
+    scene.lights.push(Light::Point {
+        position: Vec3::new(2.0, 0.0, 2.0),
+        intensity: Color::splat(8.0),
+        attenuation: Attenuation {
+            constant: 0.0,
+            linear: 0.0,
+            quadratic: 1.0,
+        },
+    });
+    let film = rendered(&scene);
+    let expected = 8.0 / 8.0 * (2.0 / 8f64.sqrt());
+    assert_close(pixel(&film, 1, 1), Color::splat(expected), 1e-6);
+}
+
+#[test]
+fn ambient_and_emission_add_up_without_lights() {
+    let mut scene = scene_looking_down_z(5, 5, 40.0);
+    scene.ambient = Color::new(0.2, 0.4, 0.6);
+    let material = scene.add_material(Material {
+        ambient: Color::splat(0.5).into(),
+        emission: Color::new(0.1, 0.0, 0.05).into(),
+        ..black()
+    });
+    scene.add_primitive(
+        Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Z).unwrap()),
+        material,
+        Transform::IDENTITY,
+    );
+    let film = rendered(&scene);
+    assert_close(pixel(&film, 2, 2), Color::new(0.2, 0.2, 0.35), 1e-7);
+}
+
+#[test]
+fn mirror_facing_a_coloured_wall_shows_the_wall_colour_times_kr() {
+    let mut scene = scene_looking_down_z(9, 9, 30.0);
+    let kr = Color::new(0.9, 0.5, 0.25);
+    let wall_colour = Color::new(0.2, 0.8, 0.6);
+    let mirror = scene.add_material(Material {
+        reflection: kr.into(),
+        ..black()
+    });
+    let wall = scene.add_material(Material {
+        emission: wall_colour.into(),
+        ..black()
+    });
+    scene.background = Color::ONE;
+    scene.add_primitive(
+        Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Z).unwrap()),
+        mirror,
+        Transform::IDENTITY,
+    );
+    // The wall is behind the camera, facing the mirror.
+    scene.add_primitive(
+        Shape::Plane(Plane::new(Vec3::new(0.0, 0.0, 10.0), -Vec3::Z).unwrap()),
+        wall,
+        Transform::IDENTITY,
+    );
+    let film = rendered(&scene);
+    for y in 0..9 {
+        for x in 0..9 {
+            assert_close(pixel(&film, x, y), kr * wall_colour, 1e-7);
+        }
+    }
+}
+
+#[test]
+fn light_through_the_centre_of_a_glass_sphere_is_scaled_by_kt_twice() {
+    let mut scene = scene_looking_down_z(5, 5, 10.0);
+    scene.background = Color::new(1.0, 0.5, 0.25);
+    let glass = scene.add_material(Material {
+        transmission: Color::splat(0.9).into(),
+        ior: 1.5,
+        ..black()
+    });
+    scene.add_primitive(
+        Shape::Sphere(Sphere::new(Vec3::ZERO, 1.0).unwrap()),
+        glass,
+        Transform::IDENTITY,
+    );
+    let film = rendered(&scene);
+    assert_close(pixel(&film, 2, 2), 0.81 * scene.background, 1e-6);
+}
+
+#[test]
+fn glass_sphere_never_shows_black_from_total_internal_reflection() {
+    let mut scene = scene_looking_down_z(41, 41, 30.0);
+    scene.background = Color::ONE;
+    let glass = scene.add_material(Material {
+        transmission: Color::ONE.into(),
+        ior: 2.4,
+        fresnel: true,
+        ..black()
+    });
+    scene.add_primitive(
+        Shape::Sphere(Sphere::new(Vec3::ZERO, 1.5).unwrap()),
+        glass,
+        Transform::IDENTITY,
+    );
+    scene.settings.max_depth = 30;
+    scene.settings.min_weight = 0.0;
+    let film = rendered(&scene);
+    for y in 0..41 {
+        for x in 0..41 {
+            let c = pixel(&film, x, y);
+            assert!(c.min_element() > 0.5, "pixel ({x}, {y}) is dark: {c:?}");
+        }
+    }
+}
+
+fn shadow_scene(occluder: Material) -> Scene {
+    let mut scene = scene_looking_down_z(5, 5, 10.0);
+    let floor = scene.add_material(Material {
+        diffuse: Color::ONE.into(),
+        ..black()
+    });
+    let occluder = scene.add_material(occluder);
+    scene.add_primitive(
+        Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Z).unwrap()),
+        floor,
+        Transform::IDENTITY,
+    );
+    // A small sphere beside the line of sight, between the floor and a
+    // light that shines along -z from off-axis.
+    scene.add_primitive(
+        Shape::Sphere(Sphere::new(Vec3::new(1.0, 0.0, 1.0), 0.5).unwrap()),
+        occluder,
+        Transform::IDENTITY,
+    );
+    scene.lights.push(Light::Point {
+        position: Vec3::new(2.0, 0.0, 2.0),
+        intensity: Color::ONE,
+        attenuation: Attenuation::NONE,
+    });
+    scene
+}
+
+#[test]
+fn opaque_occluder_blocks_the_light_completely() {
+    let film = rendered(&shadow_scene(black()));
+    assert_eq!(pixel(&film, 2, 2), Color::ZERO);
+}
+
+#[test]
+fn transparent_occluder_attenuates_by_kt_at_each_surface() {
+    let film = rendered(&shadow_scene(Material {
+        transmission: Color::new(0.5, 0.8, 1.0).into(),
+        ior: 1.0,
+        ..black()
+    }));
+    let unshadowed = 1.0 / 2f64.sqrt();
+    let kt = Color::new(0.5, 0.8, 1.0);
+    assert_close(pixel(&film, 2, 2), unshadowed * kt * kt, 1e-6);
+}
+
+#[test]
+fn phong_highlight_peaks_where_the_mirror_direction_meets_the_eye() {
+    let mut scene = scene_looking_down_z(3, 3, 10.0);
+    let material = scene.add_material(Material {
+        specular: Color::ONE.into(),
+        shininess: 10.0,
+        ..black()
+    });
+    scene.add_primitive(
+        Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Z).unwrap()),
+        material,
+        Transform::IDENTITY,
+    );
+    scene.lights.push(Light::Directional {
+        direction: -Vec3::Z,
+        intensity: Color::ONE,
+    });
+    let film = rendered(&scene);
+    assert_close(pixel(&film, 1, 1), Color::ONE, 1e-12);
+    let corner = pixel(&film, 0, 0).x;
+    assert!(corner < 1.0 && corner > 0.9, "{corner}");
+}
+
+#[test]
+fn picture_is_identical_whatever_the_thread_count() {
+    let mut scene = Scene::default_scene();
+    scene.settings.width = 48;
+    scene.settings.height = 36;
+    scene.settings.samples_per_pixel = 4;
+    let with = |threads| {
+        render(
+            &scene,
+            &RenderOptions {
+                threads: Some(threads),
+                aovs: Vec::new(),
+            },
+            &|_| {},
+        )
+        .unwrap()
+    };
+    let one = with(1);
+    let three = with(3);
+    assert_eq!(one.image, three.image);
+    assert_eq!(one.rays, three.rays);
+}
