@@ -210,7 +210,7 @@ impl Aabb {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum TransformError {
     /// The matrix has no inverse (a zero scale, or collapsed axes).
-    #[error("the transform is singular (determinant {determinant:e}); it collapses space")]
+    #[error("the transform is singular: it flattens space (a zero scale or dependent axes)")]
     Singular {
         /// The determinant of the linear part.
         determinant: f64,

@@ -267,7 +267,7 @@ mod tests {
                 "missing required key `radius` in object",
                 "unknown key `radiuss` in object; expected one of: shape, material, transform, \
                  center, radius",
-                "the transform is singular (determinant 0e0); it collapses space",
+                "the transform is singular: it flattens space (a zero scale or dependent axes)",
             ]
         );
         assert_eq!(
@@ -304,7 +304,7 @@ mod tests {
                 "missing required key `axis` in `rotate`",
                 "unknown key `turns` in `rotate`; expected one of: axis, angle",
                 "expected 3 rows of 4 numbers for `matrix`, found 2 rows",
-                "the transform is singular (determinant 0e0); it collapses space",
+                "the transform is singular: it flattens space (a zero scale or dependent axes)",
                 "expected a table for `transform`, found an integer",
             ]
         );
