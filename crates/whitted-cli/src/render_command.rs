@@ -16,6 +16,10 @@ use crate::progress::ProgressReport;
 /// .pfm (linear 32-bit float). Command-line settings override the scene
 /// file's [render] table.
 #[derive(Debug, Args)]
+#[command(after_long_help = "Examples:
+  whitted render                                  the built-in scene, to whitted.png
+  whitted render scenes/shapes.toml -o shapes.png --width 800 --height 600 --spp 4
+  whitted render scenes/whitted.toml -o out.exr --aov depth=depth.pfm --aov normal=normal.exr")]
 pub struct RenderArgs {
     /// Scene file (.toml). Without one, the built-in scene is rendered.
     scene: Option<PathBuf>,

@@ -176,3 +176,92 @@ impl Surface {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Camera;
+    use crate::material::Material;
+    use crate::shape::{Plane, Shape, Sphere};
+
+    fn scene_with(shape: Shape, transform: Transform) -> Scene {
+        let camera = Camera::new(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0).unwrap();
+        let mut scene = Scene::new(camera);
+        let m = scene.add_material(Material::default());
+        scene.add_primitive(shape, m, transform);
+        scene
+    }
+
+    #[test]
+    fn scaled_rotated_translated_sphere_is_hit_where_expected_with_correct_normals() {
+        // A unit sphere stretched to an ellipsoid with semi-axes (2, 1, 1),
+        // turned 90° about z (long axis now along y), moved to (5, 0, 0).
+        let transform = Transform::translate(Vec3::new(5.0, 0.0, 0.0))
+            .unwrap()
+            .then_after(&Transform::rotate(Vec3::Z, 90.0).unwrap())
+            .then_after(&Transform::scale(Vec3::new(2.0, 1.0, 1.0)).unwrap());
+        let sphere = Shape::Sphere(Sphere::new(Vec3::ZERO, 1.0).unwrap());
+        let scene = scene_with(sphere, transform);
+        let geometry = Geometry::new(&scene);
+
+        let down = Ray::new(Vec3::new(5.0, 10.0, 0.0), -Vec3::Y);
+        let hit = geometry.intersect(&down).unwrap();
+        assert!((hit.t() - 8.0).abs() < 1e-12);
+        let s = geometry.surface(&down, &hit);
+        assert!((s.point - Vec3::new(5.0, 2.0, 0.0)).length() < 1e-12);
+        assert!((s.normal - Vec3::Y).length() < 1e-12);
+
+        let across = Ray::new(Vec3::new(0.0, 0.0, 0.0), Vec3::X);
+        let hit = geometry.intersect(&across).unwrap();
+        assert!((hit.t() - 4.0).abs() < 1e-12);
+        assert!((geometry.surface(&across, &hit).normal + Vec3::X).length() < 1e-12);
+
+        // Off-axis: the ellipsoid x'² + (y/2)² + z² = 1 around (5, 0, 0) has
+        // its normal along (x', y/4, z) at (x', y, z).
+        let y = 3f64.sqrt();
+        let oblique = Ray::new(Vec3::new(10.0, y, 0.0), -Vec3::X);
+        let hit = geometry.intersect(&oblique).unwrap();
+        let s = geometry.surface(&oblique, &hit);
+        assert!((s.point - Vec3::new(5.5, y, 0.0)).length() < 1e-12);
+        let expected = Vec3::new(0.5, y / 4.0, 0.0).normalize();
+        assert!((s.normal - expected).length() < 1e-12);
+        assert!(geometry.occluded(&oblique));
+    }
+
+    #[test]
+    fn transformed_bounds_contain_the_transformed_shape() {
+        let transform = Transform::rotate(Vec3::new(1.0, 1.0, 1.0), 30.0)
+            .unwrap()
+            .then_after(&Transform::scale(Vec3::new(3.0, 0.5, 1.0)).unwrap());
+        let sphere = Shape::Sphere(Sphere::new(Vec3::new(1.0, 0.0, 0.0), 1.0).unwrap());
+        let scene = scene_with(sphere, transform);
+        let geometry = Geometry::new(&scene);
+        assert_eq!(geometry.accel.len(), 1);
+        let world = transform.bounds_to_world(&scene.primitives[0].shape.bounds());
+        let mut rng = crate::random::Rng::new(5);
+        let mut hits = 0;
+        for _ in 0..500 {
+            let target = rng.unit_vector() * 3.0;
+            let ray = Ray::new(Vec3::splat(20.0), target - Vec3::splat(20.0));
+            if let Some(hit) = geometry.intersect(&ray) {
+                let p = geometry.surface(&ray, &hit).point;
+                assert!(p.cmpge(world.min - 1e-9).all() && p.cmple(world.max + 1e-9).all());
+                hits += 1;
+            }
+        }
+        assert!(hits > 50);
+    }
+
+    #[test]
+    fn unbounded_planes_are_tested_beside_the_structure() {
+        let plane = Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Y).unwrap());
+        let scene = scene_with(plane, Transform::IDENTITY);
+        let geometry = Geometry::new(&scene);
+        assert!(geometry.accel.is_empty());
+        let ray = Ray::new(Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, -1.0, 0.0));
+        assert_eq!(geometry.intersect(&ray).unwrap().t(), 1.0);
+        assert!(geometry.occluded(&ray));
+        let up = Ray::new(Vec3::new(0.0, 1.0, 0.0), Vec3::Y);
+        assert!(geometry.intersect(&up).is_none() && !geometry.occluded(&up));
+    }
+}

@@ -288,3 +288,43 @@ fn picture_is_identical_whatever_the_thread_count() {
     assert_eq!(one.image, three.image);
     assert_eq!(one.rays, three.rays);
 }
+
+#[test]
+fn aovs_give_depth_normal_and_primitive_of_the_centre_ray() {
+    use whitted::render::Aov;
+    let mut scene = scene_looking_down_z(3, 3, 90.0);
+    let material = scene.add_material(Material::default());
+    // The left column sees nothing; the rest sees a wall 5 units away.
+    scene.add_primitive(
+        Shape::Sphere(Sphere::new(Vec3::new(0.0, 0.0, -1000.0), 1.0).unwrap()),
+        material,
+        Transform::IDENTITY,
+    );
+    scene.add_primitive(
+        Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Z).unwrap()),
+        material,
+        Transform::IDENTITY,
+    );
+    let options = RenderOptions {
+        threads: None,
+        aovs: vec![Aov::Id, Aov::Depth, Aov::Normal],
+    };
+    let out = render(&scene, &options, &|_| {}).unwrap();
+    let film = |aov| &out.aovs.iter().find(|(a, _)| *a == aov).unwrap().1;
+    assert_eq!(out.aovs[0].0, Aov::Id);
+    assert_eq!(film(Aov::Depth).pixel(1, 1), &[5.0]);
+    assert_eq!(film(Aov::Normal).pixel(1, 1), &[0.0, 0.0, 1.0]);
+    assert_eq!(film(Aov::Id).pixel(1, 1), &[1.0]);
+    // The corner pixel's centre ray leaves at (1/3, 1/3) of the 45° half
+    // field: it meets the plane farther away.
+    let corner_depth = f64::from(film(Aov::Depth).pixel(0, 0)[0]);
+    let s: f64 = 2.0 / 3.0;
+    assert!((corner_depth - 5.0 * (1.0 + 2.0 * s * s).sqrt()).abs() < 1e-5);
+
+    scene.primitives.pop();
+    let out = render(&scene, &options, &|_| {}).unwrap();
+    let film = |aov| &out.aovs.iter().find(|(a, _)| *a == aov).unwrap().1;
+    assert_eq!(film(Aov::Depth).pixel(0, 0), &[f32::INFINITY]);
+    assert_eq!(film(Aov::Normal).pixel(0, 0), &[0.0, 0.0, 0.0]);
+    assert_eq!(film(Aov::Id).pixel(0, 0), &[-1.0]);
+}
