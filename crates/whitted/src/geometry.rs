@@ -3,7 +3,7 @@
 //! unbounded ones, and the two queries every tracer needs — the closest hit
 //! and any hit — plus the full surface description of a final hit.
 
-use crate::accel::Linear;
+use crate::accel::{AccelKind, Accelerator, TraversalCounters};
 use crate::material::MaterialId;
 use crate::math::{DVec2, Ray, Transform, Vec3};
 use crate::scene::{Primitive, Scene};
@@ -47,14 +47,19 @@ pub struct Surface {
 pub struct Geometry<'a> {
     primitives: &'a [Primitive],
     transforms: &'a [Transform],
-    accel: Linear,
+    accel: Accelerator,
     bounded: Vec<u32>,
     unbounded: Vec<u32>,
 }
 
 impl<'a> Geometry<'a> {
-    /// Prepares the scene's primitives.
+    /// Prepares the scene's primitives with brute force.
     pub fn new(scene: &'a Scene) -> Self {
+        Self::with_accel(scene, AccelKind::Linear)
+    }
+
+    /// Prepares the scene's primitives with the structure `kind`.
+    pub fn with_accel(scene: &'a Scene, kind: AccelKind) -> Self {
         let mut bounded = Vec::new();
         let mut unbounded = Vec::new();
         let mut boxes = Vec::new();
@@ -74,7 +79,7 @@ impl<'a> Geometry<'a> {
         Self {
             primitives: &scene.primitives,
             transforms: &scene.transforms,
-            accel: Linear::build(&boxes),
+            accel: Accelerator::build(kind, &boxes),
             bounded,
             unbounded,
         }
@@ -105,8 +110,18 @@ impl<'a> Geometry<'a> {
         }
     }
 
+    /// The acceleration structure over the bounded primitives.
+    pub fn accelerator(&self) -> &Accelerator {
+        &self.accel
+    }
+
     /// The closest hit in the ray's interval.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.intersect_counted(ray, &mut TraversalCounters::default())
+    }
+
+    /// The closest hit, adding the traversal work to `counters`.
+    pub fn intersect_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> Option<Hit> {
         let mut best: Option<Hit> = None;
         let mut t_max = ray.t_max;
         for &i in &self.unbounded {
@@ -120,7 +135,7 @@ impl<'a> Geometry<'a> {
         }
         let mut clipped = *ray;
         clipped.t_max = t_max;
-        self.accel.intersect(&clipped, |slot, t_max| {
+        self.accel.intersect(&clipped, counters, |slot, t_max| {
             let i = self.bounded[slot as usize];
             let h = self.intersect_primitive(i, ray, t_max)?;
             best = Some(Hit {
@@ -134,8 +149,13 @@ impl<'a> Geometry<'a> {
 
     /// True when anything lies in the ray's interval.
     pub fn occluded(&self, ray: &Ray) -> bool {
+        self.occluded_counted(ray, &mut TraversalCounters::default())
+    }
+
+    /// Any hit, adding the traversal work to `counters`.
+    pub fn occluded_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> bool {
         self.unbounded.iter().any(|&i| self.occluded_by(i, ray))
-            || self.accel.occluded(ray, |slot| {
+            || self.accel.occluded(ray, counters, |slot| {
                 self.occluded_by(self.bounded[slot as usize], ray)
             })
     }
@@ -236,7 +256,7 @@ mod tests {
         let sphere = Shape::Sphere(Sphere::new(Vec3::new(1.0, 0.0, 0.0), 1.0).unwrap());
         let scene = scene_with(sphere, transform);
         let geometry = Geometry::new(&scene);
-        assert_eq!(geometry.accel.len(), 1);
+        assert_eq!(geometry.accel.stats().references, 1);
         let world = transform.bounds_to_world(&scene.primitives[0].shape.bounds());
         let mut rng = crate::random::Rng::new(5);
         let mut hits = 0;
@@ -257,7 +277,7 @@ mod tests {
         let plane = Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Y).unwrap());
         let scene = scene_with(plane, Transform::IDENTITY);
         let geometry = Geometry::new(&scene);
-        assert!(geometry.accel.is_empty());
+        assert_eq!(geometry.accel.stats().references, 0);
         let ray = Ray::new(Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, -1.0, 0.0));
         assert_eq!(geometry.intersect(&ray).unwrap().t(), 1.0);
         assert!(geometry.occluded(&ray));

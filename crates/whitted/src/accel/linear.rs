@@ -1,9 +1,10 @@
 //! Brute force: every primitive tested against every ray. The reference that
 //! every faster structure is checked against.
 
+use super::{AccelStats, TraversalCounters};
 use crate::math::{Aabb, Ray};
 
-/// Tests every primitive, in index order.
+/// Tests every primitive whose box the ray meets, in index order.
 #[derive(Clone, Debug, Default)]
 pub struct Linear {
     bounds: Vec<Aabb>,
@@ -27,38 +28,66 @@ impl Linear {
         self.bounds.is_empty()
     }
 
-    /// Finds the closest hit: `hit(i, t_max)` intersects primitive `i` and
-    /// returns the parameter of a hit closer than `t_max`, if any. Returns
-    /// the closest parameter found.
+    /// The closest hit (see [`super`]).
     #[inline]
     pub fn intersect(
         &self,
         ray: &Ray,
+        counters: &mut TraversalCounters,
         mut hit: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<f64> {
         let mut closest = None;
-        let mut t_max = ray.t_max;
+        let mut clipped = *ray;
         for (i, b) in self.bounds.iter().enumerate() {
-            let mut clipped = *ray;
-            clipped.t_max = t_max;
+            counters.nodes += 1;
             if b.intersect_ray(&clipped).is_none() {
                 continue;
             }
-            if let Some(t) = hit(i as u32, t_max) {
-                t_max = t;
+            counters.primitives += 1;
+            if let Some(t) = hit(i as u32, clipped.t_max) {
+                clipped.t_max = t;
                 closest = Some(t);
             }
         }
         closest
     }
 
-    /// True when `occludes(i)` holds for some primitive `i` whose box the ray
-    /// meets; stops at the first.
+    /// Any hit (see [`super`]).
     #[inline]
-    pub fn occluded(&self, ray: &Ray, mut occludes: impl FnMut(u32) -> bool) -> bool {
-        self.bounds
-            .iter()
-            .enumerate()
-            .any(|(i, b)| b.intersect_ray(ray).is_some() && occludes(i as u32))
+    pub fn occluded(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        mut occludes: impl FnMut(u32) -> bool,
+    ) -> bool {
+        self.bounds.iter().enumerate().any(|(i, b)| {
+            counters.nodes += 1;
+            if b.intersect_ray(ray).is_none() {
+                return false;
+            }
+            counters.primitives += 1;
+            occludes(i as u32)
+        })
+    }
+
+    /// Checks that it holds exactly these boxes.
+    pub fn validate(&self, boxes: &[Aabb]) -> Result<(), String> {
+        if self.bounds == boxes {
+            Ok(())
+        } else {
+            Err("the stored boxes differ from the primitives' boxes".to_string())
+        }
+    }
+
+    /// One leaf holding everything.
+    pub fn stats(&self) -> AccelStats {
+        AccelStats {
+            nodes: 1,
+            leaves: 1,
+            references: self.bounds.len(),
+            memory_bytes: std::mem::size_of_val(self.bounds.as_slice()),
+            sah_cost: self.bounds.len() as f64,
+            max_depth: 0,
+        }
     }
 }

@@ -6,7 +6,152 @@
 //! closure's state. Unbounded shapes (infinite planes) never enter a
 //! structure: [`crate::geometry::Geometry`] tests them in a short list beside
 //! it.
+//!
+//! Every structure offers the same inherent methods, dispatched by
+//! [`Accelerator`]:
+//! - `intersect(ray, counters, hit)`: the closest hit. `hit(i, t_max)`
+//!   intersects primitive `i` and returns the parameter of a hit closer than
+//!   `t_max`, if any; the structure returns the closest parameter found.
+//! - `occluded(ray, counters, occludes)`: any hit; stops at the first
+//!   primitive for which `occludes(i)` holds.
+//! - `validate(boxes)`: checks the built structure's invariants.
+//! - `stats()`: its size and quality.
+//!
+//! Culling must be conservative: a structure may skip a primitive only when
+//! the ray provably cannot meet its box within the interval, so every
+//! structure returns exactly the closest hit the brute-force [`Linear`]
+//! returns (ties at equal `t` may pick either primitive).
 
 pub mod linear;
 
+#[cfg(test)]
+pub(crate) mod conformance;
+
 pub use linear::Linear;
+
+use crate::math::{Aabb, Ray};
+
+/// Work done for one or more rays: what the cost AOV and `whitted bench`
+/// report.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TraversalCounters {
+    /// Interior nodes, leaves or cells visited.
+    pub nodes: u64,
+    /// Primitive intersection tests made.
+    pub primitives: u64,
+}
+
+impl std::ops::AddAssign for TraversalCounters {
+    fn add_assign(&mut self, o: Self) {
+        self.nodes += o.nodes;
+        self.primitives += o.primitives;
+    }
+}
+
+/// Size and quality of a built structure.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AccelStats {
+    /// All nodes (or cells), interior and leaf.
+    pub nodes: usize,
+    /// Leaves (or non-empty cells).
+    pub leaves: usize,
+    /// Primitive references stored (a primitive may be in several leaves).
+    pub references: usize,
+    /// Bytes of memory the structure holds.
+    pub memory_bytes: usize,
+    /// Surface-area-heuristic cost of the structure (traversal step 1,
+    /// primitive test 1, relative to the root box), 0 where not defined.
+    pub sah_cost: f64,
+    /// Deepest leaf (0 for a single leaf).
+    pub max_depth: usize,
+}
+
+/// Which structure to build.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum AccelKind {
+    /// Brute force: the reference.
+    #[default]
+    Linear,
+}
+
+impl AccelKind {
+    /// Every kind, in the order `whitted bench` reports them.
+    pub const ALL: [AccelKind; 1] = [AccelKind::Linear];
+
+    /// The name used on the command line and in scene files.
+    pub fn name(&self) -> &'static str {
+        match self {
+            AccelKind::Linear => "linear",
+        }
+    }
+
+    /// The kind called `name`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+}
+
+/// A built acceleration structure of any kind.
+#[derive(Clone, Debug)]
+pub enum Accelerator {
+    /// Brute force.
+    Linear(Linear),
+}
+
+impl Accelerator {
+    /// Builds a structure of `kind` over primitives `0..boxes.len()`.
+    pub fn build(kind: AccelKind, boxes: &[Aabb]) -> Self {
+        match kind {
+            AccelKind::Linear => Accelerator::Linear(Linear::build(boxes)),
+        }
+    }
+
+    /// Which kind it is.
+    pub fn kind(&self) -> AccelKind {
+        match self {
+            Accelerator::Linear(_) => AccelKind::Linear,
+        }
+    }
+
+    /// The closest hit; see the module documentation.
+    #[inline]
+    pub fn intersect(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        hit: impl FnMut(u32, f64) -> Option<f64>,
+    ) -> Option<f64> {
+        match self {
+            Accelerator::Linear(s) => s.intersect(ray, counters, hit),
+        }
+    }
+
+    /// Any hit; see the module documentation.
+    #[inline]
+    pub fn occluded(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        occludes: impl FnMut(u32) -> bool,
+    ) -> bool {
+        match self {
+            Accelerator::Linear(s) => s.occluded(ray, counters, occludes),
+        }
+    }
+
+    /// Checks the structure's invariants against the boxes it was built
+    /// from: every primitive reachable, children inside parents, depth
+    /// within the traversal stack.
+    pub fn validate(&self, boxes: &[Aabb]) -> Result<(), String> {
+        match self {
+            Accelerator::Linear(s) => s.validate(boxes),
+        }
+    }
+
+    /// Size and quality.
+    pub fn stats(&self) -> AccelStats {
+        match self {
+            Accelerator::Linear(s) => s.stats(),
+        }
+    }
+}
