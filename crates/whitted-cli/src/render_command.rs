@@ -4,6 +4,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
+use whitted::accel::AccelKind;
+use whitted::heat_map::heat_map;
 use whitted::image::ImageFormat;
 use whitted::render::{Aov, RenderOptions, render};
 use whitted::scene::{Scene, load_scene};
@@ -44,21 +46,36 @@ pub struct RenderArgs {
     #[arg(long, value_name = "D")]
     max_depth: Option<u32>,
 
+    /// Acceleration structure over the objects (overrides the scene's
+    /// `accel`); every structure gives the same picture.
+    #[arg(long, value_name = "NAME", value_parser = parse_accel)]
+    accel: Option<AccelKind>,
+
     /// Worker threads (default: all cores). The picture is the same for any
     /// number.
     #[arg(long, value_name = "T")]
     threads: Option<usize>,
 
-    /// Also write per-pixel data, as NAME=FILE with FILE a .pfm or .exr.
-    /// NAME is depth (distance along the primary ray, +inf on a miss),
-    /// normal (world-space normal of the first hit, 0 on a miss) or id
-    /// (primitive index, -1 on a miss). Repeatable.
+    /// Also write per-pixel data of the ray through each pixel centre, as
+    /// NAME=FILE with FILE a .pfm or .exr. NAME is depth (distance along the
+    /// ray, +inf on a miss), normal (world-space normal of the first hit, 0
+    /// on a miss), id (primitive index, -1 on a miss) or cost (acceleration
+    /// structure nodes visited plus primitives tested; as .png it is drawn
+    /// as a heat map with a legend). Repeatable.
     #[arg(long, value_name = "NAME=FILE")]
     aov: Vec<String>,
 
     /// Print nothing but errors.
     #[arg(short, long)]
     quiet: bool,
+}
+
+/// Parses the name of an acceleration structure.
+fn parse_accel(name: &str) -> Result<AccelKind, String> {
+    AccelKind::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = AccelKind::ALL.iter().map(AccelKind::name).collect();
+        format!("expected one of: {}", names.join(", "))
+    })
 }
 
 /// Parses `NAME=FILE` into an AOV and its destination.
@@ -70,8 +87,13 @@ fn parse_aov(spec: &str) -> Result<(Aov, PathBuf), String> {
     let aov = Aov::from_name(name)
         .ok_or_else(|| format!("--aov {spec}: unknown AOV `{name}`; expected one of {names}"))?;
     let path = PathBuf::from(file);
-    match ImageFormat::from_path(&path) {
-        Ok(ImageFormat::Exr | ImageFormat::Pfm) => Ok((aov, path)),
+    match (aov, ImageFormat::from_path(&path)) {
+        (_, Ok(ImageFormat::Exr | ImageFormat::Pfm)) | (Aov::Cost, Ok(ImageFormat::Png)) => {
+            Ok((aov, path))
+        }
+        (Aov::Cost, _) => Err(format!(
+            "--aov {spec}: the cost AOV is written as .png (a heat map) or .pfm/.exr"
+        )),
         _ => Err(format!(
             "--aov {spec}: AOVs are written as .pfm or .exr files"
         )),
@@ -96,6 +118,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     settings.height = args.height.unwrap_or(settings.height);
     settings.samples_per_pixel = args.spp.unwrap_or(settings.samples_per_pixel);
     settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
+    settings.accel = args.accel.unwrap_or(settings.accel);
     if args.threads == Some(0) {
         return Err("--threads must be at least 1".to_string());
     }
@@ -116,8 +139,12 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         .image
         .write(&args.output)
         .map_err(|e| e.to_string())?;
-    for ((_, film), (_, path)) in output.aovs.iter().zip(&aov_outputs) {
-        film.write(path).map_err(|e| e.to_string())?;
+    for ((aov, film), (_, path)) in output.aovs.iter().zip(&aov_outputs) {
+        let written = match ImageFormat::from_path(path) {
+            Ok(ImageFormat::Png) if *aov == Aov::Cost => heat_map(film).write(path),
+            _ => film.write(path),
+        };
+        written.map_err(|e| e.to_string())?;
     }
 
     if !args.quiet {
@@ -164,5 +191,10 @@ mod tests {
                 .contains("unknown AOV `albedo`")
         );
         assert!(parse_aov("id=i.png").unwrap_err().contains(".pfm or .exr"));
+        assert_eq!(
+            parse_aov("cost=c.png"),
+            Ok((Aov::Cost, PathBuf::from("c.png")))
+        );
+        assert!(parse_aov("cost=c.bmp").unwrap_err().contains("heat map"));
     }
 }

@@ -45,6 +45,7 @@
 pub mod accel;
 pub mod camera;
 pub mod geometry;
+pub mod heat_map;
 pub mod image;
 pub mod light;
 pub mod material;

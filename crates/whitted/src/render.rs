@@ -6,6 +6,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 
+use crate::accel::TraversalCounters;
 use crate::image::Film;
 use crate::math::Color;
 use crate::random::hash64;
@@ -27,11 +28,14 @@ pub enum Aov {
     Normal,
     /// Index of the primitive hit, as a float; -1 for a miss.
     Id,
+    /// Traversal cost of that ray: acceleration-structure nodes visited plus
+    /// primitives tested.
+    Cost,
 }
 
 impl Aov {
     /// Every AOV.
-    pub const ALL: [Aov; 3] = [Aov::Depth, Aov::Normal, Aov::Id];
+    pub const ALL: [Aov; 4] = [Aov::Depth, Aov::Normal, Aov::Id, Aov::Cost];
 
     /// The name used on the command line.
     pub fn name(&self) -> &'static str {
@@ -39,6 +43,7 @@ impl Aov {
             Aov::Depth => "depth",
             Aov::Normal => "normal",
             Aov::Id => "id",
+            Aov::Cost => "cost",
         }
     }
 
@@ -51,7 +56,7 @@ impl Aov {
     pub fn channels(&self) -> usize {
         match self {
             Aov::Normal => 3,
-            Aov::Depth | Aov::Id => 1,
+            Aov::Depth | Aov::Id | Aov::Cost => 1,
         }
     }
 }
@@ -269,6 +274,11 @@ fn render_tile(
                     (Aov::Normal, None) => data.extend_from_slice(&[0.0; 3]),
                     (Aov::Id, Some((hit, _))) => data.push(hit.primitive as f32),
                     (Aov::Id, None) => data.push(-1.0),
+                    (Aov::Cost, _) => {
+                        let mut counters = TraversalCounters::default();
+                        tracer.geometry().intersect_counted(&ray, &mut counters);
+                        data.push((counters.nodes + counters.primitives) as f32);
+                    }
                 }
             }
         }

@@ -119,7 +119,7 @@ impl<'a> Tracer<'a> {
     pub fn new(scene: &'a Scene, settings: RenderSettings) -> Self {
         Self {
             scene,
-            geometry: Geometry::new(scene),
+            geometry: Geometry::with_accel(scene, settings.accel),
             settings,
             any_transmissive: scene.materials.iter().any(Material::is_transmissive),
         }

@@ -9,6 +9,7 @@ mod toml_format;
 pub use diagnostic::{Diagnostic, SceneError};
 pub use toml_format::{load_scene, parse_scene};
 
+use crate::accel::AccelKind;
 use crate::camera::Camera;
 use crate::light::Light;
 use crate::material::{Material, MaterialId};
@@ -44,6 +45,8 @@ pub struct RenderSettings {
     /// A branch whose weight on the pixel falls below this stops early
     /// (adaptive depth control, Hall and Greenberg 1983).
     pub min_weight: f64,
+    /// The acceleration structure to build over the primitives.
+    pub accel: AccelKind,
 }
 
 impl Default for RenderSettings {
@@ -54,6 +57,7 @@ impl Default for RenderSettings {
             samples_per_pixel: 1,
             max_depth: 8,
             min_weight: 1e-3,
+            accel: AccelKind::default(),
         }
     }
 }

@@ -39,6 +39,7 @@ mod object;
 mod reader;
 mod shapes;
 
+use crate::accel::AccelKind;
 use std::path::Path;
 
 use toml_span::Span;
@@ -134,6 +135,7 @@ const RENDER_KEYS: &[&str] = &[
     "min_weight",
     "background",
     "ambient",
+    "accel",
 ];
 
 fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
@@ -149,6 +151,7 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
     let min_weight = r.or_default(&f, "min_weight", d.min_weight, Reader::non_negative);
     let background = r.or_default(&f, "background", Color::ZERO, Reader::color);
     let ambient = r.or_default(&f, "ambient", Color::ZERO, Reader::color);
+    let accel = r.or_default(&f, "accel", d.accel, read_accel);
     keys?;
     Ok(Render {
         settings: RenderSettings {
@@ -157,9 +160,25 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
             samples_per_pixel: samples?,
             max_depth: max_depth?,
             min_weight: min_weight?,
+            accel: accel?,
         },
         background: background?,
         ambient: ambient?,
+    })
+}
+
+/// The name of an acceleration structure.
+fn read_accel(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<AccelKind> {
+    let (name, span) = r.string(value, key)?;
+    AccelKind::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = AccelKind::ALL.iter().map(AccelKind::name).collect();
+        r.error(
+            span,
+            format!(
+                "unknown acceleration structure `{name}`; expected one of: {}",
+                names.join(", ")
+            ),
+        )
     })
 }
 
@@ -227,7 +246,7 @@ pub(super) mod tests {
     fn render_settings_are_read() {
         let s = scene(&format!(
             "{CAMERA}[render]\nwidth = 32\nheight = 24\nsamples = 4\nmax_depth = 0\n\
-             min_weight = 0\nbackground = [0.1, 0.2, 0.3]\nambient = 0.5\n"
+             min_weight = 0\nbackground = [0.1, 0.2, 0.3]\nambient = 0.5\naccel = 'linear'\n"
         ));
         assert_eq!(
             s.settings,
@@ -237,6 +256,7 @@ pub(super) mod tests {
                 samples_per_pixel: 4,
                 max_depth: 0,
                 min_weight: 0.0,
+                accel: AccelKind::Linear,
             }
         );
         assert_eq!(s.background, Color::new(0.1, 0.2, 0.3));
@@ -257,7 +277,7 @@ pub(super) mod tests {
         assert_eq!(
             errors(&format!(
                 "{CAMERA}[render]\nwidth = 0\nheight = 1.5\nsamples = '4'\nmax_depth = -1\n\
-                 min_weight = -0.5\nbackground = [1, 1]\nambient = -1\nsize = 3\n"
+                 min_weight = -0.5\nbackground = [1, 1]\nambient = -1\nsize = 3\naccel = 'octree'\n"
             )),
             [
                 "`width` must be at least 1, got 0",
@@ -268,7 +288,8 @@ pub(super) mod tests {
                 "expected 3 numbers for `background`, found 2",
                 "`ambient` must not be negative, got -1",
                 "unknown key `size` in [render]; expected one of: width, height, samples, \
-                 max_depth, min_weight, background, ambient",
+                 max_depth, min_weight, background, ambient, accel",
+                "unknown acceleration structure `octree`; expected one of: linear",
             ]
         );
     }
