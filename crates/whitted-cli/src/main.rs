@@ -1,5 +1,6 @@
 //! The `whitted` command: renders scenes with the whitted ray tracer.
 
+mod bench_command;
 mod progress;
 mod render_command;
 
@@ -23,12 +24,14 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     Render(render_command::RenderArgs),
+    Bench(bench_command::BenchArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render_command::run(&args),
+        Command::Bench(args) => bench_command::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -42,3 +42,35 @@ impl ProgressReport {
         }
     }
 }
+
+/// A spinner with a message for work of unknown length, on a terminal only.
+pub struct Status {
+    spinner: Option<ProgressBar>,
+}
+
+impl Status {
+    /// A spinner, shown only on a terminal and when not `quiet`.
+    pub fn new(quiet: bool) -> Self {
+        let show = !quiet && std::io::stderr().is_terminal();
+        let spinner = show.then(|| {
+            let s = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+            s.enable_steady_tick(std::time::Duration::from_millis(120));
+            s
+        });
+        Self { spinner }
+    }
+
+    /// Says what is being done now.
+    pub fn set(&self, message: String) {
+        if let Some(s) = &self.spinner {
+            s.set_message(message);
+        }
+    }
+
+    /// Removes the spinner.
+    pub fn finish(&self) {
+        if let Some(s) = &self.spinner {
+            s.finish_and_clear();
+        }
+    }
+}

@@ -115,3 +115,122 @@ fn help_explains_the_render_command() {
         assert!(help.contains(word), "missing {word} in:\n{help}");
     }
 }
+
+fn scenes_folder() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+}
+
+#[test]
+fn bench_reports_every_structure_and_ray_kind_as_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scenes_folder().join("whitted.toml");
+    let out = whitted(
+        &[
+            "bench",
+            scene.to_str().unwrap(),
+            "--width",
+            "16",
+            "--height",
+            "12",
+            "--runs",
+            "1",
+            "--json",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let structures = report["structures"].as_array().unwrap();
+    assert_eq!(structures.len(), whitted::accel::AccelKind::ALL.len());
+    for s in structures {
+        let kinds = s["kinds"].as_array().unwrap();
+        let names: Vec<&str> = kinds.iter().map(|k| k["rays"].as_str().unwrap()).collect();
+        assert_eq!(names, ["primary", "shadow", "diffuse"]);
+        assert_eq!(kinds[0]["count"], 16 * 12);
+        assert!(kinds[0]["mrays_per_s_1_thread"].as_f64().unwrap() > 0.0);
+        assert!(kinds[0]["nodes_per_ray"].as_f64().unwrap() > 0.0);
+    }
+}
+
+/// One ray record of the anchor harness's dump format.
+fn ray_record(o: [f32; 3], d: [f32; 3], t_far: f32) -> Vec<u8> {
+    let mut r = 0u32.to_le_bytes().to_vec();
+    for v in o.iter().chain(&d).chain(&[t_far]) {
+        r.extend_from_slice(&v.to_le_bytes());
+    }
+    r
+}
+
+#[test]
+fn bench_traces_anchor_ray_files_and_counts_agreement() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // A unit square at z = 0 made of two triangles (a quad, fan-split).
+    std::fs::write(
+        d.join("quad.obj"),
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    let rays: Vec<u8> = [
+        ray_record([0.25, 0.75, 1.0], [0.0, 0.0, -1.0], f32::INFINITY),
+        ray_record([0.75, 0.25, 2.0], [0.0, 0.0, -1.0], f32::INFINITY),
+        ray_record([2.0, 2.0, 1.0], [0.0, 0.0, -1.0], f32::INFINITY),
+    ]
+    .concat();
+    let mut hits = Vec::new();
+    for (t, id) in [(1.0f32, 1u32), (2.0, 0), (-1.0, 0)] {
+        hits.extend(t.to_le_bytes());
+        hits.extend(id.to_le_bytes());
+    }
+    for kind in ["primary", "diffuse"] {
+        std::fs::write(d.join(format!("{kind}.rays")), &rays).unwrap();
+        std::fs::write(d.join(format!("{kind}.hits")), &hits).unwrap();
+    }
+    // Shadow rays: the first is blocked by the quad, the second stops short.
+    let shadow: Vec<u8> = [
+        ray_record([0.5, 0.5, 1.0], [0.0, 0.0, -1.0], 3.0),
+        ray_record([0.5, 0.5, 1.0], [0.0, 0.0, -1.0], 0.5),
+    ]
+    .concat();
+    std::fs::write(d.join("shadow.rays"), shadow).unwrap();
+    std::fs::write(d.join("shadow.hits"), [1u8, 1]).unwrap();
+    let out = whitted(
+        &["bench", "quad.obj", "--rays", ".", "--runs", "1", "--json"],
+        d,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["primitives"], 2);
+    for s in report["structures"].as_array().unwrap() {
+        let agreeing: Vec<u64> = s["kinds"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|k| k["agreeing"].as_u64().unwrap())
+            .collect();
+        // All closest hits agree; the second shadow ray disagrees on purpose.
+        assert_eq!(agreeing, [3, 1, 3], "{}", s["accel"]);
+    }
+}
+
+#[test]
+fn bench_refuses_unknown_structures_and_missing_ray_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scenes_folder().join("whitted.toml");
+    let out = whitted(
+        &["bench", scene.to_str().unwrap(), "--accel", "octree"],
+        dir.path(),
+    );
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("expected all or one of"),
+        "{}",
+        stderr(&out)
+    );
+    let out = whitted(
+        &["bench", scene.to_str().unwrap(), "--rays", "nowhere"],
+        dir.path(),
+    );
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("primary.rays"), "{}", stderr(&out));
+}

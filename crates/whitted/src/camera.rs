@@ -6,7 +6,7 @@
 //! pixel centres: pixel `(column, row)` is centred at `(column + 0.5,
 //! row + 0.5)` in image coordinates, row 0 at the top.
 
-use crate::math::{Ray, Vec3};
+use crate::math::{Aabb, Ray, Vec3};
 
 /// Why a camera could not be built.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -67,6 +67,39 @@ impl Camera {
             true_up,
             tan_half_fov: (0.5 * fov_degrees).to_radians().tan(),
         })
+    }
+
+    /// A camera looking at the centre of `bounds` along its diagonal, from
+    /// the nearest distance at which all eight corners project inside an
+    /// image of the given aspect ratio (width / height), with `up` = +y.
+    /// This is the default view of the Embree anchor harness, so both trace
+    /// the same primary rays.
+    pub fn framing(bounds: &Aabb, aspect: f64, fov_degrees: f64) -> Result<Self, CameraError> {
+        if bounds.is_empty() || !bounds.is_finite() {
+            return Err(CameraError::NotFinite);
+        }
+        let c = bounds.centroid();
+        let diagonal = bounds
+            .extent()
+            .try_normalize()
+            .ok_or(CameraError::NoViewDirection)?;
+        let forward = -diagonal;
+        let right = forward
+            .cross(Vec3::Y)
+            .try_normalize()
+            .ok_or(CameraError::BadUp)?;
+        let up = right.cross(forward);
+        let th = (0.5 * fov_degrees).to_radians().tan();
+        let distance = bounds
+            .corners()
+            .iter()
+            .map(|q| {
+                let v = *q - c;
+                let spread = (v.dot(right).abs() / (th * aspect)).max(v.dot(up).abs() / th);
+                spread - v.dot(forward)
+            })
+            .fold(f64::NEG_INFINITY, f64::max);
+        Self::new(c + diagonal * distance, c, Vec3::Y, fov_degrees)
     }
 
     /// The eye position.
@@ -130,6 +163,24 @@ mod tests {
     fn wide_images_widen_the_horizontal_view() {
         let right = camera().ray(200, 100, 200.0, 50.0).dir;
         assert!((right.x / -right.z - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn framing_keeps_every_corner_in_view_and_touches_the_frame() {
+        let bounds = Aabb::new(Vec3::new(-1.0, 0.0, -2.0), Vec3::new(3.0, 1.0, 0.5));
+        let c = Camera::framing(&bounds, 1.5, 50.0).unwrap();
+        let th = 25f64.to_radians().tan();
+        let mut widest: f64 = 0.0;
+        for q in bounds.corners() {
+            let v = q - c.eye;
+            let depth = v.dot(c.forward);
+            let x = v.dot(c.right) / depth / (th * 1.5);
+            let y = v.dot(c.true_up) / depth / th;
+            assert!(x.abs() <= 1.0 + 1e-12 && y.abs() <= 1.0 + 1e-12);
+            widest = widest.max(x.abs()).max(y.abs());
+        }
+        assert!((widest - 1.0).abs() < 1e-12);
+        assert!((c.forward + bounds.extent().normalize()).length() < 1e-12);
     }
 
     #[test]

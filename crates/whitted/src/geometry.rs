@@ -5,7 +5,7 @@
 
 use crate::accel::{AccelKind, Accelerator, TraversalCounters};
 use crate::material::MaterialId;
-use crate::math::{DVec2, Ray, Transform, Vec3};
+use crate::math::{Aabb, DVec2, Ray, Transform, Vec3};
 use crate::scene::{Primitive, Scene};
 use crate::shape::{LocalSurface, ShapeHit};
 
@@ -48,6 +48,7 @@ pub struct Geometry<'a> {
     primitives: &'a [Primitive],
     transforms: &'a [Transform],
     accel: Accelerator,
+    bounds: Aabb,
     bounded: Vec<u32>,
     unbounded: Vec<u32>,
 }
@@ -80,6 +81,7 @@ impl<'a> Geometry<'a> {
             primitives: &scene.primitives,
             transforms: &scene.transforms,
             accel: Accelerator::build(kind, &boxes),
+            bounds: boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(b)),
             bounded,
             unbounded,
         }
@@ -108,6 +110,11 @@ impl<'a> Geometry<'a> {
             Some(t) => p.shape.occluded(&t.ray_to_object(ray)),
             None => p.shape.occluded(ray),
         }
+    }
+
+    /// The box around every bounded primitive.
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
     }
 
     /// The acceleration structure over the bounded primitives.

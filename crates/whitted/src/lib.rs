@@ -43,6 +43,7 @@
 #![deny(missing_docs)]
 
 pub mod accel;
+pub mod bench;
 pub mod camera;
 pub mod geometry;
 pub mod heat_map;
@@ -50,6 +51,7 @@ pub mod image;
 pub mod light;
 pub mod material;
 pub mod math;
+pub mod mesh;
 pub mod random;
 pub mod render;
 pub mod sampling;

@@ -1,0 +1,325 @@
+//! `whitted bench`: build every acceleration structure over a scene or mesh
+//! and measure it: build time, memory, size, SAH cost, and for primary,
+//! shadow and diffuse rays the speed on one thread and on all, with the work
+//! per ray; with `--rays DIR`, the very rays of the Embree anchor harness and
+//! how many results agree with Embree's.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::Args;
+use serde_json::{Value, json};
+use whitted::accel::{AccelKind, AccelStats};
+use whitted::bench::ray_files::{RayFile, agreement, read_ray_file};
+use whitted::bench::{RayKind, RaySet, TraceResults, scene_ray_sets, time_set, trace_all};
+use whitted::camera::Camera;
+use whitted::geometry::Geometry;
+use whitted::mesh::load_obj_positions;
+use whitted::scene::{Scene, load_scene};
+
+use crate::progress::Status;
+
+/// Brute force is skipped in `--accel all` above this many primitive tests
+/// (primitives × rays): it would take minutes. Ask for it by name instead.
+const LINEAR_BUDGET: f64 = 2e9;
+
+/// Measure the acceleration structures on a scene or mesh.
+///
+/// For each structure: build time, memory, nodes, leaves, SAH cost; then for
+/// primary rays (one per pixel centre), shadow rays (one per hit, towards
+/// the first light) and diffuse rays (one cosine-distributed bounce per hit):
+/// Mrays/s on 1 thread and on all threads, and the mean nodes visited and
+/// primitives tested per ray.
+#[derive(Debug, Args)]
+#[command(after_long_help = "Examples:
+  whitted bench scenes/shapes.toml
+  whitted bench bunny.obj --accel bvh --width 512 --height 512
+  whitted bench bunny.obj --rays /tmp/anchor_rays/bunny --json
+The ray files come from the Embree harness in shared/peers/embree (bench --dump DIR).")]
+pub struct BenchArgs {
+    /// A scene file (.toml) or a triangle mesh (.obj: positions and faces).
+    scene: PathBuf,
+
+    /// Which structure: bvh, kdtree, grid, linear, or all.
+    #[arg(long, default_value = "all", value_name = "NAME")]
+    accel: String,
+
+    /// Width of the image the primary rays cover.
+    #[arg(long, default_value_t = 1024, value_name = "W")]
+    width: u32,
+
+    /// Height of the image the primary rays cover.
+    #[arg(long, default_value_t = 1024, value_name = "H")]
+    height: u32,
+
+    /// Trace the rays in DIR ({primary,shadow,diffuse}.rays and .hits, as
+    /// written by the Embree harness's --dump) and compare with its results.
+    #[arg(long, value_name = "DIR")]
+    rays: Option<PathBuf>,
+
+    /// Timed passes per measurement (the best is reported).
+    #[arg(long, default_value_t = 3, value_name = "N")]
+    runs: usize,
+
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+
+    /// Print nothing but the results.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// The structures asked for.
+fn kinds(name: &str) -> Result<Vec<AccelKind>, String> {
+    if name == "all" {
+        return Ok(AccelKind::ALL.to_vec());
+    }
+    AccelKind::from_name(name).map(|k| vec![k]).ok_or_else(|| {
+        let names: Vec<&str> = AccelKind::ALL.iter().map(AccelKind::name).collect();
+        format!(
+            "--accel {name}: expected all or one of: {}",
+            names.join(", ")
+        )
+    })
+}
+
+/// The scene to measure: a scene file, or a mesh framed by the anchor
+/// harness's default camera.
+fn load(path: &Path, width: u32, height: u32) -> Result<Scene, String> {
+    let is_obj = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    if !is_obj {
+        return load_scene(path).map_err(|e| e.to_string());
+    }
+    let soup = load_obj_positions(path).map_err(|e| e.to_string())?;
+    let aspect = f64::from(width) / f64::from(height);
+    let camera = Camera::framing(&soup.bounds(), aspect, 50.0)
+        .map_err(|e| format!("{}: cannot frame the mesh: {e}", path.display()))?;
+    Ok(soup.to_scene(camera).0)
+}
+
+/// One kind of ray measured through one structure.
+struct KindReport {
+    kind: RayKind,
+    rays: usize,
+    seconds_one: f64,
+    seconds_all: f64,
+    nodes_per_ray: f64,
+    primitives_per_ray: f64,
+    agreeing: Option<(usize, usize)>,
+}
+
+/// One structure measured.
+struct AccelReport {
+    kind: AccelKind,
+    build_seconds: f64,
+    stats: AccelStats,
+    kinds: Vec<KindReport>,
+}
+
+/// Runs the command.
+pub fn run(args: &BenchArgs) -> Result<(), String> {
+    let kinds = kinds(&args.accel)?;
+    if args.width == 0 || args.height == 0 {
+        return Err("--width and --height must be at least 1".to_string());
+    }
+    let status = Status::new(args.quiet || args.json);
+    status.set(format!("loading {}", args.scene.display()));
+    let scene = load(&args.scene, args.width, args.height)?;
+    let all_threads = std::thread::available_parallelism().map_or(1, usize::from);
+
+    let (sets, references): (Vec<RaySet>, Vec<Option<TraceResults>>) = match &args.rays {
+        Some(dir) => {
+            status.set(format!("reading rays from {}", dir.display()));
+            let files = RayKind::ALL
+                .iter()
+                .map(|&k| read_ray_file(dir, k))
+                .collect::<Result<Vec<RayFile>, _>>()
+                .map_err(|e| e.to_string())?;
+            files
+                .into_iter()
+                .map(|f| (f.set, Some(f.reference)))
+                .unzip()
+        }
+        None => {
+            status.set("generating rays".to_string());
+            let geometry = Geometry::new(&scene);
+            let sets = scene_ray_sets(&scene, &geometry, args.width, args.height);
+            let none = sets.iter().map(|_| None).collect();
+            (sets, none)
+        }
+    };
+    let total_rays: usize = sets.iter().map(|s| s.rays.len()).sum();
+
+    let mut reports = Vec::new();
+    for &kind in &kinds {
+        let work = scene.primitives.len() as f64 * total_rays as f64;
+        if kind == AccelKind::Linear && kinds.len() > 1 && work > LINEAR_BUDGET {
+            if !args.quiet && !args.json {
+                eprintln!(
+                    "linear skipped: {} primitives x {total_rays} rays is too much brute force; \
+                     use --accel linear to run it anyway",
+                    scene.primitives.len()
+                );
+            }
+            continue;
+        }
+        status.set(format!("building {}", kind.name()));
+        let start = Instant::now();
+        let geometry = Geometry::with_accel(&scene, kind);
+        let build_seconds = start.elapsed().as_secs_f64();
+        let stats = geometry.accelerator().stats();
+        let mut kind_reports = Vec::new();
+        for (set, reference) in sets.iter().zip(&references) {
+            status.set(format!(
+                "{}: {} rays, counting",
+                kind.name(),
+                set.kind.name()
+            ));
+            let (results, counters) = trace_all(&geometry, set);
+            let per_ray = |n: u64| n as f64 / set.rays.len().max(1) as f64;
+            status.set(format!(
+                "{}: {} rays, 1 thread",
+                kind.name(),
+                set.kind.name()
+            ));
+            let seconds_one = time_set(&geometry, set, 1, args.runs)?;
+            status.set(format!(
+                "{}: {} rays, {all_threads} threads",
+                kind.name(),
+                set.kind.name()
+            ));
+            let seconds_all = time_set(&geometry, set, all_threads, args.runs)?;
+            kind_reports.push(KindReport {
+                kind: set.kind,
+                rays: set.rays.len(),
+                seconds_one,
+                seconds_all,
+                nodes_per_ray: per_ray(counters.nodes),
+                primitives_per_ray: per_ray(counters.primitives),
+                agreeing: reference.as_ref().map(|r| agreement(&results, r)),
+            });
+        }
+        reports.push(AccelReport {
+            kind,
+            build_seconds,
+            stats,
+            kinds: kind_reports,
+        });
+    }
+    status.finish();
+
+    if args.json {
+        println!("{}", to_json(args, &scene, all_threads, &reports));
+    } else {
+        print_table(args, &scene, all_threads, &reports);
+    }
+    Ok(())
+}
+
+fn mrays(rays: usize, seconds: f64) -> f64 {
+    if seconds > 0.0 {
+        rays as f64 / seconds / 1e6
+    } else {
+        0.0
+    }
+}
+
+fn print_table(args: &BenchArgs, scene: &Scene, threads: usize, reports: &[AccelReport]) {
+    let source = match &args.rays {
+        Some(dir) => format!("rays from {}", dir.display()),
+        None => format!("rays for a {}x{} image", args.width, args.height),
+    };
+    println!(
+        "{}: {} primitives; {source}; best of {} runs",
+        args.scene.display(),
+        scene.primitives.len(),
+        args.runs
+    );
+    for r in reports {
+        let s = &r.stats;
+        println!();
+        println!(
+            "{:<7} build {:.1} ms, {:.2} MB, {} nodes, {} leaves, {} references, SAH cost {:.2}, depth {}",
+            r.kind.name(),
+            r.build_seconds * 1e3,
+            s.memory_bytes as f64 / 1e6,
+            s.nodes,
+            s.leaves,
+            s.references,
+            s.sah_cost,
+            s.max_depth
+        );
+        let agree_header = if args.rays.is_some() { "  agree" } else { "" };
+        println!(
+            "        {:<8} {:>9} {:>11} {:>11} {:>10} {:>10}{agree_header}",
+            "rays",
+            "count",
+            "Mrays/s 1T",
+            format!("Mrays/s {threads}T"),
+            "nodes/ray",
+            "prims/ray"
+        );
+        for k in &r.kinds {
+            let agree = k
+                .agreeing
+                .map(|(a, n)| format!("  {:.4}%", 100.0 * a as f64 / n.max(1) as f64))
+                .unwrap_or_default();
+            println!(
+                "        {:<8} {:>9} {:>11.2} {:>11.2} {:>10.1} {:>10.1}{agree}",
+                k.kind.name(),
+                k.rays,
+                mrays(k.rays, k.seconds_one),
+                mrays(k.rays, k.seconds_all),
+                k.nodes_per_ray,
+                k.primitives_per_ray
+            );
+        }
+    }
+}
+
+fn to_json(args: &BenchArgs, scene: &Scene, threads: usize, reports: &[AccelReport]) -> Value {
+    let structures: Vec<Value> = reports
+        .iter()
+        .map(|r| {
+            let kinds: Vec<Value> = r
+                .kinds
+                .iter()
+                .map(|k| {
+                    json!({
+                        "rays": k.kind.name(),
+                        "count": k.rays,
+                        "mrays_per_s_1_thread": mrays(k.rays, k.seconds_one),
+                        "mrays_per_s_all_threads": mrays(k.rays, k.seconds_all),
+                        "nodes_per_ray": k.nodes_per_ray,
+                        "primitives_per_ray": k.primitives_per_ray,
+                        "agreeing": k.agreeing.map(|(a, _)| a),
+                    })
+                })
+                .collect();
+            json!({
+                "accel": r.kind.name(),
+                "build_ms": r.build_seconds * 1e3,
+                "memory_bytes": r.stats.memory_bytes,
+                "nodes": r.stats.nodes,
+                "leaves": r.stats.leaves,
+                "references": r.stats.references,
+                "sah_cost": r.stats.sah_cost,
+                "max_depth": r.stats.max_depth,
+                "kinds": kinds,
+            })
+        })
+        .collect();
+    json!({
+        "scene": args.scene.display().to_string(),
+        "primitives": scene.primitives.len(),
+        "rays_from": args.rays.as_ref().map(|d| d.display().to_string()),
+        "width": args.width,
+        "height": args.height,
+        "runs": args.runs,
+        "threads": threads,
+        "structures": structures,
+    })
+}
