@@ -42,8 +42,9 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N")]
     spp: Option<u32>,
 
-    /// Maximum reflection/refraction depth (0 = no secondary rays; default 8).
-    #[arg(long, value_name = "D")]
+    /// Maximum reflection/refraction depth (0 = no secondary rays; default 8;
+    /// at most 1000).
+    #[arg(long, value_name = "D", value_parser = clap::value_parser!(u32).range(..=i64::from(whitted::render::MAX_DEPTH)))]
     max_depth: Option<u32>,
 
     /// Acceleration structure over the objects (overrides the scene's

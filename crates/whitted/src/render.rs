@@ -17,6 +17,20 @@ use crate::trace::{RayCounts, Tracer};
 /// Side of the square tiles the image is cut into, in pixels.
 const TILE_SIZE: u32 = 16;
 
+/// The deepest recursion a render accepts. Each level takes a few
+/// kilobytes of a worker's stack, which is sized for it.
+pub const MAX_DEPTH: u32 = 1000;
+
+/// Worker stack: a base for everything but the recursion, plus room for
+/// each level (one level measured at about 1.5 KiB in a release build; the
+/// margin covers debug builds).
+fn worker_stack_bytes(max_depth: u32) -> usize {
+    (2 << 20) + max_depth as usize * (16 << 10)
+}
+
+/// Largest image (in pixels) a render accepts: a few gigabytes of film.
+pub const MAX_PIXELS: u64 = 1 << 28;
+
 /// Per-pixel data besides the colour.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Aov {
@@ -104,6 +118,17 @@ pub enum RenderError {
     /// Zero samples per pixel.
     #[error("samples per pixel must be at least 1")]
     NoSamples,
+    /// A recursion depth beyond [`MAX_DEPTH`].
+    #[error("the maximum depth {0} is too large: at most {MAX_DEPTH} is allowed")]
+    DepthTooLarge(u32),
+    /// More pixels than [`MAX_PIXELS`].
+    #[error("the image {width}x{height} is too large: at most {MAX_PIXELS} pixels are allowed")]
+    TooManyPixels {
+        /// Requested width.
+        width: u32,
+        /// Requested height.
+        height: u32,
+    },
     /// The thread pool could not be created.
     #[error("could not start {threads} worker threads: {message}")]
     Threads {
@@ -140,7 +165,14 @@ pub fn render(
     if settings.samples_per_pixel == 0 {
         return Err(RenderError::NoSamples);
     }
-    let mut pool = rayon::ThreadPoolBuilder::new();
+    if settings.max_depth > MAX_DEPTH {
+        return Err(RenderError::DepthTooLarge(settings.max_depth));
+    }
+    if u64::from(width) * u64::from(height) > MAX_PIXELS {
+        return Err(RenderError::TooManyPixels { width, height });
+    }
+    let mut pool =
+        rayon::ThreadPoolBuilder::new().stack_size(worker_stack_bytes(settings.max_depth));
     if let Some(threads) = options.threads {
         pool = pool.num_threads(threads);
     }

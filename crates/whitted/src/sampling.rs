@@ -57,19 +57,25 @@ fn hashed_unit(mut i: u32, pattern: u32) -> f64 {
 
 /// Sample `index` of `count` inside the unit pixel square, for the pattern
 /// `pattern`. With `count == 1` it is the centre `(0.5, 0.5)`.
+///
+/// Kensler's final form: the samples sit on an `m × n` grid (`m = ⌊√N⌋`
+/// columns, `n = ⌈N / m⌉` rows) jittered within it; y is stratified into `N`
+/// strata exactly and x into `m` columns with counts differing by at most
+/// one, for any `N`; for square `N` x falls into `N` strata too.
 pub fn pixel_sample(index: u32, count: u32, pattern: u32) -> DVec2 {
     if count <= 1 {
         return DVec2::splat(0.5);
     }
-    let columns = f64::from(count).sqrt().ceil() as u32;
+    let columns = (f64::from(count).sqrt() as u32).max(1);
     let rows = count.div_ceil(columns);
-    let sx = permute(index % columns, columns, pattern.wrapping_mul(0xa511_e9b3));
-    let sy = permute(index / columns, rows, pattern.wrapping_mul(0x63d8_3595));
-    let jx = hashed_unit(index, pattern.wrapping_mul(0xa399_d265));
-    let jy = hashed_unit(index, pattern.wrapping_mul(0x711a_d6a5));
+    let s = permute(index, count, pattern.wrapping_mul(0x5163_3e2d));
+    let sx = permute(s % columns, columns, pattern.wrapping_mul(0x68bc_21eb));
+    let sy = permute(s / columns, rows, pattern.wrapping_mul(0x02e5_be93));
+    let jx = hashed_unit(s, pattern.wrapping_mul(0x967a_889b));
+    let jy = hashed_unit(s, pattern.wrapping_mul(0x368c_c8b7));
     DVec2::new(
-        (f64::from(index % columns) + (f64::from(sy) + jx) / f64::from(rows)) / f64::from(columns),
-        (f64::from(index / columns) + (f64::from(sx) + jy) / f64::from(columns)) / f64::from(rows),
+        (f64::from(sx) + (f64::from(sy) + jx) / f64::from(rows)) / f64::from(columns),
+        (f64::from(s) + jy) / f64::from(count),
     )
 }
 
@@ -117,12 +123,33 @@ mod tests {
     }
 
     #[test]
-    fn counts_that_are_not_squares_stay_inside_the_pixel() {
-        for count in [2u32, 3, 5, 7, 10] {
-            for i in 0..count {
-                let s = pixel_sample(i, count, 5);
-                assert!((0.0..1.0).contains(&s.x) && (0.0..1.0).contains(&s.y));
+    fn any_count_is_stratified_and_unbiased() {
+        for count in [2u32, 3, 5, 7, 8, 10, 12, 15] {
+            let columns = (count as f64).sqrt() as usize;
+            let mut mean = DVec2::ZERO;
+            let patterns = 2000u32;
+            for pattern in 0..patterns {
+                let mut fine_y = vec![0; count as usize];
+                let mut column_counts = vec![0; columns];
+                for i in 0..count {
+                    let s = pixel_sample(i, count, pattern.wrapping_mul(2_654_435_761));
+                    assert!((0.0..1.0).contains(&s.x) && (0.0..1.0).contains(&s.y));
+                    fine_y[(s.y * count as f64) as usize] += 1;
+                    column_counts[(s.x * columns as f64) as usize] += 1;
+                    mean += s;
+                }
+                assert!(fine_y.iter().all(|&c| c == 1), "count {count}");
+                let (lo, hi) = (
+                    column_counts.iter().min().unwrap(),
+                    column_counts.iter().max().unwrap(),
+                );
+                assert!(hi - lo <= 1, "count {count}: columns {column_counts:?}");
             }
+            mean /= f64::from(count * patterns);
+            assert!(
+                (mean - DVec2::splat(0.5)).abs().max_element() < 0.01,
+                "count {count}: mean {mean:?}"
+            );
         }
     }
 

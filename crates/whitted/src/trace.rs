@@ -9,7 +9,7 @@
 //! - Shadow rays pass through transmissive surfaces, each crossing scaling
 //!   the light by that surface's `kt`; an opaque surface blocks it.
 //! - Refraction follows Snell's law with the index of the medium the ray is
-//!   in, tracked on a small stack of the objects it has entered; total
+//!   in, tracked on a small stack of the media it has entered; total
 //!   internal reflection moves the refracted weight onto the reflected ray.
 //! - Recursion stops at `max_depth`, and earlier when a branch's weight on
 //!   the pixel falls below `min_weight` (adaptive depth control).
@@ -50,8 +50,12 @@ impl std::ops::AddAssign for RayCounts {
     }
 }
 
-/// The objects a ray is inside, innermost last, with their indices of
-/// refraction. Fixed capacity: no allocation per ray.
+/// The media a ray is inside, innermost last: the materials of the objects
+/// it has entered, with their indices of refraction. Keyed by material, so a
+/// closed mesh of many triangles is one medium, and two overlapping objects
+/// of the same material are one medium too. The innermost entry is the
+/// medium the ray travels in. Fixed capacity (eight nested media; deeper
+/// nesting is not recorded): no allocation per ray.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct MediumStack {
     entries: [(u32, f64); Self::CAPACITY],
@@ -68,6 +72,13 @@ impl MediumStack {
         } else {
             self.entries[self.len - 1].1
         }
+    }
+
+    /// True when the ray is inside an object of `material`.
+    pub fn contains(&self, material: MaterialId) -> bool {
+        self.entries[..self.len]
+            .iter()
+            .any(|&(m, _)| m == material.0)
     }
 
     /// The stack after entering an object of `material`.
@@ -90,6 +101,45 @@ impl MediumStack {
             self.len -= 1;
         }
         self
+    }
+}
+
+/// What a ray crossing a surface goes from and to.
+#[derive(Clone, Copy, Debug)]
+pub struct Crossing {
+    /// Index of refraction on the incoming side.
+    pub n_from: f64,
+    /// Index of refraction on the far side.
+    pub n_to: f64,
+    /// The media of a ray that goes through.
+    pub after: MediumStack,
+}
+
+impl MediumStack {
+    /// Crossing the surface of an object of `material` (index `ior`),
+    /// `entering` it or leaving it.
+    pub fn cross(self, material: MaterialId, ior: f64, entering: bool) -> Crossing {
+        if entering {
+            return Crossing {
+                n_from: self.ior(),
+                n_to: ior,
+                after: self.entered(material, ior),
+            };
+        }
+        // Leaving an object that is not the innermost medium changes nothing
+        // for the ray; leaving one the stack does not know (the ray started
+        // inside it) goes from that object's material.
+        let n_from = if self.contains(material) {
+            self.ior()
+        } else {
+            ior
+        };
+        let after = self.left(material);
+        Crossing {
+            n_from,
+            n_to: after.ior(),
+            after,
+        }
     }
 }
 
@@ -230,12 +280,11 @@ impl<'a> Tracer<'a> {
             return color;
         }
 
-        let (n_from, n_to, inside_after) = if entering {
-            (media.ior(), m.ior, media.entered(s.material, m.ior))
-        } else {
-            let outside = media.left(s.material);
-            (m.ior, outside.ior(), outside)
-        };
+        let Crossing {
+            n_from,
+            n_to,
+            after: inside_after,
+        } = media.cross(s.material, m.ior, entering);
         let cos_i = view.dot(n).clamp(0.0, 1.0);
         let (mut reflected_weight, mut transmitted_weight) = if m.fresnel && kt != Color::ZERO {
             let f = schlick_reflectance(cos_i, n_from, n_to);
@@ -346,6 +395,28 @@ mod tests {
         assert_eq!(s.ior(), 1.5);
         assert_eq!(s.left(MaterialId(9)).ior(), 1.5);
         assert_eq!(s.left(glass).ior(), 1.0);
+    }
+
+    #[test]
+    fn crossings_refract_only_where_the_medium_really_changes() {
+        let (glass, bubble) = (MaterialId(1), MaterialId(2));
+        let air = MediumStack::default();
+        let into_glass = air.cross(glass, 1.5, true);
+        assert_eq!((into_glass.n_from, into_glass.n_to), (1.0, 1.5));
+        let out_of_glass = into_glass.after.cross(glass, 1.5, false);
+        assert_eq!((out_of_glass.n_from, out_of_glass.n_to), (1.5, 1.0));
+        // Entering an overlapping ior-1 object from air, then the glass, then
+        // leaving the first object while still in the glass: no interface.
+        let in_both = air
+            .cross(bubble, 1.0, true)
+            .after
+            .cross(glass, 1.5, true)
+            .after;
+        let leave_outer = in_both.cross(bubble, 1.0, false);
+        assert_eq!((leave_outer.n_from, leave_outer.n_to), (1.5, 1.5));
+        // A ray that started inside the glass leaves it into air.
+        let unknown = air.cross(glass, 1.5, false);
+        assert_eq!((unknown.n_from, unknown.n_to), (1.5, 1.0));
     }
 
     #[test]

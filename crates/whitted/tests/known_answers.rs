@@ -328,3 +328,40 @@ fn aovs_give_depth_normal_and_primitive_of_the_centre_ray() {
     assert_eq!(film(Aov::Normal).pixel(0, 0), &[0.0, 0.0, 0.0]);
     assert_eq!(film(Aov::Id).pixel(0, 0), &[-1.0]);
 }
+
+#[test]
+fn facing_perfect_mirrors_recurse_to_the_deepest_allowed_depth_without_overflow() {
+    use whitted::render::{MAX_DEPTH, RenderError};
+    let mut scene = scene_looking_down_z(2, 2, 10.0);
+    let mirror = scene.add_material(Material {
+        reflection: Color::ONE.into(),
+        emission: Color::splat(0.001).into(),
+        ..black()
+    });
+    scene.add_primitive(
+        Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Z).unwrap()),
+        mirror,
+        Transform::IDENTITY,
+    );
+    scene.add_primitive(
+        Shape::Plane(Plane::new(Vec3::new(0.0, 0.0, 10.0), -Vec3::Z).unwrap()),
+        mirror,
+        Transform::IDENTITY,
+    );
+    scene.settings.max_depth = MAX_DEPTH;
+    let options = RenderOptions {
+        threads: Some(1),
+        aovs: Vec::new(),
+    };
+    let out = render(&scene, &options, &|_| {}).unwrap();
+    // Every bounce adds the emission once: depth + 1 times in all.
+    let expected = 0.001 * f64::from(MAX_DEPTH + 1);
+    assert_close(pixel(&out.image, 0, 0), Color::splat(expected), 1e-6);
+    assert_eq!(out.rays.reflected, 4 * u64::from(MAX_DEPTH));
+
+    scene.settings.max_depth = MAX_DEPTH + 1;
+    assert!(matches!(
+        render(&scene, &options, &|_| {}),
+        Err(RenderError::DepthTooLarge(_))
+    ));
+}

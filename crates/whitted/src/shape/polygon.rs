@@ -23,7 +23,7 @@
 
 use super::plane::{onto_plane, plane_hit};
 use super::{LocalSurface, ShapeError, ShapeHit, finite, unit};
-use crate::math::{Aabb, DVec2, Ray, Vec3};
+use crate::math::{Aabb, DVec2, Ray, Vec3, gamma};
 
 /// Vertices count as collinear when twice the polygon's area is below this
 /// fraction of `Σ |wᵢ| |wᵢ₊₁|` (`wᵢ = vᵢ - v0`): the normal would be
@@ -191,9 +191,26 @@ impl Polygon {
         }
     }
 
-    /// The bounding box of the vertices.
+    /// The bounding box of the surface actually hit: the vertices moved
+    /// along the dropped axis onto the plane through `v0` (they may sit off
+    /// it by the planarity tolerance), padded by the rounding of that move.
     pub fn bounds(&self) -> Aabb {
-        Aabb::from_points(self.vertices.iter().copied())
+        let [ax, ay] = self.axes.map(usize::from);
+        let dropped = 3 - ax - ay;
+        let v0 = self.anchor();
+        let n = self.normal;
+        let lifted = self.vertices.iter().map(|&v| {
+            let mut p = v;
+            p[dropped] =
+                v0[dropped] - (n[ax] * (v[ax] - v0[ax]) + n[ay] * (v[ay] - v0[ay])) / n[dropped];
+            p
+        });
+        let b = Aabb::from_points(lifted);
+        let pad = gamma(8) * b.min.abs().max(b.max.abs());
+        Aabb {
+            min: b.min - pad,
+            max: b.max + pad,
+        }
     }
 }
 
@@ -245,6 +262,23 @@ mod tests {
 
     fn down_at(x: f64, y: f64) -> Ray {
         Ray::new(Vec3::new(x, y, 2.0), Vec3::new(0.0, 0.0, -0.5))
+    }
+
+    #[test]
+    fn slightly_non_planar_polygon_far_away_is_hit_only_inside_its_bounds() {
+        // Within the coordinate-relative tolerance at x = 1e4: one vertex
+        // 0.2 off the plane of the others; the hit surface leaves the box of
+        // the vertices, and the bounds must cover it.
+        let o = Vec3::new(1e4, 0.0, 0.0);
+        let polygon = Polygon::new(vec![
+            o,
+            o + Vec3::new(1.0, 0.0, 0.0),
+            o + Vec3::new(1.0, 1.0, 0.0),
+            o + Vec3::new(0.0, 1.0, 0.2),
+        ])
+        .unwrap();
+        let shape = Shape::Polygon(polygon);
+        assert_surface_is_sane(&shape, 3);
     }
 
     #[test]

@@ -154,6 +154,16 @@ pub(crate) fn assert_surface_is_sane(shape: &Shape, seed: u64) {
             "{}: reprojected point moved by {distance}",
             shape.kind()
         );
+        let b = shape.bounds();
+        let slack = 1e-12 * (size + b.min.abs().max(b.max.abs()).max_element());
+        let in_bounds =
+            ray.at(hit.t).cmpge(b.min - slack).all() && ray.at(hit.t).cmple(b.max + slack).all();
+        assert!(
+            !b.is_finite() || in_bounds,
+            "{}: hit at {:?} outside the bounds {b:?}",
+            shape.kind(),
+            ray.at(hit.t)
+        );
     }
 }
 
