@@ -118,8 +118,16 @@ impl Film {
         self.data[i..i + self.channels].copy_from_slice(values);
     }
 
-    /// Writes the film in the format its extension names.
+    /// Writes the film in the format its extension names, whole or not at
+    /// all.
     pub fn write(&self, path: &Path) -> Result<(), ImageError> {
+        self.encode(path)?.commit()
+    }
+
+    /// Encodes the film into a temporary file beside `path`, to be renamed
+    /// into place by [`PendingImage::commit`]. Nothing at `path` changes
+    /// until then; dropping the result removes the temporary file.
+    pub fn encode(&self, path: &Path) -> Result<PendingImage, ImageError> {
         let format = ImageFormat::from_path(path)?;
         if format == ImageFormat::Png && self.channels != 1 && self.channels != 3 {
             return Err(ImageError::Unsupported {
@@ -127,7 +135,7 @@ impl Film {
                 why: format!("PNG holds 1 or 3 channels, not {}", self.channels),
             });
         }
-        write_atomically(path, |out| match format {
+        encode_to_temp(path, |out| match format {
             ImageFormat::Png => self.encode_png(out),
             ImageFormat::Pfm => self.encode_pfm(out),
             ImageFormat::Exr => self.encode_exr(out),
@@ -218,19 +226,66 @@ pub fn encode_srgb8(linear: f32) -> u8 {
     (encoded * 255.0 + 0.5) as u8
 }
 
-/// Writes `path` through a temporary file in the same folder, renamed into
-/// place only when `encode` succeeded.
-fn write_atomically(
-    path: &Path,
-    encode: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
-) -> Result<(), ImageError> {
-    let io = |source| ImageError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let folder = match path.parent() {
+/// An encoded image waiting in a temporary file beside its destination.
+#[derive(Debug)]
+pub struct PendingImage {
+    temp: tempfile::NamedTempFile,
+    path: PathBuf,
+}
+
+impl PendingImage {
+    /// Renames the finished file over its destination.
+    pub fn commit(self) -> Result<(), ImageError> {
+        let path = self.path;
+        self.temp.persist(&path).map_err(|e| ImageError::Io {
+            path: path.clone(),
+            source: e.error,
+        })?;
+        Ok(())
+    }
+}
+
+/// The folder a file is written in (`.` for a bare file name).
+fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
+    }
+}
+
+/// Checks that `path` names a file that can be created: a known image
+/// format in an existing folder. Lets a caller refuse bad destinations
+/// before doing the work.
+pub fn check_destination(path: &Path) -> Result<ImageFormat, ImageError> {
+    let format = ImageFormat::from_path(path)?;
+    let folder = folder_of(path);
+    if !folder.is_dir() {
+        return Err(ImageError::Io {
+            path: path.to_path_buf(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                format!("the folder {} does not exist", folder.display()),
+            ),
+        });
+    }
+    if path.is_dir() {
+        return Err(ImageError::Unsupported {
+            path: path.to_path_buf(),
+            why: "this is a folder, not a file name".to_string(),
+        });
+    }
+    Ok(format)
+}
+
+/// Encodes into a new temporary file in `path`'s folder.
+fn encode_to_temp(
+    path: &Path,
+    encode: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
+) -> Result<PendingImage, ImageError> {
+    let io = |source: std::io::Error| ImageError::Io {
+        path: path.to_path_buf(),
+        // Drop the temporary file's name that some errors carry.
+        source: std::io::Error::new(source.kind(), source.kind().to_string()),
     };
     let mut builder = tempfile::Builder::new();
     builder.prefix(".whitted-").suffix(".partial");
@@ -238,11 +293,13 @@ fn write_atomically(
     // owner as temporary files are by default.
     #[cfg(unix)]
     builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let mut temp = builder.tempfile_in(folder).map_err(io)?;
+    let mut temp = builder.tempfile_in(folder_of(path)).map_err(io)?;
     encode(temp.as_file_mut()).map_err(io)?;
     temp.as_file().sync_all().map_err(io)?;
-    temp.persist(path).map_err(|e| io(e.error))?;
-    Ok(())
+    Ok(PendingImage {
+        temp,
+        path: path.to_path_buf(),
+    })
 }
 
 #[cfg(test)]
@@ -320,13 +377,47 @@ mod tests {
     }
 
     #[test]
-    fn a_failed_write_leaves_the_old_file_intact() {
+    fn an_encoder_failing_midway_leaves_the_old_file_intact_and_no_temporary() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("g.png");
         std::fs::write(&path, b"old").unwrap();
-        let four_channels = Film::new(2, 2, 4);
-        assert!(four_channels.write(&path).is_err());
+        let failed = encode_to_temp(&path, |out| {
+            out.write_all(b"half an image")?;
+            Err(std::io::Error::other("disk full"))
+        });
+        assert!(matches!(failed, Err(ImageError::Io { .. })));
         assert_eq!(std::fs::read(&path).unwrap(), b"old");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn nothing_changes_until_an_encoded_image_is_committed() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("g.pfm");
+        std::fs::write(&path, b"old").unwrap();
+        let pending = gradient().encode(&path).unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"old");
+        pending.commit().unwrap();
+        assert!(std::fs::read(&path).unwrap().starts_with(b"PF\n"));
+        drop(gradient().encode(&path).unwrap());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn destinations_are_checked_before_any_work() {
+        let dir = tempfile::tempdir().unwrap();
+        assert_eq!(
+            check_destination(&dir.path().join("a.exr")).unwrap(),
+            ImageFormat::Exr
+        );
+        let missing = check_destination(Path::new("/no/such/folder/a.png")).unwrap_err();
+        assert!(
+            missing
+                .to_string()
+                .contains("the folder /no/such/folder does not exist")
+        );
+        assert!(check_destination(dir.path()).is_err());
+        assert!(check_destination(Path::new("a.gif")).is_err());
     }
 
     #[cfg(unix)]
@@ -348,6 +439,9 @@ mod tests {
             .write(Path::new("/nonexistent-folder/x.png"))
             .unwrap_err();
         assert!(matches!(err, ImageError::Io { .. }));
-        assert!(err.to_string().starts_with("/nonexistent-folder/x.png: "));
+        assert_eq!(
+            err.to_string(),
+            "/nonexistent-folder/x.png: entity not found"
+        );
     }
 }
