@@ -10,6 +10,7 @@
 
 use super::Grid;
 use super::dda::DdaCells;
+use super::mailbox::Mailbox;
 use crate::accel::TraversalCounters;
 use crate::math::Ray;
 
@@ -25,10 +26,11 @@ impl Grid {
     ) -> Option<f64> {
         let mut closest = None;
         let mut clipped = *ray;
+        let mut mailbox = Mailbox::new();
         for (cell, _, t_exit) in DdaCells::new(&self.lattice, ray) {
             counters.nodes += 1;
             for &i in self.cell(cell) {
-                if self.culled(i, &clipped) {
+                if !mailbox.first_visit(i) || self.culled(i, &clipped) {
                     continue;
                 }
                 counters.primitives += 1;
@@ -54,10 +56,11 @@ impl Grid {
         counters: &mut TraversalCounters,
         mut occludes: impl FnMut(u32) -> bool,
     ) -> bool {
+        let mut mailbox = Mailbox::new();
         for (cell, _, _) in DdaCells::new(&self.lattice, ray) {
             counters.nodes += 1;
             for &i in self.cell(cell) {
-                if !self.culled(i, ray) {
+                if mailbox.first_visit(i) && !self.culled(i, ray) {
                     counters.primitives += 1;
                     if occludes(i) {
                         return true;
@@ -79,6 +82,47 @@ impl Grid {
 mod tests {
     use super::*;
     use crate::math::{Aabb, Vec3};
+    use crate::random::Rng;
+
+    /// Ten slabs crossing the whole scene along x, among small boxes.
+    fn slabs_among_small_boxes() -> Vec<Aabb> {
+        let mut rng = Rng::new(9);
+        let mut boxes: Vec<Aabb> = (0..10)
+            .map(|i| {
+                let y = f64::from(i);
+                Aabb::new(Vec3::new(0.0, y, 0.0), Vec3::new(10.0, y + 0.5, 10.0))
+            })
+            .collect();
+        boxes.extend((0..2000).map(|_| {
+            let c = rng.point_in(Vec3::ZERO, Vec3::splat(10.0));
+            Aabb::new(c, c + Vec3::splat(0.05))
+        }));
+        boxes
+    }
+
+    #[test]
+    fn mailboxing_tests_a_primitive_spanning_many_cells_once() {
+        let boxes = slabs_among_small_boxes();
+        let grid = Grid::build(&boxes);
+        let ray = Ray::new(Vec3::new(-1.0, 5.25, 5.0), Vec3::X);
+        let memberships: usize = DdaCells::new(&grid.lattice, &ray)
+            .map(|(cell, _, _)| grid.cell(cell).len())
+            .sum();
+        let mut tested = vec![0; boxes.len()];
+        let mut counters = TraversalCounters::default();
+        let found = grid.occluded(&ray, &mut counters, |i| {
+            tested[i as usize] += 1;
+            false
+        });
+        assert!(!found);
+        assert!(tested.iter().all(|&n| n <= 1));
+        assert_eq!(counters.primitives, tested.iter().sum::<u64>());
+        // The slab at y = 5 lies along the whole walk: one test instead of
+        // one per cell.
+        assert_eq!(tested[5], 1);
+        assert!(counters.nodes >= u64::from(grid.resolution()[0]));
+        assert!(counters.primitives + counters.nodes - 1 <= memberships as u64);
+    }
 
     #[test]
     fn closest_hit_keeps_walking_past_a_hit_beyond_its_cell() {
@@ -103,6 +147,7 @@ mod tests {
             (t < t_max).then_some(t)
         });
         assert_eq!(t, Some(6.0));
+        assert_eq!(counters.primitives, 2);
         let cells_to_the_hit = DdaCells::new(&grid.lattice, &ray)
             .take_while(|c| c.1 < 6.0)
             .count();
