@@ -2,8 +2,7 @@
 //! primitives whose boxes overlap it, walked front to back along a ray by a
 //! 3D-DDA.
 //!
-//! - `lattice` decides where the cells lie and which cells a box
-//!   overlaps;
+//! - `lattice` decides where the cells lie and which cells a box overlaps;
 //! - `build` chooses the resolution and fills the cells into flat offset and
 //!   index arrays;
 //! - `dda` walks a ray through the cells; `traverse` answers the two queries
