@@ -1,12 +1,12 @@
 //! `whitted render`: load a scene, render it, write the image and AOVs.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::Args;
 use whitted::accel::AccelKind;
 use whitted::heat_map::heat_map;
-use whitted::image::ImageFormat;
+use whitted::image::{ImageFormat, check_destination};
 use whitted::render::{Aov, RenderOptions, render};
 use whitted::scene::{Scene, load_scene};
 
@@ -101,6 +101,25 @@ fn parse_aov(spec: &str) -> Result<(Aov, PathBuf), String> {
     }
 }
 
+/// Refuses, before any work, outputs that cannot be written: unknown
+/// formats, missing folders, and two outputs to the same file.
+fn check_destinations(output: &Path, aovs: &[(Aov, PathBuf)]) -> Result<(), String> {
+    let mut seen = vec![output];
+    check_destination(output).map_err(|e| e.to_string())?;
+    for (aov, path) in aovs {
+        check_destination(path).map_err(|e| e.to_string())?;
+        if seen.contains(&path.as_path()) {
+            return Err(format!(
+                "--aov {}={}: that file is already an output of this render",
+                aov.name(),
+                path.display()
+            ));
+        }
+        seen.push(path);
+    }
+    Ok(())
+}
+
 /// Runs the command.
 pub fn run(args: &RenderArgs) -> Result<(), String> {
     let aov_outputs = args
@@ -108,7 +127,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         .iter()
         .map(|s| parse_aov(s))
         .collect::<Result<Vec<_>, _>>()?;
-    ImageFormat::from_path(&args.output).map_err(|e| e.to_string())?;
+    check_destinations(&args.output, &aov_outputs)?;
 
     let mut scene = match &args.scene {
         Some(path) => load_scene(path).map_err(|e| e.to_string())?,
@@ -136,16 +155,21 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     let output = output.map_err(|e| e.to_string())?;
     let elapsed = start.elapsed().as_secs_f64();
 
-    output
-        .image
-        .write(&args.output)
-        .map_err(|e| e.to_string())?;
+    // Every file is encoded first and renamed into place only when all
+    // are ready: a failure leaves every destination as it was.
+    let mut pending = vec![output.image.encode(&args.output)];
     for ((aov, film), (_, path)) in output.aovs.iter().zip(&aov_outputs) {
-        let written = match ImageFormat::from_path(path) {
-            Ok(ImageFormat::Png) if *aov == Aov::Cost => heat_map(film).write(path),
-            _ => film.write(path),
-        };
-        written.map_err(|e| e.to_string())?;
+        pending.push(match ImageFormat::from_path(path) {
+            Ok(ImageFormat::Png) if *aov == Aov::Cost => heat_map(film).encode(path),
+            _ => film.encode(path),
+        });
+    }
+    let pending = pending
+        .into_iter()
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string())?;
+    for file in pending {
+        file.commit().map_err(|e| e.to_string())?;
     }
 
     if !args.quiet {

@@ -234,3 +234,33 @@ fn bench_refuses_unknown_structures_and_missing_ray_files() {
     assert!(!out.status.success());
     assert!(stderr(&out).contains("primary.rays"), "{}", stderr(&out));
 }
+
+#[test]
+fn outputs_into_missing_folders_or_the_same_file_are_refused_before_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = whitted(&["render", "-o", "missing/x.png"], dir.path());
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("the folder missing does not exist"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(
+        !stderr(&out).contains("Mrays/s"),
+        "rendered anyway: {}",
+        stderr(&out)
+    );
+    let out = whitted(
+        &["render", "-o", "a.exr", "--aov", "depth=a.exr"],
+        dir.path(),
+    );
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("already an output"),
+        "{}",
+        stderr(&out)
+    );
+    let out = whitted(&["render", "--aov", "depth=missing/d.pfm"], dir.path());
+    assert!(!out.status.success());
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}

@@ -248,13 +248,15 @@ impl Transform {
         if !world_from_object.is_finite() {
             return Err(TransformError::NotFinite);
         }
-        let determinant = world_from_object.matrix3.determinant();
-        let scale = world_from_object
-            .matrix3
-            .to_cols_array()
-            .iter()
-            .fold(0.0f64, |m, v| m.max(v.abs()));
-        if determinant.abs() <= scale.powi(3) * 1e-12 || determinant == 0.0 {
+        let m = &world_from_object.matrix3;
+        let determinant = m.determinant();
+        // How flat the transformed unit cube is: |det| over the product of
+        // the column lengths is 1 for orthogonal axes, whatever their scale,
+        // and 0 when the axes are dependent. A stretch by 1e6 is fine; axes
+        // within 1e-12 radians of a plane are not.
+        let volume_ratio =
+            determinant.abs() / (m.x_axis.length() * m.y_axis.length() * m.z_axis.length());
+        if volume_ratio.is_nan() || volume_ratio <= 1e-12 {
             return Err(TransformError::Singular { determinant });
         }
         let object_from_world = world_from_object.inverse();
@@ -502,6 +504,26 @@ mod tests {
         let normal = Vec3::new(1.0, -1.0, 0.0);
         let dot = t.vector_to_world(tangent).dot(t.normal_to_world(normal));
         assert!(dot.abs() < 1e-12);
+    }
+
+    #[test]
+    fn strong_but_invertible_stretches_are_accepted() {
+        let t = Transform::scale(Vec3::new(1e6, 1.0, 1e-6)).unwrap();
+        let p = Vec3::new(2e-6, 3.0, 4e6);
+        let back = t.object_from_world().transform_point3(t.point_to_world(p));
+        assert!(((back - p) / p).abs().max_element() < 1e-12);
+        let shear = Transform::from_rows([
+            [1.0, 1e-9, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+        ]);
+        assert!(shear.is_ok());
+        let flat = Transform::from_rows([
+            [1.0, 1.0, 0.0, 0.0],
+            [1.0, 1.0 + 1e-15, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+        ]);
+        assert!(matches!(flat, Err(TransformError::Singular { .. })));
     }
 
     #[test]

@@ -294,7 +294,8 @@ fn aovs_give_depth_normal_and_primitive_of_the_centre_ray() {
     use whitted::render::Aov;
     let mut scene = scene_looking_down_z(3, 3, 90.0);
     let material = scene.add_material(Material::default());
-    // The left column sees nothing; the rest sees a wall 5 units away.
+    // Every centre ray sees a wall 5 units away (the sphere far behind
+    // it is hidden); without the wall, nothing.
     scene.add_primitive(
         Shape::Sphere(Sphere::new(Vec3::new(0.0, 0.0, -1000.0), 1.0).unwrap()),
         material,
