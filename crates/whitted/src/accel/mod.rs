@@ -22,11 +22,13 @@
 //! structure returns exactly the closest hit the brute-force [`Linear`]
 //! returns (ties at equal `t` may pick either primitive).
 
+pub mod kdtree;
 pub mod linear;
 
 #[cfg(test)]
 pub(crate) mod conformance;
 
+pub use kdtree::{KdTree, KdTreeBuildParams};
 pub use linear::Linear;
 
 use crate::math::{Aabb, Ray};
@@ -72,16 +74,19 @@ pub enum AccelKind {
     /// Brute force: the reference.
     #[default]
     Linear,
+    /// Kd-tree, built with the SAH in O(N log N).
+    KdTree,
 }
 
 impl AccelKind {
     /// Every kind, in the order `whitted bench` reports them.
-    pub const ALL: [AccelKind; 1] = [AccelKind::Linear];
+    pub const ALL: [AccelKind; 2] = [AccelKind::KdTree, AccelKind::Linear];
 
     /// The name used on the command line and in scene files.
     pub fn name(&self) -> &'static str {
         match self {
             AccelKind::Linear => "linear",
+            AccelKind::KdTree => "kdtree",
         }
     }
 
@@ -96,6 +101,8 @@ impl AccelKind {
 pub enum Accelerator {
     /// Brute force.
     Linear(Linear),
+    /// Kd-tree.
+    KdTree(KdTree),
 }
 
 impl Accelerator {
@@ -103,6 +110,7 @@ impl Accelerator {
     pub fn build(kind: AccelKind, boxes: &[Aabb]) -> Self {
         match kind {
             AccelKind::Linear => Accelerator::Linear(Linear::build(boxes)),
+            AccelKind::KdTree => Accelerator::KdTree(KdTree::build(boxes)),
         }
     }
 
@@ -110,6 +118,7 @@ impl Accelerator {
     pub fn kind(&self) -> AccelKind {
         match self {
             Accelerator::Linear(_) => AccelKind::Linear,
+            Accelerator::KdTree(_) => AccelKind::KdTree,
         }
     }
 
@@ -123,6 +132,7 @@ impl Accelerator {
     ) -> Option<f64> {
         match self {
             Accelerator::Linear(s) => s.intersect(ray, counters, hit),
+            Accelerator::KdTree(s) => s.intersect(ray, counters, hit),
         }
     }
 
@@ -136,6 +146,7 @@ impl Accelerator {
     ) -> bool {
         match self {
             Accelerator::Linear(s) => s.occluded(ray, counters, occludes),
+            Accelerator::KdTree(s) => s.occluded(ray, counters, occludes),
         }
     }
 
@@ -145,6 +156,7 @@ impl Accelerator {
     pub fn validate(&self, boxes: &[Aabb]) -> Result<(), String> {
         match self {
             Accelerator::Linear(s) => s.validate(boxes),
+            Accelerator::KdTree(s) => s.validate(boxes),
         }
     }
 
@@ -152,6 +164,7 @@ impl Accelerator {
     pub fn stats(&self) -> AccelStats {
         match self {
             Accelerator::Linear(s) => s.stats(),
+            Accelerator::KdTree(s) => s.stats(),
         }
     }
 }
