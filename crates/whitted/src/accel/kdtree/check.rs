@@ -222,3 +222,77 @@ fn same_box(a: &Aabb, b: &Aabb) -> bool {
     let bits = |b: &Aabb| [b.min, b.max].map(|v| v.to_array().map(f64::to_bits));
     bits(a) == bits(b)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::node::KdNode;
+    use super::*;
+    use crate::math::Vec3;
+
+    /// Two unit cubes meeting at x = 1.
+    fn boxes() -> Vec<Aabb> {
+        vec![
+            Aabb::new(Vec3::ZERO, Vec3::ONE),
+            Aabb::new(Vec3::X, Vec3::new(2.0, 1.0, 1.0)),
+        ]
+    }
+
+    #[test]
+    fn stats_of_a_single_split_count_nodes_references_and_sah_cost() {
+        let tree = KdTree::build(&boxes());
+        assert_eq!(tree.validate(&boxes()), Ok(()));
+        let stats = tree.stats();
+        assert_eq!(
+            (stats.nodes, stats.leaves, stats.references, stats.max_depth),
+            (3, 2, 2, 1)
+        );
+        assert_eq!(stats.memory_bytes, 3 * 8 + 2 * 4);
+        // The root, then each half (area 6 of 10) with one cube.
+        assert!((stats.sah_cost - 2.2).abs() < 1e-12, "{stats:?}");
+    }
+
+    #[test]
+    fn validate_finds_a_missing_primitive() {
+        let mut tree = KdTree::build(&boxes());
+        tree.indices[1] = 0;
+        let why = tree.validate(&boxes()).unwrap_err();
+        assert!(why.contains("primitive 1 overlaps leaf"), "{why}");
+    }
+
+    #[test]
+    fn validate_finds_bad_indices_and_misplaced_planes() {
+        let mut tree = KdTree::build(&boxes());
+        tree.nodes[0] = KdNode::interior(0, 1.0, 7);
+        assert!(
+            tree.validate(&boxes())
+                .unwrap_err()
+                .contains("out of range")
+        );
+        tree.nodes[0] = KdNode::interior(0, 3.0, 2);
+        assert!(
+            tree.validate(&boxes())
+                .unwrap_err()
+                .contains("outside its cell")
+        );
+        tree.nodes[0] = KdNode::interior(0, 1.0, 1);
+        assert!(
+            tree.validate(&boxes())
+                .unwrap_err()
+                .contains("reached twice")
+        );
+        tree.nodes[0] = KdNode::leaf(1, 5);
+        assert!(
+            tree.validate(&boxes())
+                .unwrap_err()
+                .contains("out of range")
+        );
+    }
+
+    #[test]
+    fn validate_finds_a_box_kept_aside_that_fits_the_tree() {
+        let mut tree = KdTree::build(&boxes());
+        tree.loose.push((0, boxes()[0]));
+        let why = tree.validate(&boxes()).unwrap_err();
+        assert!(why.contains("fits the tree"), "{why}");
+    }
+}
