@@ -23,12 +23,14 @@
 //! returns (ties at equal `t` may pick either primitive).
 
 pub mod grid;
+pub mod kdtree;
 pub mod linear;
 
 #[cfg(test)]
 pub(crate) mod conformance;
 
 pub use grid::{Grid, GridBuildParams};
+pub use kdtree::{KdTree, KdTreeBuildParams};
 pub use linear::Linear;
 
 use crate::math::{Aabb, Ray};
@@ -76,17 +78,20 @@ pub enum AccelKind {
     Linear,
     /// A uniform grid walked by a 3D-DDA.
     Grid,
+    /// Kd-tree, built with the SAH in O(N log N).
+    KdTree,
 }
 
 impl AccelKind {
     /// Every kind, in the order `whitted bench` reports them.
-    pub const ALL: [AccelKind; 2] = [AccelKind::Grid, AccelKind::Linear];
+    pub const ALL: [AccelKind; 3] = [AccelKind::KdTree, AccelKind::Grid, AccelKind::Linear];
 
     /// The name used on the command line and in scene files.
     pub fn name(&self) -> &'static str {
         match self {
             AccelKind::Linear => "linear",
             AccelKind::Grid => "grid",
+            AccelKind::KdTree => "kdtree",
         }
     }
 
@@ -103,6 +108,8 @@ pub enum Accelerator {
     Linear(Linear),
     /// A uniform grid.
     Grid(Grid),
+    /// Kd-tree.
+    KdTree(KdTree),
 }
 
 impl Accelerator {
@@ -111,6 +118,7 @@ impl Accelerator {
         match kind {
             AccelKind::Linear => Accelerator::Linear(Linear::build(boxes)),
             AccelKind::Grid => Accelerator::Grid(Grid::build(boxes)),
+            AccelKind::KdTree => Accelerator::KdTree(KdTree::build(boxes)),
         }
     }
 
@@ -119,6 +127,7 @@ impl Accelerator {
         match self {
             Accelerator::Linear(_) => AccelKind::Linear,
             Accelerator::Grid(_) => AccelKind::Grid,
+            Accelerator::KdTree(_) => AccelKind::KdTree,
         }
     }
 
@@ -133,6 +142,7 @@ impl Accelerator {
         match self {
             Accelerator::Linear(s) => s.intersect(ray, counters, hit),
             Accelerator::Grid(s) => s.intersect(ray, counters, hit),
+            Accelerator::KdTree(s) => s.intersect(ray, counters, hit),
         }
     }
 
@@ -147,6 +157,7 @@ impl Accelerator {
         match self {
             Accelerator::Linear(s) => s.occluded(ray, counters, occludes),
             Accelerator::Grid(s) => s.occluded(ray, counters, occludes),
+            Accelerator::KdTree(s) => s.occluded(ray, counters, occludes),
         }
     }
 
@@ -157,6 +168,7 @@ impl Accelerator {
         match self {
             Accelerator::Linear(s) => s.validate(boxes),
             Accelerator::Grid(s) => s.validate(boxes),
+            Accelerator::KdTree(s) => s.validate(boxes),
         }
     }
 
@@ -165,6 +177,7 @@ impl Accelerator {
         match self {
             Accelerator::Linear(s) => s.stats(),
             Accelerator::Grid(s) => s.stats(),
+            Accelerator::KdTree(s) => s.stats(),
         }
     }
 }

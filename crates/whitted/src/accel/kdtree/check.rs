@@ -1,0 +1,298 @@
+//! Checking a built tree against its boxes (`validate`) and measuring it
+//! (`stats`).
+
+use super::build::placed_box;
+use super::node::NodeKind;
+use super::traverse::STACK_CAPACITY;
+use super::{KdTree, split_cell};
+use crate::accel::AccelStats;
+use crate::math::Aabb;
+
+impl KdTree {
+    /// Checks the tree against the boxes it was built from:
+    /// - its shape: node and primitive indices in range, every node reached
+    ///   exactly once from the root, depth within the traversal stack,
+    ///   every split plane strictly inside its node's cell;
+    /// - every primitive reachable: every point of its box lies in a
+    ///   (closed) leaf cell that holds it. So each leaf whose cell the box
+    ///   reaches into holds it, while a box that only touches a split
+    ///   plane, or lies flat in it, may be held on one side of it only. A
+    ///   primitive not placed in the tree is kept aside with its box,
+    ///   because the box cannot be placed.
+    pub fn validate(&self, boxes: &[Aabb]) -> Result<(), String> {
+        let mut aside = vec![false; boxes.len()];
+        for &(i, b) in &self.loose {
+            let given = boxes
+                .get(i as usize)
+                .ok_or_else(|| format!("primitive {i} kept aside is out of range"))?;
+            if !same_box(given, &b) {
+                return Err(format!("primitive {i} is kept aside with a wrong box"));
+            }
+            if placed_box(i as usize, given).is_some() {
+                return Err(format!("primitive {i} is kept aside but fits the tree"));
+            }
+            if std::mem::replace(&mut aside[i as usize], true) {
+                return Err(format!("primitive {i} is kept aside twice"));
+            }
+        }
+        self.check_shape(boxes.len(), &aside)?;
+
+        let mut required = Vec::new();
+        for (i, b) in boxes.iter().enumerate().filter(|&(i, _)| !aside[i]) {
+            if placed_box(i, b).is_none() {
+                return Err(format!(
+                    "primitive {i} cannot be placed but is not kept aside"
+                ));
+            }
+            if !(b.min.cmpge(self.bounds.min).all() && b.max.cmple(self.bounds.max).all()) {
+                return Err(format!(
+                    "primitive {i}'s box {b:?} is not inside the root cell"
+                ));
+            }
+            required.push(i as u32);
+        }
+        self.check_coverage(0, self.bounds, required, boxes)
+    }
+
+    /// Checks that the nodes form a tree within the stack's depth, with
+    /// indices in range and every split inside its cell.
+    fn check_shape(&self, primitives: usize, aside: &[bool]) -> Result<(), String> {
+        let mut reached = vec![false; self.nodes.len()];
+        let mut pending = vec![(0, self.bounds, 0)];
+        while let Some((index, cell, depth)) = pending.pop() {
+            if depth > STACK_CAPACITY {
+                return Err(format!(
+                    "node {index} is at depth {depth}, beyond the stack's {STACK_CAPACITY}"
+                ));
+            }
+            let node = self
+                .nodes
+                .get(index)
+                .ok_or_else(|| format!("node index {index} is out of range"))?;
+            if std::mem::replace(&mut reached[index], true) {
+                return Err(format!("node {index} is reached twice"));
+            }
+            match node.kind() {
+                NodeKind::Leaf { offset, count } => {
+                    let held = self.leaf_primitives(offset, count).ok_or_else(|| {
+                        format!("leaf {index}'s primitives {offset}+{count} are out of range")
+                    })?;
+                    if let Some(p) = held
+                        .iter()
+                        .find(|&&p| p as usize >= primitives || aside[p as usize])
+                    {
+                        return Err(format!("leaf {index} holds primitive {p}, not in the tree"));
+                    }
+                }
+                NodeKind::Interior { axis, split, above } => {
+                    let plane = f64::from(split);
+                    if !(cell.min[axis] < plane && plane < cell.max[axis]) {
+                        return Err(format!(
+                            "node {index} splits axis {axis} at {plane}, outside its cell {cell:?}"
+                        ));
+                    }
+                    let [below_cell, above_cell] = split_cell(&cell, axis, plane);
+                    pending.push((index + 1, below_cell, depth + 1));
+                    pending.push((above as usize, above_cell, depth + 1));
+                }
+            }
+        }
+        match reached.iter().position(|r| !r) {
+            Some(i) => Err(format!("node {i} is unreachable")),
+            None => Ok(()),
+        }
+    }
+
+    /// Checks that every point of a `required` primitive's box inside
+    /// `cell` (the cell of node `index`) lies in a leaf of the subtree that
+    /// holds it. The shape is already checked.
+    fn check_coverage(
+        &self,
+        index: usize,
+        cell: Aabb,
+        required: Vec<u32>,
+        boxes: &[Aabb],
+    ) -> Result<(), String> {
+        match self.nodes[index].kind() {
+            NodeKind::Leaf { offset, count } => {
+                let mut held = self.leaf_primitives(offset, count).unwrap_or(&[]).to_vec();
+                held.sort_unstable();
+                match required.iter().find(|p| held.binary_search(p).is_err()) {
+                    Some(p) => Err(format!(
+                        "primitive {p} overlaps leaf {index}'s cell {cell:?} but is not in it"
+                    )),
+                    None => Ok(()),
+                }
+            }
+            NodeKind::Interior { axis, split, above } => {
+                let plane = f64::from(split);
+                let (mut below_required, mut above_required) = (Vec::new(), Vec::new());
+                for p in required {
+                    let b = &boxes[p as usize];
+                    let (low, high) = (b.min[axis], b.max[axis]);
+                    if low == plane && high == plane {
+                        // Flat in the plane: wholly on the side it was given.
+                        if self.subtree_holds(index + 1, p) {
+                            below_required.push(p);
+                        } else {
+                            above_required.push(p);
+                        }
+                    } else {
+                        if low < plane {
+                            below_required.push(p);
+                        }
+                        if high > plane {
+                            above_required.push(p);
+                        }
+                    }
+                }
+                let [below_cell, above_cell] = split_cell(&cell, axis, plane);
+                self.check_coverage(index + 1, below_cell, below_required, boxes)?;
+                self.check_coverage(above as usize, above_cell, above_required, boxes)
+            }
+        }
+    }
+
+    /// True when a leaf of the subtree `index` holds `primitive`.
+    fn subtree_holds(&self, index: usize, primitive: u32) -> bool {
+        match self.nodes[index].kind() {
+            NodeKind::Leaf { offset, count } => self
+                .leaf_primitives(offset, count)
+                .is_some_and(|held| held.contains(&primitive)),
+            NodeKind::Interior { above, .. } => {
+                self.subtree_holds(index + 1, primitive)
+                    || self.subtree_holds(above as usize, primitive)
+            }
+        }
+    }
+
+    fn leaf_primitives(&self, offset: u32, count: u32) -> Option<&[u32]> {
+        let start = offset as usize;
+        self.indices.get(start..start + count as usize)
+    }
+
+    /// Size and quality. The SAH cost counts one per interior node and one
+    /// per primitive in a leaf, each weighted by its cell's area relative
+    /// to the root cell's, plus one per primitive kept aside.
+    pub fn stats(&self) -> AccelStats {
+        let mut stats = AccelStats {
+            nodes: self.nodes.len(),
+            memory_bytes: size_of_val(self.nodes.as_slice())
+                + size_of_val(self.indices.as_slice())
+                + size_of_val(self.loose.as_slice()),
+            sah_cost: self.loose.len() as f64,
+            ..AccelStats::default()
+        };
+        let root_area = self.bounds.surface_area();
+        let probability = |cell: &Aabb| {
+            if root_area > 0.0 {
+                cell.surface_area() / root_area
+            } else {
+                1.0
+            }
+        };
+        let mut pending = vec![(0, self.bounds, 0)];
+        while let Some((index, cell, depth)) = pending.pop() {
+            let Some(node) = self.nodes.get(index) else {
+                continue;
+            };
+            stats.max_depth = stats.max_depth.max(depth);
+            match node.kind() {
+                NodeKind::Leaf { count, .. } => {
+                    stats.leaves += 1;
+                    stats.references += count as usize;
+                    stats.sah_cost += probability(&cell) * f64::from(count);
+                }
+                NodeKind::Interior { axis, split, above } => {
+                    stats.sah_cost += probability(&cell);
+                    if depth < STACK_CAPACITY {
+                        let [below_cell, above_cell] = split_cell(&cell, axis, f64::from(split));
+                        pending.push((index + 1, below_cell, depth + 1));
+                        pending.push((above as usize, above_cell, depth + 1));
+                    }
+                }
+            }
+        }
+        stats
+    }
+}
+
+/// Bit-for-bit equality, so a NaN box equals itself.
+fn same_box(a: &Aabb, b: &Aabb) -> bool {
+    let bits = |b: &Aabb| [b.min, b.max].map(|v| v.to_array().map(f64::to_bits));
+    bits(a) == bits(b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::node::KdNode;
+    use super::*;
+    use crate::math::Vec3;
+
+    /// Two unit cubes meeting at x = 1.
+    fn boxes() -> Vec<Aabb> {
+        vec![
+            Aabb::new(Vec3::ZERO, Vec3::ONE),
+            Aabb::new(Vec3::X, Vec3::new(2.0, 1.0, 1.0)),
+        ]
+    }
+
+    #[test]
+    fn stats_of_a_single_split_count_nodes_references_and_sah_cost() {
+        let tree = KdTree::build(&boxes());
+        assert_eq!(tree.validate(&boxes()), Ok(()));
+        let stats = tree.stats();
+        assert_eq!(
+            (stats.nodes, stats.leaves, stats.references, stats.max_depth),
+            (3, 2, 2, 1)
+        );
+        assert_eq!(stats.memory_bytes, 3 * 8 + 2 * 4);
+        // The root, then each half (area 6 of 10) with one cube.
+        assert!((stats.sah_cost - 2.2).abs() < 1e-12, "{stats:?}");
+    }
+
+    #[test]
+    fn validate_finds_a_missing_primitive() {
+        let mut tree = KdTree::build(&boxes());
+        tree.indices[1] = 0;
+        let why = tree.validate(&boxes()).unwrap_err();
+        assert!(why.contains("primitive 1 overlaps leaf"), "{why}");
+    }
+
+    #[test]
+    fn validate_finds_bad_indices_and_misplaced_planes() {
+        let mut tree = KdTree::build(&boxes());
+        tree.nodes[0] = KdNode::interior(0, 1.0, 7);
+        assert!(
+            tree.validate(&boxes())
+                .unwrap_err()
+                .contains("out of range")
+        );
+        tree.nodes[0] = KdNode::interior(0, 3.0, 2);
+        assert!(
+            tree.validate(&boxes())
+                .unwrap_err()
+                .contains("outside its cell")
+        );
+        tree.nodes[0] = KdNode::interior(0, 1.0, 1);
+        assert!(
+            tree.validate(&boxes())
+                .unwrap_err()
+                .contains("reached twice")
+        );
+        tree.nodes[0] = KdNode::leaf(1, 5);
+        assert!(
+            tree.validate(&boxes())
+                .unwrap_err()
+                .contains("out of range")
+        );
+    }
+
+    #[test]
+    fn validate_finds_a_box_kept_aside_that_fits_the_tree() {
+        let mut tree = KdTree::build(&boxes());
+        tree.loose.push((0, boxes()[0]));
+        let why = tree.validate(&boxes()).unwrap_err();
+        assert!(why.contains("fits the tree"), "{why}");
+    }
+}

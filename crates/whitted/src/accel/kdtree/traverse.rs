@@ -1,0 +1,272 @@
+//! Ray traversal: the ray is clipped to the root box, then walks the leaves
+//! it passes from near to far with a fixed-size to-do stack of
+//! `(node, t_min, t_max)` (pbrt-v4 `KdTreeAggregate::Intersect`).
+//!
+//! Every choice is conservative. The parameter where the ray crosses a
+//! split plane is widened by its rounding error, and both children are
+//! visited whenever the crossing lies within the node's range (also at its
+//! very ends), or cannot be computed because the ray lies in the plane.
+//!
+//! A hit beyond the current cell is not final: a cell farther on is skipped
+//! only when it starts beyond the closest hit found so far. That is the
+//! usual "stop when the hit is within the cell" test, but it also holds
+//! when a ray lying in a split plane visits both children over the same
+//! range.
+
+use super::KdTree;
+use super::node::NodeKind;
+use crate::accel::TraversalCounters;
+use crate::math::{Ray, gamma};
+
+/// Entries of the to-do stack: one per level at most, so this bounds the
+/// tree's depth.
+pub(super) const STACK_CAPACITY: usize = 64;
+
+/// A node to visit over a parameter range.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Entry {
+    node: u32,
+    t_min: f64,
+    t_max: f64,
+}
+
+/// What to do after a leaf.
+enum Flow {
+    /// Go on; skip cells starting beyond this parameter.
+    Continue(f64),
+    /// Done.
+    Stop,
+}
+
+impl KdTree {
+    /// The closest hit (see [`crate::accel`]).
+    #[inline]
+    pub fn intersect(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        mut hit: impl FnMut(u32, f64) -> Option<f64>,
+    ) -> Option<f64> {
+        let mut closest = None;
+        let mut t_max = ray.t_max;
+        let mut clipped = *ray;
+        for &(i, b) in &self.loose {
+            counters.nodes += 1;
+            if b.intersect_ray(&clipped).is_some() {
+                counters.primitives += 1;
+                if let Some(t) = hit(i, t_max) {
+                    (t_max, clipped.t_max, closest) = (t, t, Some(t));
+                }
+            }
+        }
+        self.walk(&clipped, counters, |primitives, counters| {
+            for &i in primitives {
+                counters.primitives += 1;
+                if let Some(t) = hit(i, t_max) {
+                    (t_max, closest) = (t, Some(t));
+                }
+            }
+            Flow::Continue(t_max)
+        });
+        closest
+    }
+
+    /// Any hit (see [`crate::accel`]).
+    #[inline]
+    pub fn occluded(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        mut occludes: impl FnMut(u32) -> bool,
+    ) -> bool {
+        let loose_hit = self.loose.iter().any(|&(i, b)| {
+            counters.nodes += 1;
+            if b.intersect_ray(ray).is_none() {
+                return false;
+            }
+            counters.primitives += 1;
+            occludes(i)
+        });
+        if loose_hit {
+            return true;
+        }
+        let mut found = false;
+        self.walk(ray, counters, |primitives, counters| {
+            for &i in primitives {
+                counters.primitives += 1;
+                if occludes(i) {
+                    found = true;
+                    return Flow::Stop;
+                }
+            }
+            Flow::Continue(ray.t_max)
+        });
+        found
+    }
+
+    /// Calls `leaf` with the primitives of every leaf the ray passes, near
+    /// to far, until it says stop.
+    #[inline]
+    fn walk(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        mut leaf: impl FnMut(&[u32], &mut TraversalCounters) -> Flow,
+    ) {
+        if self.bounds.is_empty() {
+            return;
+        }
+        let Some((t_min, t_max)) = self.bounds.intersect_ray(ray) else {
+            return;
+        };
+        let mut horizon = ray.t_max;
+        let mut stack = [Entry::default(); STACK_CAPACITY];
+        let mut pending = 0;
+        let mut entry = Entry {
+            node: 0,
+            t_min,
+            t_max,
+        };
+        loop {
+            counters.nodes += 1;
+            match self.nodes[entry.node as usize].kind() {
+                NodeKind::Interior { axis, split, above } => {
+                    match children(&entry, axis, split, above, ray) {
+                        [Some(first), Some(second)] => {
+                            stack[pending] = second;
+                            pending += 1;
+                            entry = first;
+                            continue;
+                        }
+                        [Some(only), None] | [None, Some(only)] => {
+                            entry = only;
+                            continue;
+                        }
+                        [None, None] => {}
+                    }
+                }
+                NodeKind::Leaf { offset, count } => {
+                    let start = offset as usize;
+                    let primitives = &self.indices[start..start + count as usize];
+                    match leaf(primitives, counters) {
+                        Flow::Continue(t) => horizon = t,
+                        Flow::Stop => return,
+                    }
+                }
+            }
+            // The next pending cell that starts before the closest hit.
+            loop {
+                if pending == 0 {
+                    return;
+                }
+                pending -= 1;
+                entry = stack[pending];
+                if entry.t_min <= horizon {
+                    break;
+                }
+            }
+        }
+    }
+}
+
+/// The children of the interior node `entry` that the ray meets, in the
+/// order it meets them, each with its parameter range.
+#[inline]
+fn children(entry: &Entry, axis: usize, split: f32, above: u32, ray: &Ray) -> [Option<Entry>; 2] {
+    let below = entry.node + 1;
+    let inv_dir = ray.inv_dir[axis];
+    let t_plane = (f64::from(split) - ray.origin[axis]) * inv_dir;
+    // The crossing's rounding error is below γ(3) relative; NaN means the
+    // ray lies in the plane (0 · ∞), so it is in both children throughout.
+    let (t_low, t_high) = if t_plane.is_nan() {
+        (f64::NEG_INFINITY, f64::INFINITY)
+    } else {
+        let a = t_plane * (1.0 - 2.0 * gamma(3));
+        let b = t_plane * (1.0 + 2.0 * gamma(3));
+        (a.min(b), a.max(b))
+    };
+    // A ray going up (or along the plane with a +0 direction, whose
+    // crossing is ±∞) meets the below child first.
+    let (first, second) = if inv_dir.is_sign_negative() {
+        (above, below)
+    } else {
+        (below, above)
+    };
+    let near = (entry.t_min <= t_high).then_some(Entry {
+        node: first,
+        t_min: entry.t_min,
+        t_max: entry.t_max.min(t_high),
+    });
+    let far = (t_low <= entry.t_max).then_some(Entry {
+        node: second,
+        t_min: entry.t_min.max(t_low),
+        t_max: entry.t_max,
+    });
+    [near, far]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vec3;
+
+    fn entry(t_min: f64, t_max: f64) -> Entry {
+        Entry {
+            node: 10,
+            t_min,
+            t_max,
+        }
+    }
+
+    fn nodes(children: [Option<Entry>; 2]) -> Vec<u32> {
+        children.iter().flatten().map(|e| e.node).collect()
+    }
+
+    #[test]
+    fn a_ray_lying_in_the_plane_visits_both_children_over_its_whole_range() {
+        for dir in [Vec3::Y, -Vec3::Y, Vec3::new(-0.0, 1.0, 0.0)] {
+            let ray = Ray::new(Vec3::new(2.0, 0.0, 0.0), dir);
+            let [a, b] = children(&entry(1.0, 5.0), 0, 2.0, 20, &ray);
+            assert_eq!((a.unwrap().t_min, a.unwrap().t_max), (1.0, 5.0));
+            assert_eq!((b.unwrap().t_min, b.unwrap().t_max), (1.0, 5.0));
+        }
+    }
+
+    #[test]
+    fn a_ray_parallel_to_the_plane_visits_only_its_side() {
+        for dir in [Vec3::Y, Vec3::new(-0.0, 1.0, 0.0)] {
+            let below = Ray::new(Vec3::new(1.5, 0.0, 0.0), dir);
+            assert_eq!(nodes(children(&entry(1.0, 5.0), 0, 2.0, 20, &below)), [11]);
+            let above = Ray::new(Vec3::new(2.5, 0.0, 0.0), dir);
+            assert_eq!(nodes(children(&entry(1.0, 5.0), 0, 2.0, 20, &above)), [20]);
+        }
+    }
+
+    #[test]
+    fn crossings_at_the_range_ends_visit_both_children() {
+        // The ray crosses x = 2 at t = 2.
+        let up = Ray::new(Vec3::ZERO, Vec3::X);
+        assert_eq!(nodes(children(&entry(2.0, 5.0), 0, 2.0, 20, &up)), [11, 20]);
+        assert_eq!(nodes(children(&entry(0.0, 2.0), 0, 2.0, 20, &up)), [11, 20]);
+        assert_eq!(nodes(children(&entry(0.0, 1.5), 0, 2.0, 20, &up)), [11]);
+        assert_eq!(nodes(children(&entry(2.5, 5.0), 0, 2.0, 20, &up)), [20]);
+        let down = Ray::new(Vec3::new(4.0, 0.0, 0.0), -Vec3::X);
+        assert_eq!(
+            nodes(children(&entry(0.0, 2.0), 0, 2.0, 20, &down)),
+            [20, 11]
+        );
+    }
+
+    #[test]
+    fn a_ray_starting_on_the_plane_goes_to_the_side_it_points_to_first() {
+        let up = Ray::new(Vec3::new(2.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0));
+        let [near, far] = children(&entry(0.0, 5.0), 0, 2.0, 20, &up);
+        // The below child is met only at t = 0 itself.
+        assert_eq!(near.map(|e| (e.node, e.t_max)), Some((11, 0.0)));
+        assert_eq!(far.map(|e| (e.node, e.t_min)), Some((20, 0.0)));
+        let down = Ray::new(Vec3::new(2.0, 0.0, 0.0), Vec3::new(-1.0, 1.0, 0.0));
+        let [near, far] = children(&entry(0.0, 5.0), 0, 2.0, 20, &down);
+        assert_eq!(near.map(|e| (e.node, e.t_max)), Some((20, 0.0)));
+        assert_eq!(far.map(|e| (e.node, e.t_min)), Some((11, 0.0)));
+    }
+}
