@@ -160,6 +160,14 @@ mod tests {
     }
 
     #[test]
+    fn looking_along_plus_z_with_y_up_puts_plus_x_on_the_left() {
+        // The convention stated in docs/scene-format.md: a right-handed world.
+        let c = Camera::new(Vec3::ZERO, Vec3::Z, Vec3::Y, 90.0).unwrap();
+        assert!(c.ray(100, 100, 0.0, 50.0).dir.x > 0.0);
+        assert!(c.ray(100, 100, 100.0, 50.0).dir.x < 0.0);
+    }
+
+    #[test]
     fn wide_images_widen_the_horizontal_view() {
         let right = camera().ray(200, 100, 200.0, 50.0).dir;
         assert!((right.x / -right.z - 2.0).abs() < 1e-12);
