@@ -11,7 +11,7 @@ use std::path::Path;
 use toml_span::Span;
 use toml_span::value::{Key, Table, Value};
 
-use crate::math::{Color, Vec3};
+use crate::math::{Color, Vec3, unit};
 use crate::scene::{Diagnostic, SceneError};
 
 /// A value was wrong and its error has been recorded. Only [`Reader::error`]
@@ -365,10 +365,11 @@ impl<'s> Reader<'s> {
         all(items.iter().map(|item| self.vec3(item, key)))
     }
 
-    /// A non-zero vector `[x, y, z]`, normalised.
+    /// A non-zero vector `[x, y, z]`, normalised. Only `[0, 0, 0]` is
+    /// refused: however short or long, any other vector has a direction.
     pub(super) fn direction(&mut self, value: &Value<'_>, key: &str) -> Parsed<Vec3> {
         let v = self.vec3(value, key)?;
-        v.try_normalize()
+        unit(v)
             .ok_or_else(|| self.error(value.span, format!("`{key}` must not be the zero vector")))
     }
 
@@ -472,6 +473,9 @@ mod tests {
             ])
         );
         assert_eq!(read("x = [0, 0, 2]", Reader::direction), Ok(Vec3::Z));
+        assert_eq!(read("x = [1e-200, 0, 0]", Reader::direction), Ok(Vec3::X));
+        assert_eq!(read("x = [0, -1e200, 0]", Reader::direction), Ok(-Vec3::Y));
+        assert_eq!(read("x = [0, 0, -5e-324]", Reader::direction), Ok(-Vec3::Z));
         assert_eq!(
             read("x = [0, 0, 0]", Reader::direction),
             Err(vec!["`x` must not be the zero vector".into()])
