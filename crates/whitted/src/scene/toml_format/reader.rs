@@ -186,21 +186,51 @@ impl<'s> Reader<'s> {
 
     /// Records an error for every key of `fields` not in `allowed`.
     pub(super) fn check_keys(&mut self, fields: &Fields<'_, '_>, allowed: &[&str]) -> Parsed<()> {
+        let expected = format!("expected one of: {}", list(allowed));
+        self.check_keys_saying(fields, allowed, &expected)
+    }
+
+    /// Records an error for every key of `fields` not in `allowed`, its
+    /// message ending with `expected` (what the keys could have been).
+    pub(super) fn check_keys_saying(
+        &mut self,
+        fields: &Fields<'_, '_>,
+        allowed: &[&str],
+        expected: &str,
+    ) -> Parsed<()> {
         let mut result = Ok(());
         for key in fields.table.keys() {
             if !allowed.contains(&key.name.as_ref()) {
                 result = Err(self.error(
                     key.span,
-                    format!(
-                        "unknown key `{}` in {}; expected one of: {}",
-                        key.name,
-                        fields.what,
-                        list(allowed)
-                    ),
+                    format!("unknown key `{}` in {}; {expected}", key.name, fields.what),
                 ));
             }
         }
         result
+    }
+
+    /// Records an error for every key of `fields` that none of its possible
+    /// kinds has, when which kind it is could not be read: `keys_of_kinds`
+    /// gives the keys of each kind, `kinds` names them in the message
+    /// ("light types", "shapes").
+    pub(super) fn check_keys_of_any_kind(
+        &mut self,
+        fields: &Fields<'_, '_>,
+        keys_of_kinds: &[&[&str]],
+        kinds: &str,
+    ) -> Parsed<()> {
+        let mut allowed: Vec<&str> = Vec::new();
+        for key in keys_of_kinds.iter().copied().flatten() {
+            if !allowed.contains(key) {
+                allowed.push(key);
+            }
+        }
+        let expected = format!(
+            "none of the {kinds} has it; expected one of: {}",
+            list(&allowed)
+        );
+        self.check_keys_saying(fields, &allowed, &expected)
     }
 
     /// The span of the value of `key`, or of the table when it is absent.
