@@ -28,6 +28,11 @@ pub(super) fn all<T>(steps: impl IntoIterator<Item = Parsed<T>>) -> Parsed<Vec<T
     results.into_iter().collect()
 }
 
+/// Both values, or failure when either step failed (both already ran).
+pub(super) fn both<A, B>(a: Parsed<A>, b: Parsed<B>) -> Parsed<(A, B)> {
+    Ok((a?, b?))
+}
+
 /// The state of a walk: the text (for spans) and the errors found so far.
 pub(super) struct Reader<'s> {
     source: &'s str,
