@@ -6,7 +6,7 @@
 //! pixel centres: pixel `(column, row)` is centred at `(column + 0.5,
 //! row + 0.5)` in image coordinates, row 0 at the top.
 
-use crate::math::{Aabb, Ray, Vec3};
+use crate::math::{Aabb, Ray, Vec3, unit};
 
 /// Why a camera could not be built.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -48,14 +48,20 @@ impl Camera {
         if !(fov_degrees > 0.0 && fov_degrees < 180.0) {
             return Err(CameraError::BadFov(fov_degrees));
         }
-        let forward = (look_at - eye)
-            .try_normalize()
-            .ok_or(CameraError::NoViewDirection)?;
-        let right = forward
-            .cross(up)
-            .try_normalize()
-            .filter(|_| forward.cross(up.normalize_or_zero()).length() > 1e-9)
-            .ok_or(CameraError::BadUp)?;
+        // Halved when the difference overflows (an eye and a look_at near
+        // opposite ends of the f64 range): the direction is the same.
+        let view = look_at - eye;
+        let view = if view.is_finite() {
+            view
+        } else {
+            0.5 * look_at - 0.5 * eye
+        };
+        let forward = unit(view).ok_or(CameraError::NoViewDirection)?;
+        let side = forward.cross(unit(up).ok_or(CameraError::BadUp)?);
+        if side.length() <= 1e-9 {
+            return Err(CameraError::BadUp);
+        }
+        let right = side.normalize();
         let true_up = right.cross(forward);
         Ok(Self {
             eye,
@@ -79,15 +85,9 @@ impl Camera {
             return Err(CameraError::NotFinite);
         }
         let c = bounds.centroid();
-        let diagonal = bounds
-            .extent()
-            .try_normalize()
-            .ok_or(CameraError::NoViewDirection)?;
+        let diagonal = unit(bounds.extent()).ok_or(CameraError::NoViewDirection)?;
         let forward = -diagonal;
-        let right = forward
-            .cross(Vec3::Y)
-            .try_normalize()
-            .ok_or(CameraError::BadUp)?;
+        let right = unit(forward.cross(Vec3::Y)).ok_or(CameraError::BadUp)?;
         let up = right.cross(forward);
         let th = (0.5 * fov_degrees).to_radians().tan();
         let distance = bounds
@@ -160,6 +160,14 @@ mod tests {
     }
 
     #[test]
+    fn looking_along_plus_z_with_y_up_puts_plus_x_on_the_left() {
+        // The convention stated in docs/scene-format.md: a right-handed world.
+        let c = Camera::new(Vec3::ZERO, Vec3::Z, Vec3::Y, 90.0).unwrap();
+        assert!(c.ray(100, 100, 0.0, 50.0).dir.x > 0.0);
+        assert!(c.ray(100, 100, 100.0, 50.0).dir.x < 0.0);
+    }
+
+    #[test]
     fn wide_images_widen_the_horizontal_view() {
         let right = camera().ray(200, 100, 200.0, 50.0).dir;
         assert!((right.x / -right.z - 2.0).abs() < 1e-12);
@@ -181,6 +189,28 @@ mod tests {
         }
         assert!((widest - 1.0).abs() < 1e-12);
         assert!((c.forward + bounds.extent().normalize()).length() < 1e-12);
+    }
+
+    #[test]
+    fn tiny_and_huge_view_directions_and_up_vectors_are_accepted() {
+        let straight = camera().ray(3, 3, 1.5, 1.5).dir;
+        for (eye, look_at, up) in [
+            (Vec3::ZERO, Vec3::new(0.0, 0.0, -1e-200), Vec3::Y),
+            (Vec3::ZERO, Vec3::new(0.0, 0.0, -1e200), Vec3::Y),
+            (
+                Vec3::new(0.0, 0.0, f64::MAX),
+                Vec3::new(0.0, 0.0, -f64::MAX),
+                Vec3::Y,
+            ),
+            (Vec3::ZERO, -Vec3::Z, Vec3::new(0.0, 1e-200, 0.0)),
+            (Vec3::ZERO, -Vec3::Z, Vec3::new(0.0, 1e200, 0.0)),
+        ] {
+            let c = Camera::new(eye, look_at, up, 90.0).unwrap();
+            let dir = c.ray(3, 3, 1.5, 1.5).dir;
+            assert!((dir - straight).length() < 1e-15, "{look_at} {up}: {dir}");
+            let right = c.ray(3, 3, 3.0, 1.5).dir;
+            assert!(right.x > 0.0, "{look_at} {up}: {right}");
+        }
     }
 
     #[test]

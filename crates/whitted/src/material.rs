@@ -38,7 +38,8 @@ pub struct Material {
     pub emission: Texture,
     /// Index of refraction of the material's inside.
     pub ior: f64,
-    /// Weight `kr`/`kt` by Schlick's Fresnel term.
+    /// Split the transmission `kt` by Schlick's Fresnel term `F`: `kt (1 - F)`
+    /// to the refracted ray, `kr + kt F` to the reflected one.
     pub fresnel: bool,
 }
 

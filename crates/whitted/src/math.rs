@@ -291,7 +291,7 @@ impl Transform {
         if !axis.is_finite() || !degrees.is_finite() {
             return Err(TransformError::NotFinite);
         }
-        let axis = axis.try_normalize().ok_or(TransformError::ZeroAxis)?;
+        let axis = unit(axis).ok_or(TransformError::ZeroAxis)?;
         Self::from_affine(DAffine3::from_axis_angle(axis, degrees.to_radians()))
     }
 
@@ -302,7 +302,7 @@ impl Transform {
         if !(origin.is_finite() && axis.is_finite()) {
             return Err(TransformError::NotFinite);
         }
-        let w = axis.try_normalize().ok_or(TransformError::ZeroAxis)?;
+        let w = unit(axis).ok_or(TransformError::ZeroAxis)?;
         let (u, v) = w.any_orthonormal_pair();
         Self::from_affine(DAffine3::from_cols(u, v, w, origin))
     }
@@ -409,6 +409,19 @@ fn round_away(value: f64, offset: f64) -> f64 {
     } else {
         value
     }
+}
+
+/// `v` scaled to unit length, or `None` when it is zero or not finite.
+///
+/// Divides by the largest absolute component first, so that vectors whose
+/// squared length would underflow or overflow (`[1e-200, 0, 0]`,
+/// `[1e200, 0, 0]`) still normalise: only a true zero vector is refused.
+pub fn unit(v: Vec3) -> Option<Vec3> {
+    let largest = v.abs().max_element();
+    if !(largest.is_finite() && largest > 0.0) {
+        return None;
+    }
+    (v / largest).try_normalize()
 }
 
 /// The mirror direction of `incident` about the unit normal `n`.
@@ -541,6 +554,32 @@ mod tests {
             Transform::translate(Vec3::new(f64::NAN, 0.0, 0.0)),
             Err(TransformError::NotFinite)
         );
+    }
+
+    #[test]
+    fn unit_normalises_tiny_and_huge_vectors_and_refuses_only_zero() {
+        for scale in [1e-300, 1e-200, 1e-160, 1.0, 1e160, 1e200, 1e300] {
+            let v = unit(Vec3::new(3.0, -4.0, 0.0) * scale).unwrap();
+            assert!(close(v, Vec3::new(0.6, -0.8, 0.0)), "{scale:e}: {v}");
+        }
+        assert_eq!(
+            unit(Vec3::new(f64::MIN_POSITIVE / 4.0, 0.0, 0.0)),
+            Some(Vec3::X)
+        );
+        assert_eq!(unit(Vec3::new(0.0, -f64::MAX, 0.0)), Some(-Vec3::Y));
+        assert_eq!(unit(Vec3::ZERO), None);
+        assert_eq!(unit(Vec3::new(f64::INFINITY, 0.0, 0.0)), None);
+        assert_eq!(unit(Vec3::new(f64::NAN, 1.0, 0.0)), None);
+    }
+
+    #[test]
+    fn rotations_and_frames_accept_tiny_and_huge_axes() {
+        for axis in [Vec3::new(0.0, 0.0, 1e-200), Vec3::new(0.0, 0.0, 1e200)] {
+            let r = Transform::rotate(axis, 90.0).unwrap();
+            assert!(close(r.vector_to_world(Vec3::X), Vec3::Y));
+            let f = Transform::frame(Vec3::ZERO, Vec3::new(axis.z, 0.0, 0.0)).unwrap();
+            assert!(close(f.vector_to_world(Vec3::Z), Vec3::X));
+        }
     }
 
     #[test]

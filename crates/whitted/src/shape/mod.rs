@@ -155,19 +155,6 @@ pub(crate) fn non_negative(what: &'static str, value: f64) -> Result<f64, ShapeE
     }
 }
 
-/// `v` scaled to unit length, or `None` when it is zero or not finite.
-///
-/// Scales by the largest component first, so vectors whose squared length
-/// would underflow or overflow (a normal of length 1e-200 or 1e200) still
-/// normalise.
-pub(crate) fn unit(v: Vec3) -> Option<Vec3> {
-    let largest = v.abs().max_element();
-    if !(largest.is_finite() && largest > 0.0) {
-        return None;
-    }
-    (v / largest).try_normalize()
-}
-
 /// Checks that every component of `v` is finite.
 pub(crate) fn finite(what: &'static str, v: Vec3) -> Result<Vec3, ShapeError> {
     if v.is_finite() {

@@ -11,8 +11,8 @@
 //! a plane; the bounded flat shapes (parallelogram, polygon) use them too, so
 //! every flat shape is hit and reprojected the same way.
 
-use super::{LocalSurface, ShapeError, ShapeHit, finite, unit};
-use crate::math::{Aabb, DVec2, Ray, Vec3, gamma};
+use super::{LocalSurface, ShapeError, ShapeHit, finite};
+use crate::math::{Aabb, DVec2, Ray, Vec3, gamma, unit};
 
 /// An infinite plane.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -22,8 +22,8 @@
 //! [`super::plane`]).
 
 use super::plane::{onto_plane, plane_hit};
-use super::{LocalSurface, ShapeError, ShapeHit, finite, unit};
-use crate::math::{Aabb, DVec2, Ray, Vec3, gamma};
+use super::{LocalSurface, ShapeError, ShapeHit, finite};
+use crate::math::{Aabb, DVec2, Ray, Vec3, gamma, unit};
 
 /// Vertices count as collinear when twice the polygon's area is below this
 /// fraction of `Σ |wᵢ| |wᵢ₊₁|` (`wᵢ = vᵢ - v0`): the normal would be

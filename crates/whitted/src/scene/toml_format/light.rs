@@ -22,14 +22,30 @@
 //!
 //! Directions are normalised; a zero direction is an error.
 
+use toml_span::Span;
 use toml_span::value::Value;
 
 use super::reader::{Parsed, Reader, all, list};
 use crate::light::{Attenuation, Light};
 use crate::math::Color;
 
-/// The kinds of light, as written in `type`.
-const KINDS: &[&str] = &["point", "directional", "spot"];
+/// The kinds of light, as written in `type`, each with its keys.
+const KINDS: &[(&str, &[&str])] = &[
+    ("point", &["type", "position", "intensity", "attenuation"]),
+    ("directional", &["type", "direction", "intensity"]),
+    (
+        "spot",
+        &[
+            "type",
+            "position",
+            "direction",
+            "intensity",
+            "attenuation",
+            "angle",
+            "falloff",
+        ],
+    ),
+];
 
 /// Reads the `[[lights]]` array, if any.
 pub(super) fn read_lights(r: &mut Reader<'_>, value: Option<&Value<'_>>) -> Parsed<Vec<Light>> {
@@ -42,32 +58,20 @@ pub(super) fn read_lights(r: &mut Reader<'_>, value: Option<&Value<'_>>) -> Pars
 
 fn read_light(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Light> {
     let mut f = r.table(value, "lights", "light")?;
-    let (kind, kind_span) = r.require(&f, "type", Reader::string)?;
-    let keys: &[&str] = match kind {
-        "point" => &["type", "position", "intensity", "attenuation"],
-        "directional" => &["type", "direction", "intensity"],
-        "spot" => &[
-            "type",
-            "position",
-            "direction",
-            "intensity",
-            "attenuation",
-            "angle",
-            "falloff",
-        ],
-        _ => {
-            return Err(r.error(
-                kind_span,
-                format!(
-                    "unknown light type `{kind}`; expected one of: {}",
-                    list(KINDS)
-                ),
-            ));
+    let kind = r
+        .require(&f, "type", Reader::string)
+        .and_then(|(name, span)| find_kind(r, name, span));
+    let intensity = r.or_default(&f, "intensity", Color::ONE, Reader::color);
+    let (kind, keys) = match kind {
+        Ok(kind) => kind,
+        Err(reported) => {
+            let keys_of_kinds: Vec<&[&str]> = KINDS.iter().map(|(_, keys)| *keys).collect();
+            r.check_keys_of_any_kind(&f, &keys_of_kinds, "light types")?;
+            return Err(reported);
         }
     };
     f.rename(format!("{kind} light"));
     let keys = r.check_keys(&f, keys);
-    let intensity = r.or_default(&f, "intensity", Color::ONE, Reader::color);
     let light = match kind {
         "point" => {
             let position = r.require(&f, "position", Reader::vec3);
@@ -103,6 +107,28 @@ fn read_light(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Light> {
     };
     keys?;
     Ok(light)
+}
+
+/// The kind of light called `name`, written at `span`, and its keys.
+fn find_kind(
+    r: &mut Reader<'_>,
+    name: &str,
+    span: Span,
+) -> Parsed<(&'static str, &'static [&'static str])> {
+    KINDS
+        .iter()
+        .find(|(kind, _)| *kind == name)
+        .copied()
+        .ok_or_else(|| {
+            let names: Vec<&str> = KINDS.iter().map(|(kind, _)| *kind).collect();
+            r.error(
+                span,
+                format!(
+                    "unknown light type `{name}`; expected one of: {}",
+                    list(&names)
+                ),
+            )
+        })
 }
 
 /// `[constant, linear, quadratic]`, none negative, not all zero.
@@ -216,8 +242,8 @@ mod tests {
     fn every_light_error_is_reported() {
         assert_eq!(
             errors(&format!(
-                "{CAMERA}[[lights]]\nposition = [0, 0, 0]\n\
-                 [[lights]]\ntype = 'sun'\n\
+                "{CAMERA}[[lights]]\nposition = [0, 0, 0]\ncolour = 3\nfoo = 1\n\
+                 [[lights]]\ntype = 'sun'\nangle = 10\nintensity = -1\nradius = 2\n\
                  [[lights]]\ntype = 'point'\npositon = [0, 0, 0]\nattenuation = [0, 0, 0]\n\
                  [[lights]]\ntype = 'directional'\ndirection = [0, 0, 0]\nangle = 3\n\
                  [[lights]]\ntype = 'spot'\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n\
@@ -225,7 +251,14 @@ mod tests {
             )),
             [
                 "missing required key `type` in light",
+                "unknown key `colour` in light; none of the light types has it; expected one \
+                 of: type, position, intensity, attenuation, direction, angle, falloff",
+                "unknown key `foo` in light; none of the light types has it; expected one \
+                 of: type, position, intensity, attenuation, direction, angle, falloff",
                 "unknown light type `sun`; expected one of: point, directional, spot",
+                "`intensity` must not be negative, got -1",
+                "unknown key `radius` in light; none of the light types has it; expected one \
+                 of: type, position, intensity, attenuation, direction, angle, falloff",
                 "missing required key `position` in point light",
                 "unknown key `positon` in point light; expected one of: type, position, \
                  intensity, attenuation",

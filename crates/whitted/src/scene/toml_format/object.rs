@@ -67,7 +67,16 @@ fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> P
             .ok_or_else(|| r.error(span, unknown_material(name, materials)))
     });
     let transform = r.or_default(&f, "transform", Transform::IDENTITY, read_transform);
-    let (kind, kind_span) = kind?;
+    let (kind, kind_span) = match kind {
+        Ok(kind) => kind,
+        Err(reported) => {
+            let keys_of_kinds: Vec<&[&str]> = std::iter::once(COMMON_KEYS)
+                .chain(shapes::SHAPE_KINDS.iter().map(|kind| kind.keys))
+                .collect();
+            r.check_keys_of_any_kind(&f, &keys_of_kinds, "shapes")?;
+            return Err(reported);
+        }
+    };
     let keys = r.check_keys(&f, &[COMMON_KEYS, kind.keys].concat());
     let placed = shapes::build(kind, r, &f, kind_span);
     keys?;
@@ -253,17 +262,28 @@ mod tests {
     fn every_object_error_is_reported() {
         let kinds: Vec<&str> = SHAPE_KINDS.iter().map(|kind| kind.name).collect();
         let kinds = kinds.join(", ");
+        let keys_of_any_shape = "shape, material, transform, center, radius, point, normal, \
+                                 vertices, origin, edge_u, edge_v, inner_radius, base, top, \
+                                 caps, base_radius, top_radius, min, max";
         assert_eq!(
             errors(&format!(
                 "{CAMERA}[materials.glass]\n\
-                 [[objects]]\nradius = 1\nmaterial = 'glas'\n\
-                 [[objects]]\nshape = 'blob'\nsize = 3\n\
+                 [[objects]]\nradius = 1\nmaterial = 'glas'\ncolour = 3\n\
+                 [[objects]]\nshape = 'blob'\nsize = 3\ntop = [0, 1, 0]\n\
                  [[objects]]\nshape = 'sphere'\nradiuss = 1\ntransform = [{{ scale = 0 }}]\n"
             )),
             [
                 "missing required key `shape` in object",
                 "unknown material `glas`; the materials defined are: glass",
+                &format!(
+                    "unknown key `colour` in object; none of the shapes has it; \
+                     expected one of: {keys_of_any_shape}"
+                ),
                 &format!("unknown shape `blob`; expected one of: {kinds}"),
+                &format!(
+                    "unknown key `size` in object; none of the shapes has it; \
+                     expected one of: {keys_of_any_shape}"
+                ),
                 "missing required key `radius` in object",
                 "unknown key `radiuss` in object; expected one of: shape, material, transform, \
                  center, radius",

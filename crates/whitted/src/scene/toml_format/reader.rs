@@ -11,7 +11,7 @@ use std::path::Path;
 use toml_span::Span;
 use toml_span::value::{Key, Table, Value};
 
-use crate::math::{Color, Vec3};
+use crate::math::{Color, Vec3, unit};
 use crate::scene::{Diagnostic, SceneError};
 
 /// A value was wrong and its error has been recorded. Only [`Reader::error`]
@@ -26,6 +26,11 @@ pub(super) type Parsed<T> = Result<T, Reported>;
 pub(super) fn all<T>(steps: impl IntoIterator<Item = Parsed<T>>) -> Parsed<Vec<T>> {
     let results: Vec<Parsed<T>> = steps.into_iter().collect();
     results.into_iter().collect()
+}
+
+/// Both values, or failure when either step failed (both already ran).
+pub(super) fn both<A, B>(a: Parsed<A>, b: Parsed<B>) -> Parsed<(A, B)> {
+    Ok((a?, b?))
 }
 
 /// The state of a walk: the text (for spans) and the errors found so far.
@@ -186,21 +191,51 @@ impl<'s> Reader<'s> {
 
     /// Records an error for every key of `fields` not in `allowed`.
     pub(super) fn check_keys(&mut self, fields: &Fields<'_, '_>, allowed: &[&str]) -> Parsed<()> {
+        let expected = format!("expected one of: {}", list(allowed));
+        self.check_keys_saying(fields, allowed, &expected)
+    }
+
+    /// Records an error for every key of `fields` not in `allowed`, its
+    /// message ending with `expected` (what the keys could have been).
+    pub(super) fn check_keys_saying(
+        &mut self,
+        fields: &Fields<'_, '_>,
+        allowed: &[&str],
+        expected: &str,
+    ) -> Parsed<()> {
         let mut result = Ok(());
         for key in fields.table.keys() {
             if !allowed.contains(&key.name.as_ref()) {
                 result = Err(self.error(
                     key.span,
-                    format!(
-                        "unknown key `{}` in {}; expected one of: {}",
-                        key.name,
-                        fields.what,
-                        list(allowed)
-                    ),
+                    format!("unknown key `{}` in {}; {expected}", key.name, fields.what),
                 ));
             }
         }
         result
+    }
+
+    /// Records an error for every key of `fields` that none of its possible
+    /// kinds has, when which kind it is could not be read: `keys_of_kinds`
+    /// gives the keys of each kind, `kinds` names them in the message
+    /// ("light types", "shapes").
+    pub(super) fn check_keys_of_any_kind(
+        &mut self,
+        fields: &Fields<'_, '_>,
+        keys_of_kinds: &[&[&str]],
+        kinds: &str,
+    ) -> Parsed<()> {
+        let mut allowed: Vec<&str> = Vec::new();
+        for key in keys_of_kinds.iter().copied().flatten() {
+            if !allowed.contains(key) {
+                allowed.push(key);
+            }
+        }
+        let expected = format!(
+            "none of the {kinds} has it; expected one of: {}",
+            list(&allowed)
+        );
+        self.check_keys_saying(fields, &allowed, &expected)
     }
 
     /// The span of the value of `key`, or of the table when it is absent.
@@ -365,10 +400,11 @@ impl<'s> Reader<'s> {
         all(items.iter().map(|item| self.vec3(item, key)))
     }
 
-    /// A non-zero vector `[x, y, z]`, normalised.
+    /// A non-zero vector `[x, y, z]`, normalised. Only `[0, 0, 0]` is
+    /// refused: however short or long, any other vector has a direction.
     pub(super) fn direction(&mut self, value: &Value<'_>, key: &str) -> Parsed<Vec3> {
         let v = self.vec3(value, key)?;
-        v.try_normalize()
+        unit(v)
             .ok_or_else(|| self.error(value.span, format!("`{key}` must not be the zero vector")))
     }
 
@@ -472,6 +508,9 @@ mod tests {
             ])
         );
         assert_eq!(read("x = [0, 0, 2]", Reader::direction), Ok(Vec3::Z));
+        assert_eq!(read("x = [1e-200, 0, 0]", Reader::direction), Ok(Vec3::X));
+        assert_eq!(read("x = [0, -1e200, 0]", Reader::direction), Ok(-Vec3::Y));
+        assert_eq!(read("x = [0, 0, -5e-324]", Reader::direction), Ok(-Vec3::Z));
         assert_eq!(
             read("x = [0, 0, 0]", Reader::direction),
             Err(vec!["`x` must not be the zero vector".into()])

@@ -22,14 +22,22 @@
 //! A constructor's refusal is reported at the value it names (`radius` ...)
 //! or else at the value most to blame (the `normal` of a plane, the
 //! `vertices` of a triangle, the stray vertex of a polygon off its plane).
+//!
+//! Every value is checked on its own, so one wrong value never hides
+//! another: radii are range-checked as they are read, with the constructors'
+//! own checks and messages, and a disk's placement is built apart from its
+//! shape. A check on several values together (a triangle's vertices, a
+//! disk's hole against its radius, a cone's two radii) runs when all the
+//! values it needs were read; the constructors stay the final authority.
 
 use toml_span::Span;
+use toml_span::value::Value;
 
-use super::reader::{Fields, Parsed, Reader, Reported, list};
+use super::reader::{Fields, Parsed, Reader, Reported, both, list};
 use crate::math::{Transform, Vec3};
 use crate::shape::{
     AxisBox, Cone, Cylinder, Disk, Parallelogram, Plane, Polygon, Shape, ShapeError, Sphere,
-    Triangle,
+    Triangle, non_negative, positive,
 };
 
 /// A shape in its object space and where that space sits before the
@@ -148,9 +156,27 @@ fn refused(r: &mut Reader<'_>, f: &Fields<'_, '_>, fallback: Span, error: ShapeE
     r.error(span, error.to_string())
 }
 
+/// A check a shape's constructor makes on one of its numbers.
+type Check = fn(&'static str, f64) -> Result<f64, ShapeError>;
+
+/// The number `key` of `f`, required and accepted by `check`.
+fn measure(r: &mut Reader<'_>, f: &Fields<'_, '_>, key: &'static str, check: Check) -> Parsed<f64> {
+    r.require(f, key, |r, value, _| checked(r, value, key, check))
+}
+
+/// The number `value` of `key`, accepted by `check`; its refusal is
+/// reported at the value, in the constructor's words.
+fn checked(r: &mut Reader<'_>, value: &Value<'_>, key: &'static str, check: Check) -> Parsed<f64> {
+    let number = r.number(value, key)?;
+    check(key, number).map_err(|error| {
+        let span = r.span_of(value);
+        r.error(span, error.to_string())
+    })
+}
+
 fn sphere(r: &mut Reader<'_>, f: &Fields<'_, '_>, at: Span) -> Parsed<Placed> {
     let center = r.or_default(f, "center", Vec3::ZERO, Reader::vec3);
-    let radius = r.require(f, "radius", Reader::number);
+    let radius = measure(r, f, "radius", positive);
     let sphere = Sphere::new(center?, radius?).map_err(|e| refused(r, f, at, e))?;
     Ok(Placed::in_place(Shape::Sphere(sphere)))
 }
@@ -207,9 +233,11 @@ fn parallelogram(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Plac
 fn disk(r: &mut Reader<'_>, f: &Fields<'_, '_>, at: Span) -> Parsed<Placed> {
     let center = r.require(f, "center", Reader::vec3);
     let normal = r.require(f, "normal", Reader::direction);
-    let radius = r.require(f, "radius", Reader::number);
-    let inner_radius = r.or_default(f, "inner_radius", 0.0, Reader::number);
-    let placement = frame(r, center?, normal?, at);
+    let radius = measure(r, f, "radius", positive);
+    let inner_radius = r.or_default(f, "inner_radius", 0.0, |r, value, _| {
+        checked(r, value, "inner_radius", non_negative)
+    });
+    let placement = both(center, normal).and_then(|(center, normal)| frame(r, center, normal, at));
     let too_wide = r.value_span(f, "inner_radius");
     let disk = Disk::new(radius?, inner_radius?).map_err(|e| refused(r, f, too_wide, e))?;
     Ok(Placed {
@@ -220,7 +248,7 @@ fn disk(r: &mut Reader<'_>, f: &Fields<'_, '_>, at: Span) -> Parsed<Placed> {
 
 fn cylinder(r: &mut Reader<'_>, f: &Fields<'_, '_>, at: Span) -> Parsed<Placed> {
     let axis = axis(r, f);
-    let radius = r.require(f, "radius", Reader::number);
+    let radius = measure(r, f, "radius", positive);
     let caps = r.or_default(f, "caps", true, Reader::boolean);
     let (base, axis) = axis?;
     let placement = frame(r, base, axis, at);
@@ -515,6 +543,36 @@ mod tests {
             .unwrap();
         let starts = [13, 24, 35, 46, 57];
         assert_eq!(d.column, starts[vertex], "{d}");
+    }
+
+    #[test]
+    fn one_bad_value_never_hides_another() {
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[[objects]]\nshape = 'sphere'\ncenter = [0, 1]\nradius = -1\n\
+                 [[objects]]\nshape = 'disk'\ncenter = 'here'\nnormal = [0, 1, 0]\n\
+                 radius = -1\ninner_radius = -0.5\n\
+                 [[objects]]\nshape = 'disk'\ncenter = [0, 0, 0]\nnormal = [0, 0, 0]\n\
+                 radius = 1\ninner_radius = 2\n\
+                 [[objects]]\nshape = 'disk'\ncenter = [0, 0, 0]\nnormal = [0, 1, 0]\n\
+                 radius = 'big'\ninner_radius = -1\n\
+                 [[objects]]\nshape = 'cylinder'\nbase = [0, 1, 0]\ntop = [0, 1, 0]\n\
+                 radius = 0\n"
+            )),
+            [
+                "expected 3 numbers for `center`, found 2",
+                "radius must be a positive number, got -1",
+                "expected an array of 3 numbers for `center`, found a string",
+                "radius must be a positive number, got -1",
+                "inner_radius must not be negative, got -0.5",
+                "`normal` must not be the zero vector",
+                "degenerate disk: the inner radius is not smaller than the radius",
+                "expected a number for `radius`, found a string",
+                "inner_radius must not be negative, got -1",
+                "`top` must differ from `base`: the shape has no height",
+                "radius must be a positive number, got 0",
+            ]
+        );
     }
 
     #[test]
