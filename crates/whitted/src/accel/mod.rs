@@ -22,11 +22,13 @@
 //! structure returns exactly the closest hit the brute-force [`Linear`]
 //! returns (ties at equal `t` may pick either primitive).
 
+pub mod bvh;
 pub mod linear;
 
 #[cfg(test)]
 pub(crate) mod conformance;
 
+pub use bvh::{Bvh, BvhBuildParams};
 pub use linear::Linear;
 
 use crate::math::{Aabb, Ray};
@@ -69,6 +71,8 @@ pub struct AccelStats {
 /// Which structure to build.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum AccelKind {
+    /// Bounding volume hierarchy, built with the binned SAH.
+    Bvh,
     /// Brute force: the reference.
     #[default]
     Linear,
@@ -76,11 +80,12 @@ pub enum AccelKind {
 
 impl AccelKind {
     /// Every kind, in the order `whitted bench` reports them.
-    pub const ALL: [AccelKind; 1] = [AccelKind::Linear];
+    pub const ALL: [AccelKind; 2] = [AccelKind::Bvh, AccelKind::Linear];
 
     /// The name used on the command line and in scene files.
     pub fn name(&self) -> &'static str {
         match self {
+            AccelKind::Bvh => "bvh",
             AccelKind::Linear => "linear",
         }
     }
@@ -94,6 +99,8 @@ impl AccelKind {
 /// A built acceleration structure of any kind.
 #[derive(Clone, Debug)]
 pub enum Accelerator {
+    /// Bounding volume hierarchy.
+    Bvh(Bvh),
     /// Brute force.
     Linear(Linear),
 }
@@ -102,6 +109,7 @@ impl Accelerator {
     /// Builds a structure of `kind` over primitives `0..boxes.len()`.
     pub fn build(kind: AccelKind, boxes: &[Aabb]) -> Self {
         match kind {
+            AccelKind::Bvh => Accelerator::Bvh(Bvh::build(boxes)),
             AccelKind::Linear => Accelerator::Linear(Linear::build(boxes)),
         }
     }
@@ -109,6 +117,7 @@ impl Accelerator {
     /// Which kind it is.
     pub fn kind(&self) -> AccelKind {
         match self {
+            Accelerator::Bvh(_) => AccelKind::Bvh,
             Accelerator::Linear(_) => AccelKind::Linear,
         }
     }
@@ -122,6 +131,7 @@ impl Accelerator {
         hit: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<f64> {
         match self {
+            Accelerator::Bvh(s) => s.intersect(ray, counters, hit),
             Accelerator::Linear(s) => s.intersect(ray, counters, hit),
         }
     }
@@ -135,6 +145,7 @@ impl Accelerator {
         occludes: impl FnMut(u32) -> bool,
     ) -> bool {
         match self {
+            Accelerator::Bvh(s) => s.occluded(ray, counters, occludes),
             Accelerator::Linear(s) => s.occluded(ray, counters, occludes),
         }
     }
@@ -144,6 +155,7 @@ impl Accelerator {
     /// within the traversal stack.
     pub fn validate(&self, boxes: &[Aabb]) -> Result<(), String> {
         match self {
+            Accelerator::Bvh(s) => s.validate(boxes),
             Accelerator::Linear(s) => s.validate(boxes),
         }
     }
@@ -151,6 +163,7 @@ impl Accelerator {
     /// Size and quality.
     pub fn stats(&self) -> AccelStats {
         match self {
+            Accelerator::Bvh(s) => s.stats(),
             Accelerator::Linear(s) => s.stats(),
         }
     }
