@@ -72,9 +72,9 @@ pub struct AccelStats {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum AccelKind {
     /// Bounding volume hierarchy, built with the binned SAH.
+    #[default]
     Bvh,
     /// Brute force: the reference.
-    #[default]
     Linear,
 }
 
