@@ -6,6 +6,13 @@
 //! subtraction and multiplication round monotonically, and a node's box
 //! contains its primitives' boxes, so whenever the brute force would test a
 //! primitive the walk reaches its leaf: culling is conservative.
+//!
+//! Tried and not kept, on camera rays and random rays over a 200k-triangle
+//! mesh (interleaved runs, best of 8): testing both children at once, in
+//! `f64` or in `f32` with glam's SIMD `Vec3A` (and that without the padding
+//! it would need to stay conservative). Both ran at 0.88 to 0.93 times the
+//! speed of this loop: the time goes to memory and to the primitives, not
+//! to the slab arithmetic.
 
 use super::node::BvhNode;
 use super::{Bvh, MAX_DEPTH};
@@ -261,33 +268,34 @@ mod tests {
 
     #[test]
     fn rays_lying_in_box_faces_are_inside_like_brute_force() {
-        // Flat boxes in z = 0; rays in that plane have 0 · ∞ = NaN slabs,
-        // with either sign of zero in their direction.
+        // Flat boxes in z = 0 at coordinates f32 cannot hold exactly; rays
+        // in that plane along their faces have 0 · ∞ = NaN slabs, with
+        // either sign of zero in their direction.
+        let corner = |i: u32| Vec3::new(0.1 * f64::from(i % 8), 0.1 * f64::from(i / 8), 0.0);
+        let size = Vec3::new(0.07, 0.03, 0.0);
         let boxes: Vec<Aabb> = (0..64)
-            .map(|i| {
-                let p = Vec3::new(f64::from(i % 8), f64::from(i / 8), 0.0);
-                Aabb::new(p, p + Vec3::new(0.5, 0.5, 0.0))
-            })
+            .map(|i| Aabb::new(corner(i), corner(i) + size))
             .collect();
         let bvh = Bvh::build(&boxes);
         let linear = Linear::build(&boxes);
-        let zeros = [0.0, -0.0];
-        for (y, dz, dy) in zeros
+        let faces = [0, 9, 26, 63].map(corner);
+        let ys = faces
             .iter()
-            .flat_map(|&dz| zeros.map(|dy| (dz, dy)))
-            .flat_map(|(dz, dy)| [0.0, 0.25, 0.5, 2.5, 7.5].map(|y| (y, dz, dy)))
-        {
-            for dir in [Vec3::new(1.0, dy, dz), Vec3::new(-1.0, dy, dz)] {
-                let origin = Vec3::new(-20.0 * dir.x + 3.0, y, 0.0);
-                let ray = Ray::new(origin, dir);
-                let mut counters = TraversalCounters::default();
-                let expected =
-                    linear.intersect(&ray, &mut counters, |i, t| box_entry(&boxes, &ray, i, t));
-                let actual =
-                    bvh.intersect(&ray, &mut counters, |i, t| box_entry(&boxes, &ray, i, t));
-                assert!(expected.is_some());
-                assert_eq!(actual, expected, "{ray:?}");
-                assert!(bvh.occluded(&ray, &mut counters, |_| true));
+            .flat_map(|c| [c.y, c.y + size.y, c.y + 0.5 * size.y]);
+        for y in ys {
+            for (dy, dz) in [(0.0, 0.0), (-0.0, 0.0), (0.0, -0.0), (-0.0, -0.0)] {
+                for dir in [Vec3::new(1.0, dy, dz), Vec3::new(-1.0, dy, dz)] {
+                    let origin = Vec3::new(0.4 - 2.0 * dir.x, y, 0.0);
+                    let ray = Ray::new(origin, dir);
+                    let mut counters = TraversalCounters::default();
+                    let expected =
+                        linear.intersect(&ray, &mut counters, |i, t| box_entry(&boxes, &ray, i, t));
+                    let actual =
+                        bvh.intersect(&ray, &mut counters, |i, t| box_entry(&boxes, &ray, i, t));
+                    assert!(expected.is_some());
+                    assert_eq!(actual, expected, "{ray:?}");
+                    assert!(bvh.occluded(&ray, &mut counters, |_| true));
+                }
             }
         }
     }
