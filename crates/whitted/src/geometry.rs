@@ -54,9 +54,9 @@ pub struct Geometry<'a> {
 }
 
 impl<'a> Geometry<'a> {
-    /// Prepares the scene's primitives with brute force.
+    /// Prepares the scene's primitives with the default structure.
     pub fn new(scene: &'a Scene) -> Self {
-        Self::with_accel(scene, AccelKind::Linear)
+        Self::with_accel(scene, AccelKind::default())
     }
 
     /// Prepares the scene's primitives with the structure `kind`.

@@ -22,6 +22,7 @@
 //! structure returns exactly the closest hit the brute-force [`Linear`]
 //! returns (ties at equal `t` may pick either primitive).
 
+pub mod bvh;
 pub mod grid;
 pub mod kdtree;
 pub mod linear;
@@ -29,6 +30,7 @@ pub mod linear;
 #[cfg(test)]
 pub(crate) mod conformance;
 
+pub use bvh::{Bvh, BvhBuildParams};
 pub use grid::{Grid, GridBuildParams};
 pub use kdtree::{KdTree, KdTreeBuildParams};
 pub use linear::Linear;
@@ -73,8 +75,10 @@ pub struct AccelStats {
 /// Which structure to build.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum AccelKind {
-    /// Brute force: the reference.
+    /// Bounding volume hierarchy, built with the binned SAH.
     #[default]
+    Bvh,
+    /// Brute force: the reference.
     Linear,
     /// A uniform grid walked by a 3D-DDA.
     Grid,
@@ -84,11 +88,17 @@ pub enum AccelKind {
 
 impl AccelKind {
     /// Every kind, in the order `whitted bench` reports them.
-    pub const ALL: [AccelKind; 3] = [AccelKind::KdTree, AccelKind::Grid, AccelKind::Linear];
+    pub const ALL: [AccelKind; 4] = [
+        AccelKind::Bvh,
+        AccelKind::KdTree,
+        AccelKind::Grid,
+        AccelKind::Linear,
+    ];
 
     /// The name used on the command line and in scene files.
     pub fn name(&self) -> &'static str {
         match self {
+            AccelKind::Bvh => "bvh",
             AccelKind::Linear => "linear",
             AccelKind::Grid => "grid",
             AccelKind::KdTree => "kdtree",
@@ -104,6 +114,8 @@ impl AccelKind {
 /// A built acceleration structure of any kind.
 #[derive(Clone, Debug)]
 pub enum Accelerator {
+    /// Bounding volume hierarchy.
+    Bvh(Bvh),
     /// Brute force.
     Linear(Linear),
     /// A uniform grid.
@@ -116,6 +128,7 @@ impl Accelerator {
     /// Builds a structure of `kind` over primitives `0..boxes.len()`.
     pub fn build(kind: AccelKind, boxes: &[Aabb]) -> Self {
         match kind {
+            AccelKind::Bvh => Accelerator::Bvh(Bvh::build(boxes)),
             AccelKind::Linear => Accelerator::Linear(Linear::build(boxes)),
             AccelKind::Grid => Accelerator::Grid(Grid::build(boxes)),
             AccelKind::KdTree => Accelerator::KdTree(KdTree::build(boxes)),
@@ -125,6 +138,7 @@ impl Accelerator {
     /// Which kind it is.
     pub fn kind(&self) -> AccelKind {
         match self {
+            Accelerator::Bvh(_) => AccelKind::Bvh,
             Accelerator::Linear(_) => AccelKind::Linear,
             Accelerator::Grid(_) => AccelKind::Grid,
             Accelerator::KdTree(_) => AccelKind::KdTree,
@@ -140,6 +154,7 @@ impl Accelerator {
         hit: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<f64> {
         match self {
+            Accelerator::Bvh(s) => s.intersect(ray, counters, hit),
             Accelerator::Linear(s) => s.intersect(ray, counters, hit),
             Accelerator::Grid(s) => s.intersect(ray, counters, hit),
             Accelerator::KdTree(s) => s.intersect(ray, counters, hit),
@@ -155,6 +170,7 @@ impl Accelerator {
         occludes: impl FnMut(u32) -> bool,
     ) -> bool {
         match self {
+            Accelerator::Bvh(s) => s.occluded(ray, counters, occludes),
             Accelerator::Linear(s) => s.occluded(ray, counters, occludes),
             Accelerator::Grid(s) => s.occluded(ray, counters, occludes),
             Accelerator::KdTree(s) => s.occluded(ray, counters, occludes),
@@ -166,6 +182,7 @@ impl Accelerator {
     /// within the traversal stack.
     pub fn validate(&self, boxes: &[Aabb]) -> Result<(), String> {
         match self {
+            Accelerator::Bvh(s) => s.validate(boxes),
             Accelerator::Linear(s) => s.validate(boxes),
             Accelerator::Grid(s) => s.validate(boxes),
             Accelerator::KdTree(s) => s.validate(boxes),
@@ -175,6 +192,7 @@ impl Accelerator {
     /// Size and quality.
     pub fn stats(&self) -> AccelStats {
         match self {
+            Accelerator::Bvh(s) => s.stats(),
             Accelerator::Linear(s) => s.stats(),
             Accelerator::Grid(s) => s.stats(),
             Accelerator::KdTree(s) => s.stats(),

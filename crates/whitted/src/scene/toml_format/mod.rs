@@ -289,7 +289,7 @@ pub(super) mod tests {
                 "`ambient` must not be negative, got -1",
                 "unknown key `size` in [render]; expected one of: width, height, samples, \
                  max_depth, min_weight, background, ambient, accel",
-                "unknown acceleration structure `octree`; expected one of: kdtree, grid, linear",
+                "unknown acceleration structure `octree`; expected one of: bvh, kdtree, grid, linear",
             ]
         );
     }

@@ -1,0 +1,388 @@
+//! The top-down build: binned surface area heuristic (SAH) splits, an object
+//! median where the SAH has nothing to offer, subtrees built in parallel.
+//!
+//! Every subtree over `n` primitives owns, in a scratch node array, its own
+//! slot plus a region of `2n - 2` slots for its descendants (a binary tree
+//! with `n` non-empty leaves never needs more), so the two halves of a split
+//! write to disjoint slices and the result is the same whatever the number
+//! of threads. A final depth-first pass packs the nodes densely, sibling
+//! pairs adjacent.
+
+use super::MAX_DEPTH;
+use super::node::BvhNode;
+use crate::math::{Aabb, Vec3};
+
+/// How a node's primitives are divided between its two children.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SplitMethod {
+    /// The cheapest of the planes between centroid bins on all three axes,
+    /// by the surface area heuristic; a leaf when no split is cheaper.
+    BinnedSah,
+    /// Half the primitives on each side, sorted by centroid along the
+    /// widest axis: fast to build, slower to trace.
+    ObjectMedian,
+}
+
+/// Options of [`super::Bvh::build_with`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BvhBuildParams {
+    /// How nodes are split.
+    pub split: SplitMethod,
+    /// Centroid bins per axis for [`SplitMethod::BinnedSah`], clamped to
+    /// `2..=64`; a node of `n` primitives uses at most `2n`.
+    pub bins: usize,
+    /// Nodes with more primitives are always split (at least 1).
+    pub max_leaf_size: usize,
+    /// Subtrees of at least this many primitives are built in parallel.
+    pub parallel_threshold: usize,
+}
+
+impl Default for BvhBuildParams {
+    /// Binned SAH with 16 bins, leaves of at most 8 primitives.
+    fn default() -> Self {
+        Self {
+            split: SplitMethod::BinnedSah,
+            bins: 16,
+            max_leaf_size: 8,
+            parallel_threshold: 4096,
+        }
+    }
+}
+
+impl BvhBuildParams {
+    /// Object-median splits down to single primitives: the quickest build,
+    /// a baseline for the SAH.
+    pub fn fastest_build() -> Self {
+        Self {
+            split: SplitMethod::ObjectMedian,
+            max_leaf_size: 1,
+            ..Self::default()
+        }
+    }
+
+    /// Binned SAH with 32 bins: a slower build for a slightly better tree.
+    pub fn high_quality() -> Self {
+        Self {
+            bins: 32,
+            ..Self::default()
+        }
+    }
+}
+
+/// The most bins per axis.
+const MAX_BINS: usize = 64;
+
+/// Below this depth splits may be as uneven as the SAH likes; from it on
+/// they are object medians, which halve the count, so no leaf of a tree
+/// over up to 2³² primitives lies deeper than [`MAX_DEPTH`].
+const SAH_DEPTH_LIMIT: usize = MAX_DEPTH - 32;
+
+/// The packed nodes, the reordered primitive indices and the deepest leaf's
+/// depth. No primitives, no nodes.
+pub(super) fn build(boxes: &[Aabb], params: &BvhBuildParams) -> (Vec<BvhNode>, Vec<u32>, usize) {
+    let n = boxes.len();
+    if n == 0 {
+        return (Vec::new(), Vec::new(), 0);
+    }
+    let builder = Builder {
+        boxes,
+        centroids: boxes.iter().map(Aabb::centroid).collect(),
+        params: BvhBuildParams {
+            bins: params.bins.clamp(2, MAX_BINS),
+            max_leaf_size: params.max_leaf_size.max(1),
+            ..*params
+        },
+    };
+    let mut indices: Vec<u32> = (0..n as u32).collect();
+    let mut scratch = vec![BvhNode::default(); 2 * n - 1];
+    let (root, below) = scratch.split_at_mut(1);
+    let task = Subtree {
+        prims: &mut indices,
+        first_prim: 0,
+        depth: 0,
+        node: &mut root[0],
+        below,
+        first_below: 1,
+    };
+    builder.subtree(task, &mut Bins::default());
+    let (nodes, max_depth) = pack(&scratch);
+    (nodes, indices, max_depth)
+}
+
+/// Read-only state shared by every subtree.
+struct Builder<'a> {
+    boxes: &'a [Aabb],
+    centroids: Vec<Vec3>,
+    params: BvhBuildParams,
+}
+
+/// One subtree to build: its primitives and where its nodes go.
+struct Subtree<'s> {
+    /// Its slice of the index array, reordered in place.
+    prims: &'s mut [u32],
+    /// Position of `prims` in the whole index array.
+    first_prim: usize,
+    depth: usize,
+    /// Its root's slot.
+    node: &'s mut BvhNode,
+    /// The `2 * prims.len() - 2` slots reserved for its descendants.
+    below: &'s mut [BvhNode],
+    /// Position of `below` in the scratch node array.
+    first_below: usize,
+}
+
+/// Where a node's primitives are divided.
+enum Split {
+    Leaf,
+    /// `prims[..mid]` go left, the rest right.
+    At(usize),
+}
+
+impl Builder<'_> {
+    fn subtree(&self, task: Subtree<'_>, bins: &mut Bins) {
+        let (bounds, centroid_bounds) = self.bounds(task.prims);
+        let mid = match self.split(task.prims, task.depth, &bounds, &centroid_bounds, bins) {
+            Split::Leaf => {
+                *task.node =
+                    BvhNode::leaf(&bounds, task.first_prim as u32, task.prims.len() as u32);
+                return;
+            }
+            Split::At(mid) => mid,
+        };
+        *task.node = BvhNode::interior(&bounds, task.first_below as u32);
+        let (pair, rest) = task.below.split_at_mut(2);
+        let (left_node, right_node) = pair.split_at_mut(1);
+        let (left_below, right_below) = rest.split_at_mut(2 * mid - 2);
+        let parallel = task.prims.len() >= self.params.parallel_threshold;
+        let (left_prims, right_prims) = task.prims.split_at_mut(mid);
+        let left = Subtree {
+            prims: left_prims,
+            first_prim: task.first_prim,
+            depth: task.depth + 1,
+            node: &mut left_node[0],
+            below: left_below,
+            first_below: task.first_below + 2,
+        };
+        let right = Subtree {
+            prims: right_prims,
+            first_prim: task.first_prim + mid,
+            depth: task.depth + 1,
+            node: &mut right_node[0],
+            first_below: task.first_below + 2 * mid,
+            below: right_below,
+        };
+        if parallel {
+            rayon::join(
+                || self.subtree(left, bins),
+                || self.subtree(right, &mut Bins::default()),
+            );
+        } else {
+            self.subtree(left, bins);
+            self.subtree(right, bins);
+        }
+    }
+
+    /// The box around the primitives and the box around their centroids.
+    fn bounds(&self, prims: &[u32]) -> (Aabb, Aabb) {
+        prims.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), &p| {
+            let p = p as usize;
+            (b.union(&self.boxes[p]), c.union_point(self.centroids[p]))
+        })
+    }
+
+    /// Decides where to split and partitions `prims` accordingly.
+    fn split(
+        &self,
+        prims: &mut [u32],
+        depth: usize,
+        bounds: &Aabb,
+        centroid_bounds: &Aabb,
+        bins: &mut Bins,
+    ) -> Split {
+        let n = prims.len();
+        if n == 1 {
+            return Split::Leaf;
+        }
+        let must_split = n > self.params.max_leaf_size;
+        if self.params.split == SplitMethod::BinnedSah
+            && depth < SAH_DEPTH_LIMIT
+            && let Some(best) = bins.best_plane(self, prims, centroid_bounds)
+        {
+            // Costs times the parent's area: traversal step 1, primitive
+            // test 1.
+            let leaf_cost = n as f64 * bounds.surface_area();
+            if !must_split && best.cost + bounds.surface_area() >= leaf_cost {
+                return Split::Leaf;
+            }
+            return Split::At(self.partition(prims, &best));
+        }
+        if must_split {
+            Split::At(self.median(prims, centroid_bounds))
+        } else {
+            Split::Leaf
+        }
+    }
+
+    /// Moves the primitives left of `plane` to the front; returns how many.
+    fn partition(&self, prims: &mut [u32], plane: &Plane) -> usize {
+        let mut left = 0;
+        let mut right = prims.len();
+        while left < right {
+            let c = self.centroids[prims[left] as usize][plane.axis];
+            if plane.bin_of(c) < plane.first_right_bin {
+                left += 1;
+            } else {
+                right -= 1;
+                prims.swap(left, right);
+            }
+        }
+        left
+    }
+
+    /// Splits at the centroid median of the widest centroid axis; equal
+    /// centroids are ordered by index, so both halves are never empty.
+    fn median(&self, prims: &mut [u32], centroid_bounds: &Aabb) -> usize {
+        let axis = centroid_bounds.extent().max_position();
+        let mid = prims.len() / 2;
+        prims.select_nth_unstable_by(mid, |&a, &b| {
+            let (ca, cb) = (
+                self.centroids[a as usize][axis],
+                self.centroids[b as usize][axis],
+            );
+            ca.total_cmp(&cb).then(a.cmp(&b))
+        });
+        mid
+    }
+}
+
+/// A candidate split: the bins of one axis from `first_right_bin` on go
+/// right.
+struct Plane {
+    axis: usize,
+    low: f64,
+    scale: f64,
+    bins: usize,
+    first_right_bin: usize,
+    /// Σ area × count over both sides (before dividing by the parent's area).
+    cost: f64,
+}
+
+impl Plane {
+    #[inline]
+    fn bin_of(&self, c: f64) -> usize {
+        (((c - self.low) * self.scale) as usize).min(self.bins - 1)
+    }
+}
+
+/// The bins' contents and the sweep's partial sums, reused from node to node
+/// of one thread.
+#[derive(Default)]
+struct Bins {
+    bounds: Vec<Aabb>,
+    counts: Vec<usize>,
+    right_cost: Vec<f64>,
+}
+
+impl Bins {
+    /// The cheapest plane between bins that leaves primitives on both sides,
+    /// if the centroids are spread along any axis.
+    fn best_plane(
+        &mut self,
+        builder: &Builder<'_>,
+        prims: &[u32],
+        centroids: &Aabb,
+    ) -> Option<Plane> {
+        // Small nodes need fewer bins to find their planes: on 100k random
+        // boxes this saves a quarter of the build's instructions and changes
+        // the SAH cost by 5e-6.
+        let bins = builder.params.bins.min(2 * prims.len());
+        let planes = [0, 1, 2].map(|axis| {
+            let low = centroids.min[axis];
+            let extent = centroids.max[axis] - low;
+            let spread = extent > 0.0 && extent.is_finite();
+            Plane {
+                axis,
+                low,
+                // Without spread everything lands in bin 0.
+                scale: if spread { bins as f64 / extent } else { 0.0 },
+                bins,
+                first_right_bin: 0,
+                cost: f64::INFINITY,
+            }
+        });
+        self.fill(builder, prims, &planes);
+        let mut best: Option<Plane> = None;
+        for mut plane in planes {
+            let bounds = &self.bounds[plane.axis * bins..][..bins];
+            let counts = &self.counts[plane.axis * bins..][..bins];
+            // Right to left: the cost of everything from bin i on.
+            self.right_cost.clear();
+            self.right_cost.resize(bins, 0.0);
+            let (mut area_box, mut count) = (Aabb::EMPTY, 0);
+            for i in (1..bins).rev() {
+                area_box = area_box.union(&bounds[i]);
+                count += counts[i];
+                self.right_cost[i] = area_box.surface_area() * count as f64;
+            }
+            // Left to right, pairing with the right side of each plane.
+            let (mut area_box, mut count) = (Aabb::EMPTY, 0);
+            for i in 1..bins {
+                area_box = area_box.union(&bounds[i - 1]);
+                count += counts[i - 1];
+                if count == 0 || count == prims.len() {
+                    continue;
+                }
+                let cost = area_box.surface_area() * count as f64 + self.right_cost[i];
+                if cost < plane.cost {
+                    plane.cost = cost;
+                    plane.first_right_bin = i;
+                }
+            }
+            if plane.first_right_bin > 0 && best.as_ref().is_none_or(|b| plane.cost < b.cost) {
+                best = Some(plane);
+            }
+        }
+        best
+    }
+
+    /// Puts every primitive in its bin along each axis, in one pass (one
+    /// pass per axis made the whole build run 12% more instructions).
+    fn fill(&mut self, builder: &Builder<'_>, prims: &[u32], planes: &[Plane; 3]) {
+        let bins = planes[0].bins;
+        self.bounds.clear();
+        self.bounds.resize(3 * bins, Aabb::EMPTY);
+        self.counts.clear();
+        self.counts.resize(3 * bins, 0);
+        for &p in prims {
+            let p = p as usize;
+            let centroid = builder.centroids[p];
+            for plane in planes {
+                let bin = plane.axis * bins + plane.bin_of(centroid[plane.axis]);
+                self.bounds[bin] = self.bounds[bin].union(&builder.boxes[p]);
+                self.counts[bin] += 1;
+            }
+        }
+    }
+}
+
+/// Packs the scratch tree depth first, each sibling pair allocated when its
+/// parent is reached; returns the nodes and the deepest leaf's depth.
+fn pack(scratch: &[BvhNode]) -> (Vec<BvhNode>, usize) {
+    let mut nodes = vec![scratch[0]];
+    let mut todo = vec![(0, 0, 0)];
+    let mut max_depth = 0;
+    while let Some((packed, old, depth)) = todo.pop() {
+        max_depth = max_depth.max(depth);
+        let node = scratch[old];
+        if node.is_leaf() {
+            continue;
+        }
+        let child = node.first as usize;
+        let at = nodes.len();
+        nodes.extend_from_slice(&scratch[child..child + 2]);
+        nodes[packed].first = at as u32;
+        todo.push((at + 1, child + 1, depth + 1));
+        todo.push((at, child, depth + 1));
+    }
+    (nodes, max_depth)
+}

@@ -1,0 +1,250 @@
+//! A bounding volume hierarchy: a binary tree of boxes over the primitives,
+//! built top-down with the binned surface area heuristic and flattened into
+//! an array of 32-byte nodes whose sibling pairs are adjacent.
+//!
+//! - `node`: the node and the outward rounding of its `f32` box.
+//! - `build`: the binned SAH build, parallel and deterministic.
+//! - `traverse`: the two ray queries; `counters.nodes` counts the nodes the
+//!   walk enters, `counters.primitives` the primitive tests.
+//! - `validate`: the invariants.
+
+mod build;
+mod node;
+mod traverse;
+mod validate;
+
+pub use build::{BvhBuildParams, SplitMethod};
+pub use node::BvhNode;
+
+use super::AccelStats;
+use crate::math::Aabb;
+
+/// The deepest a leaf may lie, and so the size of the traversal stack. The
+/// build guarantees it for up to 2³² primitives.
+const MAX_DEPTH: usize = 64;
+
+/// A bounding volume hierarchy over primitives `0..n`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Bvh {
+    /// Root first; the children of an interior node are adjacent.
+    nodes: Vec<BvhNode>,
+    /// Primitive indices, reordered so that each leaf's are contiguous.
+    indices: Vec<u32>,
+    /// Depth of the deepest leaf (0 when the root is a leaf).
+    max_depth: usize,
+}
+
+impl Bvh {
+    /// A BVH over primitives `0..boxes.len()` with these boxes, built with
+    /// the default [`BvhBuildParams`].
+    pub fn build(boxes: &[Aabb]) -> Self {
+        Self::build_with(boxes, &BvhBuildParams::default())
+    }
+
+    /// A BVH over primitives `0..boxes.len()` (at most 2³¹), built with
+    /// `params`. The result does not depend on the number of threads.
+    pub fn build_with(boxes: &[Aabb], params: &BvhBuildParams) -> Self {
+        let (nodes, indices, max_depth) = build::build(boxes, params);
+        Self {
+            nodes,
+            indices,
+            max_depth,
+        }
+    }
+
+    /// The nodes, root first.
+    pub fn nodes(&self) -> &[BvhNode] {
+        &self.nodes
+    }
+
+    /// The primitive indices the leaves point into.
+    pub fn indices(&self) -> &[u32] {
+        &self.indices
+    }
+
+    /// Size and quality.
+    pub fn stats(&self) -> AccelStats {
+        let root_area = self
+            .nodes
+            .first()
+            .map_or(0.0, |n| n.bounds().surface_area());
+        let weighted_area: f64 = self
+            .nodes
+            .iter()
+            .map(|n| n.bounds().surface_area() * if n.is_leaf() { n.count as f64 } else { 1.0 })
+            .sum();
+        AccelStats {
+            nodes: self.nodes.len(),
+            leaves: self.nodes.iter().filter(|n| n.is_leaf()).count(),
+            references: self.indices.len(),
+            memory_bytes: size_of_val(self.nodes.as_slice()) + size_of_val(self.indices.as_slice()),
+            sah_cost: if root_area > 0.0 && root_area.is_finite() {
+                weighted_area / root_area
+            } else {
+                0.0
+            },
+            max_depth: self.max_depth,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::AccelKind;
+    use crate::accel::conformance::assert_conforms;
+    use crate::math::Vec3;
+    use crate::random::Rng;
+
+    fn random_boxes(seed: u64, n: usize) -> Vec<Aabb> {
+        let mut rng = Rng::new(seed);
+        (0..n)
+            .map(|_| {
+                let c = rng.point_in(Vec3::splat(-100.0), Vec3::splat(100.0));
+                let half = rng.point_in(Vec3::ZERO, Vec3::splat(2.0));
+                Aabb::new(c - half, c + half)
+            })
+            .collect()
+    }
+
+    fn assert_valid(name: &str, boxes: &[Aabb], params: &BvhBuildParams) -> Bvh {
+        let bvh = Bvh::build_with(boxes, params);
+        if let Err(why) = bvh.validate(boxes) {
+            panic!("{name}: {why}");
+        }
+        bvh
+    }
+
+    #[test]
+    fn bvh_conforms_to_brute_force() {
+        assert_conforms(AccelKind::Bvh);
+    }
+
+    #[test]
+    fn builds_are_valid_for_random_inputs_of_many_sizes() {
+        for n in [0, 1, 2, 3, 7, 8, 9, 100, 1000, 20_000] {
+            for params in [BvhBuildParams::default(), BvhBuildParams::fastest_build()] {
+                let bvh = assert_valid(&format!("{n} boxes"), &random_boxes(n as u64, n), &params);
+                assert_eq!(bvh.stats().references, n);
+            }
+        }
+    }
+
+    #[test]
+    fn builds_are_valid_for_degenerate_inputs() {
+        let unit = Aabb::new(Vec3::ZERO, Vec3::ONE);
+        let mut rng = Rng::new(3);
+        let mut point = || {
+            let p = rng.point_in(Vec3::splat(-1.0), Vec3::ONE);
+            Aabb::new(p, p)
+        };
+        let points: Vec<Aabb> = (0..500).map(|_| point()).collect();
+        let flat: Vec<Aabb> = points
+            .iter()
+            .map(|b| Aabb::new(b.min * Vec3::new(1.0, 1.0, 0.0), b.max + Vec3::X))
+            .collect();
+        let cases: Vec<(&str, Vec<Aabb>)> = vec![
+            ("identical boxes", vec![unit; 1000]),
+            (
+                "nested boxes with one centroid",
+                (1..=300).map(|i| unit.expanded(f64::from(i))).collect(),
+            ),
+            (
+                "one point many times",
+                vec![Aabb::new(Vec3::ONE, Vec3::ONE); 300],
+            ),
+            ("scattered points", points),
+            ("flat boxes in one plane", flat),
+            (
+                "empty boxes among others",
+                vec![Aabb::EMPTY, unit, Aabb::EMPTY],
+            ),
+            (
+                "beyond the f32 range",
+                vec![Aabb::new(Vec3::splat(-1e300), Vec3::splat(1e300)), unit],
+            ),
+        ];
+        for (name, boxes) in &cases {
+            assert_valid(name, boxes, &BvhBuildParams::default());
+            assert_valid(name, boxes, &BvhBuildParams::fastest_build());
+        }
+    }
+
+    #[test]
+    fn geometric_spacing_stays_within_the_traversal_stack() {
+        // Every centroid but the last falls in the first bin, so each SAH
+        // split peels off one box: the tree would be as deep as it is long
+        // without the fall-back to medians.
+        let boxes: Vec<Aabb> = (0..200)
+            .map(|i| {
+                let p = Vec3::new(20f64.powi(i), 0.0, 0.0);
+                Aabb::new(p, p + Vec3::ONE)
+            })
+            .collect();
+        let bvh = assert_valid("geometric spacing", &boxes, &BvhBuildParams::default());
+        assert!(bvh.stats().max_depth <= MAX_DEPTH);
+        assert!(
+            bvh.stats().max_depth > 32,
+            "the test should reach the limit"
+        );
+    }
+
+    #[test]
+    fn same_tree_whatever_the_thread_count() {
+        let boxes = random_boxes(11, 20_000);
+        let reference = Bvh::build(&boxes);
+        assert_eq!(Bvh::build(&boxes), reference);
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            assert_eq!(pool.install(|| Bvh::build(&boxes)), reference);
+        }
+        let eager = BvhBuildParams {
+            parallel_threshold: 2,
+            ..BvhBuildParams::default()
+        };
+        let sequential = BvhBuildParams {
+            parallel_threshold: usize::MAX,
+            ..BvhBuildParams::default()
+        };
+        assert_eq!(Bvh::build_with(&boxes, &eager), reference);
+        assert_eq!(Bvh::build_with(&boxes, &sequential), reference);
+    }
+
+    #[test]
+    fn sah_beats_object_median_on_clustered_input() {
+        // Dense clusters of very different sizes with sparse boxes between.
+        let mut rng = Rng::new(17);
+        let mut boxes = Vec::new();
+        for (count, centre) in [(3000, -80.0), (300, 0.0), (30, 60.0)] {
+            for _ in 0..count {
+                let c = Vec3::splat(centre) + rng.point_in(Vec3::splat(-1.0), Vec3::ONE);
+                boxes.push(Aabb::new(c, c + Vec3::splat(0.05)));
+            }
+        }
+        boxes.extend(random_boxes(18, 200));
+        let sah = Bvh::build(&boxes).stats().sah_cost;
+        let median = Bvh::build_with(&boxes, &BvhBuildParams::fastest_build())
+            .stats()
+            .sah_cost;
+        assert!(sah < 0.8 * median, "SAH {sah}, median {median}");
+    }
+
+    #[test]
+    fn stats_of_two_separate_boxes() {
+        let a = Aabb::new(Vec3::ZERO, Vec3::ONE);
+        let b = Aabb::new(Vec3::splat(9.0), Vec3::splat(10.0));
+        let stats = Bvh::build(&[a, b]).stats();
+        let root = a.union(&b).surface_area();
+        assert_eq!(stats.nodes, 3);
+        assert_eq!(stats.leaves, 2);
+        assert_eq!(stats.references, 2);
+        assert_eq!(stats.memory_bytes, 3 * 32 + 2 * 4);
+        assert_eq!(stats.max_depth, 1);
+        let expected = 1.0 + (a.surface_area() + b.surface_area()) / root;
+        assert!((stats.sah_cost - expected).abs() < 1e-12);
+        assert_eq!(Bvh::build(&[]).stats(), AccelStats::default());
+    }
+}
