@@ -97,7 +97,8 @@ fn load(path: &Path, width: u32, height: u32) -> Result<Scene, String> {
     let aspect = f64::from(width) / f64::from(height);
     let camera = Camera::framing(&soup.bounds(), aspect, 50.0)
         .map_err(|e| format!("{}: cannot frame the mesh: {e}", path.display()))?;
-    Ok(soup.to_scene(camera).0)
+    soup.to_scene(camera)
+        .map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// One kind of ray measured through one structure.
@@ -152,16 +153,16 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         }
     };
     let total_rays: usize = sets.iter().map(|s| s.rays.len()).sum();
+    let primitives = scene.primitive_count();
 
     let mut reports = Vec::new();
     for &kind in &kinds {
-        let work = scene.primitives.len() as f64 * total_rays as f64;
+        let work = primitives as f64 * total_rays as f64;
         if kind == AccelKind::Linear && kinds.len() > 1 && work > LINEAR_BUDGET {
             if !args.quiet && !args.json {
                 eprintln!(
-                    "linear skipped: {} primitives x {total_rays} rays is too much brute force; \
-                     use --accel linear to run it anyway",
-                    scene.primitives.len()
+                    "linear skipped: {primitives} primitives x {total_rays} rays is too much \
+                     brute force; use --accel linear to run it anyway"
                 );
             }
             continue;
@@ -212,9 +213,9 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
     status.finish();
 
     if args.json {
-        println!("{}", to_json(args, &scene, all_threads, &reports));
+        println!("{}", to_json(args, primitives, all_threads, &reports));
     } else {
-        print_table(args, &scene, all_threads, &reports);
+        print_table(args, primitives, all_threads, &reports);
     }
     Ok(())
 }
@@ -227,15 +228,14 @@ fn mrays(rays: usize, seconds: f64) -> f64 {
     }
 }
 
-fn print_table(args: &BenchArgs, scene: &Scene, threads: usize, reports: &[AccelReport]) {
+fn print_table(args: &BenchArgs, primitives: usize, threads: usize, reports: &[AccelReport]) {
     let source = match &args.rays {
         Some(dir) => format!("rays from {}", dir.display()),
         None => format!("rays for a {}x{} image", args.width, args.height),
     };
     println!(
-        "{}: {} primitives; {source}; best of {} runs",
+        "{}: {primitives} primitives; {source}; best of {} runs",
         args.scene.display(),
-        scene.primitives.len(),
         args.runs
     );
     for r in reports {
@@ -280,7 +280,7 @@ fn print_table(args: &BenchArgs, scene: &Scene, threads: usize, reports: &[Accel
     }
 }
 
-fn to_json(args: &BenchArgs, scene: &Scene, threads: usize, reports: &[AccelReport]) -> Value {
+fn to_json(args: &BenchArgs, primitives: usize, threads: usize, reports: &[AccelReport]) -> Value {
     let structures: Vec<Value> = reports
         .iter()
         .map(|r| {
@@ -314,7 +314,7 @@ fn to_json(args: &BenchArgs, scene: &Scene, threads: usize, reports: &[AccelRepo
         .collect();
     json!({
         "scene": args.scene.display().to_string(),
-        "primitives": scene.primitives.len(),
+        "primitives": primitives,
         "rays_from": args.rays.as_ref().map(|d| d.display().to_string()),
         "width": args.width,
         "height": args.height,

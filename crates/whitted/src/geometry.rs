@@ -2,17 +2,23 @@
 //! acceleration structure over the bounded ones, a short list of the
 //! unbounded ones, and the two queries every tracer needs — the closest hit
 //! and any hit — plus the full surface description of a final hit.
+//!
+//! Primitives are numbered once for the whole scene: first the shapes of
+//! [`Scene::primitives`] in order, then the triangles of each mesh instance
+//! of [`Scene::mesh_instances`] in order. That number is what [`Hit`]
+//! reports (and the `id` AOV shows).
 
 use crate::accel::{AccelKind, Accelerator, TraversalCounters};
 use crate::material::MaterialId;
 use crate::math::{Aabb, DVec2, Ray, Transform, Vec3};
-use crate::scene::{Primitive, Scene};
-use crate::shape::{LocalSurface, ShapeHit};
+use crate::mesh::TriangleMesh;
+use crate::scene::{MeshInstance, Primitive, Scene, TransformId};
+use crate::shape::{LocalSurface, RayShear, ShapeHit};
 
 /// The closest hit found by [`Geometry::intersect`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
-    /// Index of the primitive in [`Scene::primitives`].
+    /// The primitive's number in the whole scene (see the module doc).
     pub primitive: u32,
     /// What the shape recorded (its `t` is the ray parameter).
     pub shape_hit: ShapeHit,
@@ -34,6 +40,9 @@ pub struct Surface {
     pub point_error: Vec3,
     /// Unit geometric normal, outward (not yet turned towards the ray).
     pub normal: Vec3,
+    /// Unit normal for shading: the geometric one, or the one interpolated
+    /// from a mesh's vertex normals.
+    pub shading_normal: Vec3,
     /// Texture coordinates.
     pub uv: DVec2,
     /// Tangent along u (not normalised).
@@ -42,15 +51,39 @@ pub struct Surface {
     pub material: MaterialId,
 }
 
+/// What a primitive number stands for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum PrimitiveRef {
+    /// Index into [`Scene::primitives`].
+    Shape(u32),
+    /// Triangle `triangle` of mesh instance `instance`.
+    Triangle {
+        /// Index into [`Scene::mesh_instances`].
+        instance: u32,
+        /// The triangle in that instance's mesh.
+        triangle: u32,
+    },
+}
+
 /// The scene's geometry, ready for ray queries.
 #[derive(Debug)]
 pub struct Geometry<'a> {
     primitives: &'a [Primitive],
+    instances: &'a [MeshInstance],
+    meshes: &'a [TriangleMesh],
     transforms: &'a [Transform],
+    refs: Vec<PrimitiveRef>,
     accel: Accelerator,
     bounds: Aabb,
     bounded: Vec<u32>,
     unbounded: Vec<u32>,
+}
+
+/// A world-space ray with what the triangle test needs of it, computed once
+/// per query.
+struct Query<'r> {
+    ray: &'r Ray,
+    shear: RayShear,
 }
 
 impl<'a> Geometry<'a> {
@@ -61,25 +94,41 @@ impl<'a> Geometry<'a> {
 
     /// Prepares the scene's primitives with the structure `kind`.
     pub fn with_accel(scene: &'a Scene, kind: AccelKind) -> Self {
+        let mut refs = Vec::new();
         let mut bounded = Vec::new();
         let mut unbounded = Vec::new();
         let mut boxes = Vec::new();
+        let to_world = |transform: Option<TransformId>, local: Aabb| match transform {
+            Some(id) => scene.transforms[id.0 as usize].bounds_to_world(&local),
+            None => local,
+        };
         for (i, p) in scene.primitives.iter().enumerate() {
             let local = p.shape.bounds();
             if local.is_finite() {
-                let world = match p.transform {
-                    Some(id) => scene.transforms[id.0 as usize].bounds_to_world(&local),
-                    None => local,
-                };
-                boxes.push(world);
-                bounded.push(i as u32);
+                boxes.push(to_world(p.transform, local));
+                bounded.push(refs.len() as u32);
             } else {
-                unbounded.push(i as u32);
+                unbounded.push(refs.len() as u32);
+            }
+            refs.push(PrimitiveRef::Shape(i as u32));
+        }
+        for (instance, m) in scene.mesh_instances.iter().enumerate() {
+            let mesh = &scene.meshes[m.mesh.0 as usize];
+            for triangle in 0..mesh.len() as u32 {
+                boxes.push(to_world(m.transform, mesh.triangle_bounds(triangle)));
+                bounded.push(refs.len() as u32);
+                refs.push(PrimitiveRef::Triangle {
+                    instance: instance as u32,
+                    triangle,
+                });
             }
         }
         Self {
             primitives: &scene.primitives,
+            instances: &scene.mesh_instances,
+            meshes: &scene.meshes,
             transforms: &scene.transforms,
+            refs,
             accel: Accelerator::build(kind, &boxes),
             bounds: boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(b)),
             bounded,
@@ -87,34 +136,67 @@ impl<'a> Geometry<'a> {
         }
     }
 
-    fn transform(&self, p: &Primitive) -> Option<&Transform> {
-        p.transform.map(|id| &self.transforms[id.0 as usize])
+    fn transform(&self, id: Option<TransformId>) -> Option<&Transform> {
+        id.map(|id| &self.transforms[id.0 as usize])
     }
 
-    /// Primitive `index` hit by the world-space `ray`, closer than `t_max`.
+    /// Primitive `index` hit by the query's ray, closer than `t_max`.
     #[inline]
-    fn intersect_primitive(&self, index: u32, ray: &Ray, t_max: f64) -> Option<ShapeHit> {
-        let p = &self.primitives[index as usize];
-        let mut ray = *ray;
+    fn intersect_primitive(&self, index: u32, query: &Query, t_max: f64) -> Option<ShapeHit> {
+        let mut ray = *query.ray;
         ray.t_max = t_max;
-        match self.transform(p) {
-            Some(t) => p.shape.intersect(&t.ray_to_object(&ray)),
-            None => p.shape.intersect(&ray),
+        match self.refs[index as usize] {
+            PrimitiveRef::Shape(i) => {
+                let p = &self.primitives[i as usize];
+                match self.transform(p.transform) {
+                    Some(t) => p.shape.intersect(&t.ray_to_object(&ray)),
+                    None => p.shape.intersect(&ray),
+                }
+            }
+            PrimitiveRef::Triangle { instance, triangle } => {
+                let m = &self.instances[instance as usize];
+                let mesh = &self.meshes[m.mesh.0 as usize];
+                match self.transform(m.transform) {
+                    Some(t) => {
+                        let local = t.ray_to_object(&ray);
+                        mesh.intersect(triangle, &local, &RayShear::new(&local))
+                    }
+                    None => mesh.intersect(triangle, &ray, &query.shear),
+                }
+            }
         }
     }
 
+    /// True when primitive `index` lies in the query's ray interval.
     #[inline]
-    fn occluded_by(&self, index: u32, ray: &Ray) -> bool {
-        let p = &self.primitives[index as usize];
-        match self.transform(p) {
-            Some(t) => p.shape.occluded(&t.ray_to_object(ray)),
-            None => p.shape.occluded(ray),
+    fn occluded_by(&self, index: u32, query: &Query) -> bool {
+        match self.refs[index as usize] {
+            PrimitiveRef::Shape(i) => {
+                let p = &self.primitives[i as usize];
+                match self.transform(p.transform) {
+                    Some(t) => p.shape.occluded(&t.ray_to_object(query.ray)),
+                    None => p.shape.occluded(query.ray),
+                }
+            }
+            PrimitiveRef::Triangle { .. } => self
+                .intersect_primitive(index, query, query.ray.t_max)
+                .is_some(),
         }
     }
 
     /// The box around every bounded primitive.
     pub fn bounds(&self) -> Aabb {
         self.bounds
+    }
+
+    /// How many primitives (shapes and mesh triangles) there are.
+    pub fn len(&self) -> usize {
+        self.refs.len()
+    }
+
+    /// True when there are none.
+    pub fn is_empty(&self) -> bool {
+        self.refs.is_empty()
     }
 
     /// The acceleration structure over the bounded primitives.
@@ -129,10 +211,14 @@ impl<'a> Geometry<'a> {
 
     /// The closest hit, adding the traversal work to `counters`.
     pub fn intersect_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> Option<Hit> {
+        let query = Query {
+            ray,
+            shear: RayShear::new(ray),
+        };
         let mut best: Option<Hit> = None;
         let mut t_max = ray.t_max;
         for &i in &self.unbounded {
-            if let Some(h) = self.intersect_primitive(i, ray, t_max) {
+            if let Some(h) = self.intersect_primitive(i, &query, t_max) {
                 t_max = h.t;
                 best = Some(Hit {
                     primitive: i,
@@ -144,7 +230,7 @@ impl<'a> Geometry<'a> {
         clipped.t_max = t_max;
         self.accel.intersect(&clipped, counters, |slot, t_max| {
             let i = self.bounded[slot as usize];
-            let h = self.intersect_primitive(i, ray, t_max)?;
+            let h = self.intersect_primitive(i, &query, t_max)?;
             best = Some(Hit {
                 primitive: i,
                 shape_hit: h,
@@ -161,30 +247,48 @@ impl<'a> Geometry<'a> {
 
     /// Any hit, adding the traversal work to `counters`.
     pub fn occluded_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> bool {
-        self.unbounded.iter().any(|&i| self.occluded_by(i, ray))
+        let query = Query {
+            ray,
+            shear: RayShear::new(ray),
+        };
+        self.unbounded.iter().any(|&i| self.occluded_by(i, &query))
             || self.accel.occluded(ray, counters, |slot| {
-                self.occluded_by(self.bounded[slot as usize], ray)
+                self.occluded_by(self.bounded[slot as usize], &query)
             })
     }
 
     /// The world-space surface at a hit returned for `ray`.
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> Surface {
-        let p = &self.primitives[hit.primitive as usize];
-        match self.transform(p) {
-            None => {
-                let s = p.shape.surface(ray, &hit.shape_hit);
-                Surface::from_local(s, p.material)
+        let (local, shading_normal, material, transform) = match self.refs[hit.primitive as usize] {
+            PrimitiveRef::Shape(i) => {
+                let p = &self.primitives[i as usize];
+                let transform = self.transform(p.transform);
+                let object_ray = transform.map_or(*ray, |t| t.ray_to_object(ray));
+                let s = p.shape.surface(&object_ray, &hit.shape_hit);
+                (s, s.normal, p.material, transform)
             }
+            PrimitiveRef::Triangle { instance, triangle } => {
+                let m = &self.instances[instance as usize];
+                let transform = self.transform(m.transform);
+                let object_ray = transform.map_or(*ray, |t| t.ray_to_object(ray));
+                let s =
+                    self.meshes[m.mesh.0 as usize].surface(triangle, &object_ray, &hit.shape_hit);
+                (s.local, s.shading_normal, m.material, transform)
+            }
+        };
+        match transform {
+            None => Surface::from_local(local, shading_normal, material),
             Some(t) => {
-                let s = p.shape.surface(&t.ray_to_object(ray), &hit.shape_hit);
-                let (point, point_error) = t.point_with_error_to_world(s.point, s.point_error);
+                let (point, point_error) =
+                    t.point_with_error_to_world(local.point, local.point_error);
                 Surface {
                     point,
                     point_error,
-                    normal: t.normal_to_world(s.normal).normalize(),
-                    uv: s.uv,
-                    dpdu: t.vector_to_world(s.dpdu),
-                    material: p.material,
+                    normal: t.normal_to_world(local.normal).normalize(),
+                    shading_normal: t.normal_to_world(shading_normal).normalize(),
+                    uv: local.uv,
+                    dpdu: t.vector_to_world(local.dpdu),
+                    material,
                 }
             }
         }
@@ -192,11 +296,12 @@ impl<'a> Geometry<'a> {
 }
 
 impl Surface {
-    fn from_local(s: LocalSurface, material: MaterialId) -> Self {
+    fn from_local(s: LocalSurface, shading_normal: Vec3, material: MaterialId) -> Self {
         Self {
             point: s.point,
             point_error: s.point_error,
             normal: s.normal,
+            shading_normal,
             uv: s.uv,
             dpdu: s.dpdu,
             material,

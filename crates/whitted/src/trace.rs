@@ -243,7 +243,13 @@ impl<'a> Tracer<'a> {
         let incident = ray.dir;
         let view = -incident;
         let entering = incident.dot(s.normal) < 0.0;
-        let n = if entering { s.normal } else { -s.normal };
+        let facing = if entering { s.normal } else { -s.normal };
+        // The shading normal (interpolated on meshes) on the viewer's side.
+        let n = if s.shading_normal.dot(facing) < 0.0 {
+            -s.shading_normal
+        } else {
+            s.shading_normal
+        };
 
         let mut color = m.emission.at(s.uv) + m.ambient.at(s.uv) * self.scene.ambient;
 

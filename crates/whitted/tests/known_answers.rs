@@ -366,3 +366,85 @@ fn facing_perfect_mirrors_recurse_to_the_deepest_allowed_depth_without_overflow(
         Err(RenderError::DepthTooLarge(_))
     ));
 }
+
+#[test]
+fn a_mesh_renders_exactly_like_its_triangles_given_one_by_one() {
+    use whitted::mesh::TriangleMesh;
+    use whitted::shape::Triangle;
+    // A small tetrahedron-like cap, moved and turned by a transform.
+    let positions = vec![
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(0.0, 1.2, 0.0),
+        Vec3::new(0.0, 0.0, 1.0),
+    ];
+    let triangles = vec![[0, 1, 3], [1, 2, 3], [2, 0, 3]];
+    let placement = Transform::rotate(Vec3::new(1.0, 0.5, 0.0), 25.0).unwrap();
+    let build = |as_mesh: bool| {
+        let mut scene = scene_looking_down_z(40, 30, 50.0);
+        scene.ambient = Color::splat(0.1);
+        scene.lights.push(Light::Point {
+            position: Vec3::new(2.0, 3.0, 4.0),
+            intensity: Color::ONE,
+            attenuation: Attenuation::NONE,
+        });
+        let m = scene.add_material(Material {
+            specular: Color::splat(0.5).into(),
+            ..Material::default()
+        });
+        if as_mesh {
+            let mesh = TriangleMesh::new(positions.clone(), triangles.clone()).unwrap();
+            let id = scene.add_mesh(mesh);
+            scene.add_mesh_instance(id, m, placement);
+        } else {
+            for t in &triangles {
+                let [a, b, c] = t.map(|i| positions[i as usize]);
+                scene.add_primitive(
+                    Shape::Triangle(Triangle::new(a, b, c).unwrap()),
+                    m,
+                    placement,
+                );
+            }
+        }
+        scene
+    };
+    let mesh = render(&build(true), &RenderOptions::default(), &|_| {}).unwrap();
+    let single = render(&build(false), &RenderOptions::default(), &|_| {}).unwrap();
+    assert_eq!(mesh.image, single.image);
+    assert!(mesh.image.data().iter().any(|&v| v > 0.2));
+}
+
+#[test]
+fn vertex_normals_shade_a_flat_mesh_as_if_it_were_curved() {
+    use whitted::mesh::TriangleMesh;
+    // One big triangle facing +z whose vertex normals all lean towards +x:
+    // lit from +x it must look brighter than its flat twin.
+    let positions = vec![
+        Vec3::new(-5.0, -5.0, 0.0),
+        Vec3::new(5.0, -5.0, 0.0),
+        Vec3::new(0.0, 5.0, 0.0),
+    ];
+    let lean = Vec3::new(1.0, 0.0, 1.0).normalize();
+    let brightness = |normals: Option<Vec<Vec3>>| {
+        let mut scene = scene_looking_down_z(3, 3, 10.0);
+        scene.lights.push(Light::Directional {
+            direction: -lean,
+            intensity: Color::ONE,
+        });
+        let m = scene.add_material(Material {
+            diffuse: Color::ONE.into(),
+            ..black()
+        });
+        let mut mesh = TriangleMesh::new(positions.clone(), vec![[0, 1, 2]]).unwrap();
+        if let Some(n) = normals {
+            mesh = mesh.with_normals(n).unwrap();
+        }
+        let id = scene.add_mesh(mesh);
+        scene.add_mesh_instance(id, m, Transform::IDENTITY);
+        pixel(&rendered(&scene), 1, 1).x
+    };
+    let flat = brightness(None);
+    let curved = brightness(Some(vec![lean; 3]));
+    assert!((flat - lean.z).abs() < 1e-6, "{flat}");
+    assert!((curved - 1.0).abs() < 1e-6, "{curved}");
+}

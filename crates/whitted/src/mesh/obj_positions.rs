@@ -14,8 +14,8 @@ use std::path::Path;
 use crate::camera::Camera;
 use crate::material::Material;
 use crate::math::{Aabb, Transform, Vec3};
+use crate::mesh::{MeshError, TriangleMesh};
 use crate::scene::{Diagnostic, Scene, SceneError};
-use crate::shape::{Shape, Triangle};
 
 /// Positions and triangles as they appear in the file.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -32,22 +32,16 @@ impl TriangleSoup {
         Aabb::from_points(self.positions.iter().copied())
     }
 
-    /// A scene of these triangles, all of one grey material, seen by
-    /// `camera`, with the triangles' indices in the file. Zero-area
-    /// triangles can never be hit and are left out: the returned list maps
-    /// each primitive of the scene to its triangle's index in the file.
-    pub fn to_scene(&self, camera: Camera) -> (Scene, Vec<u32>) {
+    /// A scene of one mesh of these triangles, all of one grey material,
+    /// seen by `camera`. Every triangle keeps its index in the file as its
+    /// primitive number, zero-area ones included (they are never hit).
+    pub fn to_scene(&self, camera: Camera) -> Result<Scene, MeshError> {
         let mut scene = Scene::new(camera);
         let material = scene.add_material(Material::default());
-        let mut file_index = Vec::with_capacity(self.triangles.len());
-        for (i, t) in self.triangles.iter().enumerate() {
-            let [a, b, c] = t.map(|v| self.positions[v as usize]);
-            if let Ok(triangle) = Triangle::new(a, b, c) {
-                scene.add_primitive(Shape::Triangle(triangle), material, Transform::IDENTITY);
-                file_index.push(i as u32);
-            }
-        }
-        (scene, file_index)
+        let mesh = TriangleMesh::new(self.positions.clone(), self.triangles.clone())?;
+        let mesh = scene.add_mesh(mesh);
+        scene.add_mesh_instance(mesh, material, Transform::IDENTITY);
+        Ok(scene)
     }
 }
 
@@ -221,12 +215,14 @@ mod tests {
     }
 
     #[test]
-    fn zero_area_triangles_are_left_out_of_the_scene_but_indices_kept() {
+    fn the_scene_numbers_triangles_as_the_file_does_zero_area_ones_included() {
         let soup = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 4\nf 1 2 3\n").unwrap();
         let camera = Camera::framing(&soup.bounds(), 1.0, 50.0).unwrap();
-        let (scene, file_index) = soup.to_scene(camera);
-        assert_eq!(scene.primitives.len(), 1);
-        assert_eq!(file_index, vec![1]);
+        let scene = soup.to_scene(camera).unwrap();
+        let geometry = crate::geometry::Geometry::new(&scene);
+        assert_eq!(geometry.len(), 2);
+        let ray = crate::math::Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z);
+        assert_eq!(geometry.intersect(&ray).unwrap().primitive, 1);
     }
 
     #[test]

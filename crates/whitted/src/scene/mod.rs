@@ -14,6 +14,7 @@ use crate::camera::Camera;
 use crate::light::Light;
 use crate::material::{Material, MaterialId};
 use crate::math::{Color, Transform};
+use crate::mesh::{MeshId, TriangleMesh};
 use crate::shape::Shape;
 
 /// Index of a transform in [`Scene::transforms`].
@@ -28,6 +29,17 @@ pub struct Primitive {
     /// What its surface is made of.
     pub material: MaterialId,
     /// Where object space sits in the world; `None` means they coincide.
+    pub transform: Option<TransformId>,
+}
+
+/// A triangle mesh placed in the world with a material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshInstance {
+    /// The mesh, in [`Scene::meshes`].
+    pub mesh: MeshId,
+    /// What its surface is made of.
+    pub material: MaterialId,
+    /// Where the mesh's space sits in the world; `None` means they coincide.
     pub transform: Option<TransformId>,
 }
 
@@ -81,6 +93,10 @@ pub struct Scene {
     pub transforms: Vec<Transform>,
     /// The objects.
     pub primitives: Vec<Primitive>,
+    /// Triangle meshes, indexed by [`MeshId`].
+    pub meshes: Vec<TriangleMesh>,
+    /// Meshes placed in the world.
+    pub mesh_instances: Vec<MeshInstance>,
 }
 
 /// The text of the built-in scene, `scenes/whitted.toml`: a homage to
@@ -113,6 +129,8 @@ impl Scene {
             lights: Vec::new(),
             transforms: Vec::new(),
             primitives: Vec::new(),
+            meshes: Vec::new(),
+            mesh_instances: Vec::new(),
         }
     }
 
@@ -122,13 +140,45 @@ impl Scene {
         MaterialId((self.materials.len() - 1) as u32)
     }
 
+    /// How many primitives the scene has: its shapes and the triangles of
+    /// every mesh instance.
+    pub fn primitive_count(&self) -> usize {
+        self.primitives.len()
+            + self
+                .mesh_instances
+                .iter()
+                .map(|m| self.meshes[m.mesh.0 as usize].len())
+                .sum::<usize>()
+    }
+
+    /// Stores a transform, or nothing for the identity.
+    fn add_transform(&mut self, transform: Transform) -> Option<TransformId> {
+        (!transform.is_identity()).then(|| {
+            self.transforms.push(transform);
+            TransformId((self.transforms.len() - 1) as u32)
+        })
+    }
+
+    /// Adds a mesh and returns its id (place it with [`Scene::add_mesh_instance`]).
+    pub fn add_mesh(&mut self, mesh: TriangleMesh) -> MeshId {
+        self.meshes.push(mesh);
+        MeshId((self.meshes.len() - 1) as u32)
+    }
+
+    /// Places a mesh in the world with a material and a transform.
+    pub fn add_mesh_instance(&mut self, mesh: MeshId, material: MaterialId, transform: Transform) {
+        let transform = self.add_transform(transform);
+        self.mesh_instances.push(MeshInstance {
+            mesh,
+            material,
+            transform,
+        });
+    }
+
     /// Adds a shape with a material and an object-to-world transform (the
     /// identity is stored as no transform at all).
     pub fn add_primitive(&mut self, shape: Shape, material: MaterialId, transform: Transform) {
-        let transform = (!transform.is_identity()).then(|| {
-            self.transforms.push(transform);
-            TransformId((self.transforms.len() - 1) as u32)
-        });
+        let transform = self.add_transform(transform);
         self.primitives.push(Primitive {
             shape,
             material,

@@ -38,7 +38,7 @@ pub use parallelogram::Parallelogram;
 pub use plane::Plane;
 pub use polygon::Polygon;
 pub use sphere::Sphere;
-pub use triangle::Triangle;
+pub use triangle::{RayShear, Triangle, watertight};
 
 use crate::math::{Aabb, DVec2, Ray, Vec3};
 

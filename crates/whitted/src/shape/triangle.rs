@@ -59,71 +59,7 @@ impl Triangle {
     /// The closest hit in the ray's interval, with the barycentric
     /// coordinates `b1, b2` in `u, v`.
     pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        // Move to a space where the ray starts at the origin and runs along
-        // +z (a permutation, then a shear), so the test is 2D.
-        let kz = ray.dir.abs().max_position();
-        let kx = (kz + 1) % 3;
-        let ky = (kx + 1) % 3;
-        let permute = |v: Vec3| Vec3::new(v[kx], v[ky], v[kz]);
-        let d = permute(ray.dir);
-        let shear = Vec3::new(-d.x / d.z, -d.y / d.z, 1.0 / d.z);
-        let to_ray_space = |p: Vec3| {
-            let p = permute(p - ray.origin);
-            Vec3::new(p.x + shear.x * p.z, p.y + shear.y * p.z, p.z)
-        };
-        let (mut a, mut b, mut c) = (
-            to_ray_space(self.p0),
-            to_ray_space(self.p1),
-            to_ray_space(self.p2),
-        );
-
-        // Edge functions: twice the signed areas opposite each vertex. An
-        // edge shared with a neighbour gives the same value, negated, there.
-        let e0 = b.x * c.y - b.y * c.x;
-        let e1 = c.x * a.y - c.y * a.x;
-        let e2 = a.x * b.y - a.y * b.x;
-        let negative = e0 < 0.0 || e1 < 0.0 || e2 < 0.0;
-        let positive = e0 > 0.0 || e1 > 0.0 || e2 > 0.0;
-        if negative && positive {
-            return None;
-        }
-        let det = e0 + e1 + e2;
-        if det == 0.0 {
-            return None;
-        }
-        a.z *= shear.z;
-        b.z *= shear.z;
-        c.z *= shear.z;
-        let t = (e0 * a.z + e1 * b.z + e2 * c.z) / det;
-        if !ray.contains(t) {
-            return None;
-        }
-
-        // Error bounds of pbrt-v4 (section 6.8.4): reject a `t` that is not
-        // conservatively positive, and edge functions that are all rounding
-        // noise (a ray lying in the triangle's plane).
-        let max_x = Vec3::new(a.x, b.x, c.x).abs().max_element();
-        let max_y = Vec3::new(a.y, b.y, c.y).abs().max_element();
-        let max_z = Vec3::new(a.z, b.z, c.z).abs().max_element();
-        let delta_x = gamma(5) * (max_x + max_z);
-        let delta_y = gamma(5) * (max_y + max_z);
-        let delta_z = gamma(3) * max_z;
-        let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
-        if det.abs() <= 3.0 * delta_e {
-            return None;
-        }
-        let max_e = Vec3::new(e0, e1, e2).abs().max_element();
-        let delta_t =
-            3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) / det.abs();
-        if t <= delta_t {
-            return None;
-        }
-        Some(ShapeHit {
-            t,
-            u: e1 / det,
-            v: e2 / det,
-            part: 0,
-        })
+        watertight(self.p0, self.p1, self.p2, ray, &RayShear::new(ray))
     }
 
     /// True when the ray meets the triangle in its interval.
@@ -154,6 +90,100 @@ impl Triangle {
     pub fn bounds(&self) -> Aabb {
         Aabb::from_points([self.p0, self.p1, self.p2])
     }
+}
+
+/// What the watertight test needs of a ray, computed once per ray: the axis
+/// permutation that makes the largest direction component z, and the shear
+/// that turns the ray into the +z axis from the origin.
+#[derive(Clone, Copy, Debug)]
+pub struct RayShear {
+    axes: [usize; 3],
+    shear: Vec3,
+}
+
+impl RayShear {
+    /// The shear for `ray`.
+    pub fn new(ray: &Ray) -> Self {
+        let kz = ray.dir.abs().max_position();
+        let kx = (kz + 1) % 3;
+        let ky = (kx + 1) % 3;
+        let d = Vec3::new(ray.dir[kx], ray.dir[ky], ray.dir[kz]);
+        Self {
+            axes: [kx, ky, kz],
+            shear: Vec3::new(-d.x / d.z, -d.y / d.z, 1.0 / d.z),
+        }
+    }
+
+    /// A point in the ray's sheared space (z not yet scaled).
+    #[inline]
+    fn apply(&self, p: Vec3, origin: Vec3) -> Vec3 {
+        let q = p - origin;
+        let [kx, ky, kz] = self.axes;
+        let z = q[kz];
+        Vec3::new(q[kx] + self.shear.x * z, q[ky] + self.shear.y * z, z)
+    }
+}
+
+/// The watertight ray/triangle test of Woop, Benthin and Wald with pbrt-v4's
+/// conservative bound on `t`, for the triangle `p0, p1, p2` and a ray with
+/// its precomputed shear: the closest hit in the ray's interval with the
+/// barycentric coordinates `b1, b2` in `u, v`. A zero-area triangle is
+/// never hit.
+#[inline]
+pub fn watertight(p0: Vec3, p1: Vec3, p2: Vec3, ray: &Ray, shear: &RayShear) -> Option<ShapeHit> {
+    let (mut a, mut b, mut c) = (
+        shear.apply(p0, ray.origin),
+        shear.apply(p1, ray.origin),
+        shear.apply(p2, ray.origin),
+    );
+    let shear = shear.shear;
+
+    // Edge functions: twice the signed areas opposite each vertex. An
+    // edge shared with a neighbour gives the same value, negated, there.
+    let e0 = b.x * c.y - b.y * c.x;
+    let e1 = c.x * a.y - c.y * a.x;
+    let e2 = a.x * b.y - a.y * b.x;
+    let negative = e0 < 0.0 || e1 < 0.0 || e2 < 0.0;
+    let positive = e0 > 0.0 || e1 > 0.0 || e2 > 0.0;
+    if negative && positive {
+        return None;
+    }
+    let det = e0 + e1 + e2;
+    if det == 0.0 {
+        return None;
+    }
+    a.z *= shear.z;
+    b.z *= shear.z;
+    c.z *= shear.z;
+    let t = (e0 * a.z + e1 * b.z + e2 * c.z) / det;
+    if !ray.contains(t) {
+        return None;
+    }
+
+    // Error bounds of pbrt-v4 (section 6.8.4): reject a `t` that is not
+    // conservatively positive, and edge functions that are all rounding
+    // noise (a ray lying in the triangle's plane).
+    let max_x = Vec3::new(a.x, b.x, c.x).abs().max_element();
+    let max_y = Vec3::new(a.y, b.y, c.y).abs().max_element();
+    let max_z = Vec3::new(a.z, b.z, c.z).abs().max_element();
+    let delta_x = gamma(5) * (max_x + max_z);
+    let delta_y = gamma(5) * (max_y + max_z);
+    let delta_z = gamma(3) * max_z;
+    let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+    if det.abs() <= 3.0 * delta_e {
+        return None;
+    }
+    let max_e = Vec3::new(e0, e1, e2).abs().max_element();
+    let delta_t = 3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) / det.abs();
+    if t <= delta_t {
+        return None;
+    }
+    Some(ShapeHit {
+        t,
+        u: e1 / det,
+        v: e2 / det,
+        part: 0,
+    })
 }
 
 #[cfg(test)]
