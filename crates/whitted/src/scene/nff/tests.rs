@@ -177,3 +177,32 @@ fn a_missing_file_is_an_io_error_naming_it() {
     assert!(matches!(error, SceneError::Io { .. }));
     assert!(error.to_string().contains("/nonexistent/scene.nff"));
 }
+
+#[test]
+fn truncated_and_mangled_files_give_errors_never_panics() {
+    let source = include_str!("../../../tests/nff/spd_like.nff");
+    for end in (0..=source.len()).filter(|&end| source.is_char_boundary(end)) {
+        let _ = parse_nff(&source[..end], Path::new("t.nff"));
+    }
+    // Seeded replacements of single tokens by troublesome words.
+    let words = [
+        "-1",
+        "0",
+        "nan",
+        "1e999",
+        "x",
+        "p",
+        "pp",
+        "#",
+        "99999999999",
+        "é",
+    ];
+    let tokens: Vec<&str> = source.split_ascii_whitespace().collect();
+    let mut rng = crate::random::Rng::new(7);
+    for _ in 0..2000 {
+        let mut mangled = tokens.clone();
+        let at = rng.below(mangled.len() as u32) as usize;
+        mangled[at] = words[rng.below(words.len() as u32) as usize];
+        let _ = parse_nff(&mangled.join(" "), Path::new("t.nff"));
+    }
+}
