@@ -15,7 +15,7 @@ use whitted::bench::{RayKind, RaySet, TraceResults, scene_ray_sets, time_set, tr
 use whitted::camera::Camera;
 use whitted::geometry::Geometry;
 use whitted::mesh::load_obj_positions;
-use whitted::scene::{Scene, load_scene};
+use whitted::scene::{Scene, load_any};
 
 use crate::progress::Status;
 
@@ -37,7 +37,8 @@ const LINEAR_BUDGET: f64 = 2e9;
   whitted bench bunny.obj --rays /tmp/anchor_rays/bunny --json
 The ray files come from the Embree harness in shared/peers/embree (bench --dump DIR).")]
 pub struct BenchArgs {
-    /// A scene file (.toml) or a triangle mesh (.obj: positions and faces).
+    /// A scene file (.toml or .nff) or a triangle mesh (.obj: positions and
+    /// faces).
     scene: PathBuf,
 
     /// Which structure: bvh, kdtree, grid, linear, or all.
@@ -91,7 +92,7 @@ fn load(path: &Path, width: u32, height: u32) -> Result<Scene, String> {
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
     if !is_obj {
-        return load_scene(path).map_err(|e| e.to_string());
+        return load_any(path).map_err(|e| e.to_string());
     }
     let soup = load_obj_positions(path).map_err(|e| e.to_string())?;
     let aspect = f64::from(width) / f64::from(height);

@@ -8,7 +8,7 @@ use whitted::accel::AccelKind;
 use whitted::heat_map::heat_map;
 use whitted::image::{ImageFormat, check_destination};
 use whitted::render::{Aov, RenderOptions, render};
-use whitted::scene::{Scene, load_scene};
+use whitted::scene::{Scene, load_any};
 
 use crate::progress::ProgressReport;
 
@@ -16,14 +16,16 @@ use crate::progress::ProgressReport;
 ///
 /// The output format follows the file name: .png (8-bit sRGB), .exr or
 /// .pfm (linear 32-bit float). Command-line settings override the scene
-/// file's [render] table.
+/// file's [render] table (or an NFF file's resolution).
 #[derive(Debug, Args)]
 #[command(after_long_help = "Examples:
   whitted render                                  the built-in scene, to whitted.png
   whitted render scenes/shapes.toml -o shapes.png --width 800 --height 600 --spp 4
+  whitted render balls.nff -o balls.png           an SPD scene in NFF
   whitted render scenes/whitted.toml -o out.exr --aov depth=depth.pfm --aov normal=normal.exr")]
 pub struct RenderArgs {
-    /// Scene file (.toml). Without one, the built-in scene is rendered.
+    /// Scene file: .toml (ours) or .nff (Neutral File Format). Without one,
+    /// the built-in scene is rendered.
     scene: Option<PathBuf>,
 
     /// Output image: .png, .exr or .pfm.
@@ -130,7 +132,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     check_destinations(&args.output, &aov_outputs)?;
 
     let mut scene = match &args.scene {
-        Some(path) => load_scene(path).map_err(|e| e.to_string())?,
+        Some(path) => load_any(path).map_err(|e| e.to_string())?,
         None => Scene::default_scene(),
     };
     let settings = &mut scene.settings;

@@ -85,6 +85,44 @@ fn a_bad_scene_file_reports_every_error_with_its_location() {
 }
 
 #[test]
+fn an_nff_scene_renders_at_its_own_resolution_unless_overridden() {
+    let dir = tempfile::tempdir().unwrap();
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("../whitted/tests/nff/spd_like.nff");
+    let fixture = fixture.to_str().unwrap();
+    let out = whitted(&["render", fixture, "-o", "a.png"], dir.path());
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("64x48"), "{}", stderr(&out));
+    let out = whitted(
+        &[
+            "render", fixture, "-o", "b.png", "--width", "16", "--height", "16",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("16x16"), "{}", stderr(&out));
+    let out = whitted(
+        &[
+            "bench", fixture, "--accel", "linear", "--width", "8", "--height", "8", "--json",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+#[test]
+fn a_scene_of_an_unknown_format_is_refused_naming_the_formats() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("scene.rib"), "").unwrap();
+    let out = whitted(&["render", "scene.rib"], dir.path());
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("expected a file ending in .toml or .nff"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
 fn unknown_output_formats_and_aovs_are_refused_before_rendering() {
     let dir = tempfile::tempdir().unwrap();
     let out = whitted(&["render", "-o", "x.bmp"], dir.path());

@@ -27,6 +27,16 @@ pub enum SceneError {
         /// What the operating system said.
         source: std::io::Error,
     },
+    /// The file's name says no format we read.
+    #[error(
+        "cannot read `{}`: unknown scene format; expected a file ending in {}",
+        path.display(),
+        extensions()
+    )]
+    UnknownFormat {
+        /// The file.
+        path: PathBuf,
+    },
     /// The file was read but what it says is wrong: every problem found, in
     /// the order they appear in the file.
     #[error("{}", summary(diagnostics))]
@@ -34,6 +44,19 @@ pub enum SceneError {
         /// One entry per problem.
         diagnostics: Vec<Diagnostic>,
     },
+}
+
+/// The extensions of the scene formats, as `.toml or .nff`.
+fn extensions() -> String {
+    let names: Vec<String> = super::SCENE_EXTENSIONS
+        .iter()
+        .map(|e| format!(".{e}"))
+        .collect();
+    match names.split_last() {
+        Some((last, [])) => last.clone(),
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+        None => String::new(),
+    }
 }
 
 /// Every diagnostic, a blank line between them, then the count.

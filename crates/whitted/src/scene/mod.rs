@@ -1,13 +1,18 @@
 //! The scene: what to render, independent of the file format it came from.
 //!
-//! Every reader (our TOML format today, NFF and OBJ later) produces the same
-//! [`Scene`]; the renderer only ever sees this.
+//! Every reader (our TOML format, NFF, and OBJ later) produces the same
+//! [`Scene`]; the renderer only ever sees this. [`load_any`] picks the
+//! reader by the file's extension.
 
 mod diagnostic;
+mod nff;
 mod toml_format;
 
 pub use diagnostic::{Diagnostic, SceneError};
+pub use nff::{load_nff, parse_nff};
 pub use toml_format::{load_scene, parse_scene};
+
+use std::path::Path;
 
 use crate::accel::AccelKind;
 use crate::camera::Camera;
@@ -16,6 +21,25 @@ use crate::material::{Material, MaterialId};
 use crate::math::{Color, Transform};
 use crate::mesh::{MeshId, TriangleMesh};
 use crate::shape::Shape;
+
+/// The scene formats [`load_any`] reads, by file extension (compared
+/// without regard to case).
+pub const SCENE_EXTENSIONS: &[&str] = &["toml", "nff"];
+
+/// Reads a scene file in the format its extension names: `.toml` (ours) or
+/// `.nff` (Eric Haines' Neutral File Format).
+pub fn load_any(path: &Path) -> Result<Scene, SceneError> {
+    let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if extension.eq_ignore_ascii_case("nff") {
+        load_nff(path)
+    } else if extension.eq_ignore_ascii_case("toml") {
+        load_scene(path)
+    } else {
+        Err(SceneError::UnknownFormat {
+            path: path.to_path_buf(),
+        })
+    }
+}
 
 /// Index of a transform in [`Scene::transforms`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -190,6 +214,28 @@ impl Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn load_any_reads_by_extension_and_refuses_others() {
+        let folder = tempfile::tempdir().unwrap();
+        let nff = folder.path().join("scene.NFF");
+        std::fs::write(
+            &nff,
+            "v from 0 0 5 at 0 0 0 up 0 1 0 angle 30 hither 1 resolution 4 2",
+        )
+        .unwrap();
+        assert_eq!(load_any(&nff).unwrap().settings.width, 4);
+        let toml = folder.path().join("scene.toml");
+        std::fs::write(&toml, DEFAULT_SCENE).unwrap();
+        assert_eq!(load_any(&toml).unwrap(), Scene::default_scene());
+        let error = load_any(Path::new("mesh.obj")).unwrap_err();
+        assert!(matches!(error, SceneError::UnknownFormat { .. }));
+        assert_eq!(
+            error.to_string(),
+            "cannot read `mesh.obj`: unknown scene format; expected a file ending in .toml or .nff"
+        );
+        assert!(load_any(Path::new("no_extension")).is_err());
+    }
 
     #[test]
     fn default_scene_parses() {

@@ -437,7 +437,7 @@ mod tests {
             SceneError::Invalid { diagnostics } => {
                 diagnostics.into_iter().map(|d| d.message).collect()
             }
-            SceneError::Io { .. } => unreachable!(),
+            other => panic!("{other}"),
         })
     }
 

@@ -1,0 +1,89 @@
+//! NFF files that must be read: the SPD reference scenes (when the shared
+//! folder is there) and a small SPD-like fixture kept in the repository.
+
+use std::path::{Path, PathBuf};
+
+use whitted::light::Light;
+use whitted::math::{Color, Vec3};
+use whitted::scene::{load_any, load_nff};
+
+/// The SPD scenes, outside the repository: `shared/scenes/spd` beside it.
+fn spd_folder() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes/spd")
+}
+
+#[test]
+fn every_spd_scene_parses() {
+    let folder = spd_folder();
+    let Ok(entries) = std::fs::read_dir(&folder) else {
+        println!("skipped: no SPD scenes at {}", folder.display());
+        return;
+    };
+    let mut files: Vec<PathBuf> = entries
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|path| path.extension().is_some_and(|e| e == "nff"))
+        .collect();
+    files.sort();
+    assert!(!files.is_empty(), "no .nff files in {}", folder.display());
+    let mut failures = Vec::new();
+    for file in &files {
+        match load_nff(file) {
+            Ok(scene) => assert!(
+                !scene.primitives.is_empty() && !scene.lights.is_empty(),
+                "{} is empty",
+                file.display()
+            ),
+            Err(error) => failures.push(error.to_string()),
+        }
+    }
+    assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
+}
+
+#[test]
+fn the_spd_primitive_counts_are_kept() {
+    // Totals from the SPD's own statistics, as listed in its README.
+    for (name, total) in [
+        ("balls", 7382),
+        ("gears", 9345),
+        ("teapot", 9264),
+        ("tree", 8191),
+    ] {
+        let file = spd_folder().join(format!("{name}.nff"));
+        if !file.exists() {
+            println!("skipped: no {}", file.display());
+            continue;
+        }
+        let scene = load_nff(&file).unwrap();
+        assert_eq!(scene.primitives.len(), total, "{name}");
+    }
+}
+
+#[test]
+fn the_spd_like_fixture_reads_every_entity() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/nff/spd_like.nff");
+    let scene = load_any(&file).unwrap();
+    assert_eq!((scene.settings.width, scene.settings.height), (64, 48));
+    assert_eq!(scene.background, Color::new(0.078, 0.361, 0.753));
+    assert_eq!(scene.camera.eye(), Vec3::new(0.0, -6.0, 2.5));
+    let kinds: Vec<&str> = scene.primitives.iter().map(|p| p.shape.kind()).collect();
+    assert_eq!(
+        kinds,
+        [
+            "polygon", "sphere", "cone", "cylinder", "sphere", "polygon", "triangle"
+        ]
+    );
+    // Four distinct `f` entities, in order of appearance.
+    let materials: Vec<u32> = scene.primitives.iter().map(|p| p.material.0).collect();
+    assert_eq!(materials, [0, 1, 1, 1, 2, 3, 3]);
+    assert!(scene.materials[2].is_transmissive());
+    let intensities: Vec<Color> = scene
+        .lights
+        .iter()
+        .filter_map(|light| match light {
+            Light::Point { intensity, .. } => Some(*intensity),
+            _ => None,
+        })
+        .collect();
+    let default = Color::splat(1.0 / 2f64.sqrt());
+    assert_eq!(intensities, [default, Color::new(0.3, 0.3, 0.25)]);
+}
