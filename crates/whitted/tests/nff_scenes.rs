@@ -29,7 +29,7 @@ fn every_spd_scene_parses() {
     for file in &files {
         match load_nff(file) {
             Ok(scene) => assert!(
-                !scene.primitives.is_empty() && !scene.lights.is_empty(),
+                scene.primitive_count() > 0 && !scene.lights.is_empty(),
                 "{} is empty",
                 file.display()
             ),
@@ -54,7 +54,7 @@ fn the_spd_primitive_counts_are_kept() {
             continue;
         }
         let scene = load_nff(&file).unwrap();
-        assert_eq!(scene.primitives.len(), total, "{name}");
+        assert_eq!(scene.primitive_count(), total, "{name}");
     }
 }
 
@@ -68,13 +68,15 @@ fn the_spd_like_fixture_reads_every_entity() {
     let kinds: Vec<&str> = scene.primitives.iter().map(|p| p.shape.kind()).collect();
     assert_eq!(
         kinds,
-        [
-            "polygon", "sphere", "cone", "cylinder", "sphere", "polygon", "triangle"
-        ]
+        ["polygon", "sphere", "cone", "cylinder", "sphere", "polygon"]
     );
+    // The patch is a smooth mesh.
+    assert_eq!(scene.meshes.len(), 1);
+    assert_eq!(scene.primitive_count(), 7);
     // Four distinct `f` entities, in order of appearance.
     let materials: Vec<u32> = scene.primitives.iter().map(|p| p.material.0).collect();
-    assert_eq!(materials, [0, 1, 1, 1, 2, 3, 3]);
+    assert_eq!(materials, [0, 1, 1, 1, 2, 3]);
+    assert_eq!(scene.mesh_instances[0].material.0, 3);
     assert!(scene.materials[2].is_transmissive());
     let intensities: Vec<Color> = scene
         .lights

@@ -39,9 +39,9 @@ use std::path::Path;
 
 use self::lexer::ENTITY_KEYWORDS;
 use self::material::{AMBIENT, Fill, default_light_intensity, read_fill};
-use self::patches::{PatchSet, patches_to_shapes, read_patch};
+use self::patches::{PatchSet, patches_to_meshes, read_patch};
 use self::reader::{Parsed, Reader};
-use self::shapes::{Placed, read_cone, read_polygon, read_sphere};
+use self::shapes::{Placed, flat_shape, read_cone, read_polygon, read_sphere};
 use self::view::{View, read_view};
 use crate::light::{Attenuation, Light};
 use crate::material::{Material, MaterialId};
@@ -164,15 +164,14 @@ impl Document {
 
     /// The scene, once every entity is read; `None` without a view.
     fn finish(self, r: &mut Reader<'_>) -> Option<Scene> {
-        let mut objects = self.objects;
-        for (patch, shape) in patches_to_shapes(&self.patches) {
-            match shape {
-                Ok(shape) => objects.push(((shape, Transform::IDENTITY), patch.material)),
-                Err(error) => {
-                    r.error(patch.span.clone(), error.to_string());
-                }
+        let objects = self.objects;
+        for patch in &self.patches.patches {
+            // A patch with no area would never be seen: refused like a `p`.
+            if let Err(error) = flat_shape(patch.positions.clone()) {
+                r.error(patch.span.clone(), error.to_string());
             }
         }
+        let meshes = patches_to_meshes(&self.patches);
         let Some(view) = self.view else {
             if !self.view_seen {
                 r.error(0..0, "the file has no view `v`: an NFF scene needs one");
@@ -202,6 +201,10 @@ impl Document {
             .collect();
         for ((shape, placement), material) in objects {
             scene.add_primitive(shape, material, placement);
+        }
+        for (mesh, material) in meshes {
+            let mesh = scene.add_mesh(mesh);
+            scene.add_mesh_instance(mesh, material, Transform::IDENTITY);
         }
         Some(scene)
     }

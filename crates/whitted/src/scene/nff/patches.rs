@@ -8,17 +8,20 @@
 //! ```
 //!
 //! Patches are read in full, positions and normals both checked, and kept
-//! apart from the other shapes in a [`PatchSet`]. [`patches_to_shapes`] then
-//! turns them into flat triangles (or polygons): flat shading until meshes
-//! with vertex normals exist, when that one function becomes a mesh.
+//! apart from the other shapes in a [`PatchSet`]. [`patches_to_meshes`] then
+//! turns each run of patches of one material into a triangle mesh whose
+//! vertex normals are the patches' normals, so a patch is shaded smoothly: at
+//! a vertex the shading normal is that vertex's normal. A patch of more than
+//! three vertices is split into a fan of triangles; a zero-area one is kept
+//! and never hit.
 
 use std::ops::Range;
 
 use super::reader::{Parsed, Reader};
-use super::shapes::{flat_shape, vertex_count};
+use super::shapes::vertex_count;
 use crate::material::MaterialId;
 use crate::math::Vec3;
-use crate::shape::{Shape, ShapeError};
+use crate::mesh::TriangleMesh;
 
 /// One `pp` entity.
 #[derive(Clone, Debug, PartialEq)]
@@ -69,16 +72,29 @@ pub(super) fn read_patch(
     })
 }
 
-/// Flat shading until meshes with vertex normals exist: each patch becomes
-/// the flat shape of its positions (a triangle, or a polygon past three
-/// vertices), its normals unused. With the patch it came from, for the
-/// material and for locating a refusal.
-pub(super) fn patches_to_shapes(
-    set: &PatchSet,
-) -> impl Iterator<Item = (&Patch, Result<Shape, ShapeError>)> {
+/// One mesh per run of consecutive patches of the same material, with the
+/// material.
+pub(super) fn patches_to_meshes(set: &PatchSet) -> Vec<(TriangleMesh, MaterialId)> {
     set.patches
-        .iter()
-        .map(|patch| (patch, flat_shape(patch.positions.clone())))
+        .chunk_by(|a, b| a.material == b.material)
+        .filter_map(|run| {
+            let mut positions = Vec::new();
+            let mut normals = Vec::new();
+            let mut triangles = Vec::new();
+            for patch in run {
+                let first = positions.len() as u32;
+                positions.extend_from_slice(&patch.positions);
+                normals.extend(patch.normals.iter().map(|n| n.normalize_or_zero()));
+                for k in 1..patch.positions.len().saturating_sub(1) as u32 {
+                    triangles.push([first, first + k, first + k + 1]);
+                }
+            }
+            // Positions and normals were checked finite as they were read,
+            // and every index is in range by construction.
+            let mesh = TriangleMesh::new(positions, triangles).ok()?;
+            Some((mesh.with_normals(normals).ok()?, run[0].material))
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -107,16 +123,42 @@ mod tests {
     }
 
     #[test]
-    fn patches_become_flat_triangles() {
+    fn runs_of_patches_of_one_material_become_one_smooth_mesh() {
+        let mut second = patch("pp 4 0 0 1 0 0 1 1 0 1 0 0 1 1 1 1 0 0 1 0 1 1 0 0 1").unwrap();
+        second.material = MaterialId(2);
+        let mut third = patch("pp 3 0 0 2 1 0 0 1 0 2 0 1 0 0 1 2 0 0 1").unwrap();
+        third.material = MaterialId(5);
         let set = PatchSet {
-            patches: vec![patch("pp 3 0 0 0 0 0 1 1 0 0 0 0 1 0 1 0 0 0 1").unwrap()],
+            patches: vec![
+                patch("pp 3 0 0 0 0 0 2 1 0 0 0 0 1 0 1 0 0 0 1").unwrap(),
+                second,
+                third,
+            ],
         };
-        let shapes: Vec<_> = patches_to_shapes(&set).collect();
-        assert_eq!(shapes.len(), 1);
-        let Ok(Shape::Triangle(triangle)) = &shapes[0].1 else {
-            panic!("{:?}", shapes[0].1);
+        let meshes = patches_to_meshes(&set);
+        assert_eq!(meshes.len(), 2);
+        let (mesh, material) = &meshes[0];
+        assert_eq!(*material, MaterialId(2));
+        assert_eq!(mesh.len(), 3);
+        assert_eq!(mesh.triangles(), [[0, 1, 2], [3, 4, 5], [3, 5, 6]]);
+        assert_eq!(meshes[1].1, MaterialId(5));
+    }
+
+    #[test]
+    fn a_patch_is_shaded_with_its_vertex_normal_at_that_vertex() {
+        let set = PatchSet {
+            patches: vec![patch("pp 3 0 0 0 1 0 1 1 0 0 0 0 1 0 1 0 0 0 1").unwrap()],
         };
-        assert_eq!(triangle.vertices(), [Vec3::ZERO, Vec3::X, Vec3::Y]);
+        let (mesh, _) = &patches_to_meshes(&set)[0];
+        let ray = crate::math::Ray::new(Vec3::new(0.0, 0.0, 1.0), -Vec3::Z);
+        let hit = crate::shape::ShapeHit {
+            t: 1.0,
+            u: 0.0,
+            v: 0.0,
+            part: 0,
+        };
+        let n = mesh.surface(0, &ray, &hit).shading_normal;
+        assert!((n - Vec3::new(1.0, 0.0, 1.0).normalize()).length() < 1e-15);
     }
 
     #[test]

@@ -90,7 +90,10 @@ fn every_entity_is_read_and_patches_follow_the_other_shapes() {
          p 5 0 0 0 2 0 0 2 2 0 1 1 0 0 2 0\n"
     ));
     let kinds: Vec<&str> = s.primitives.iter().map(|p| p.shape.kind()).collect();
-    assert_eq!(kinds, ["sphere", "cone", "polygon", "triangle"]);
+    assert_eq!(kinds, ["sphere", "cone", "polygon"]);
+    assert_eq!(s.meshes.len(), 1);
+    assert_eq!(s.meshes[0].len(), 1);
+    assert_eq!(s.primitive_count(), 4);
     let cone = &s.primitives[1];
     let placement = cone
         .transform
