@@ -185,7 +185,7 @@ fn whitted_material(m: &tobj::Material, extra: &Extra) -> Material {
     if illum >= 2 {
         material.specular = ks.into();
     }
-    if illum >= 3 {
+    if (3..=7).contains(&illum) {
         material.reflection = ks.into();
     }
     if illum == 4 {
