@@ -7,8 +7,9 @@ use clap::Args;
 use whitted::accel::AccelKind;
 use whitted::heat_map::heat_map;
 use whitted::image::{ImageFormat, check_destination};
+use whitted::math::Vec3;
 use whitted::render::{Aov, RenderOptions, render};
-use whitted::scene::{Scene, load_any};
+use whitted::scene::{CameraOverride, LoadOptions, Scene, load_any_with};
 
 use crate::progress::ProgressReport;
 
@@ -22,10 +23,12 @@ use crate::progress::ProgressReport;
   whitted render                                  the built-in scene, to whitted.png
   whitted render scenes/shapes.toml -o shapes.png --width 800 --height 600 --spp 4
   whitted render balls.nff -o balls.png           an SPD scene in NFF
+  whitted render bunny.obj --eye 0,0.1,0.3 --fov 40   a Wavefront OBJ model, seen from elsewhere
   whitted render scenes/whitted.toml -o out.exr --aov depth=depth.pfm --aov normal=normal.exr")]
 pub struct RenderArgs {
-    /// Scene file: .toml (ours) or .nff (Neutral File Format). Without one,
-    /// the built-in scene is rendered.
+    /// Scene file: .toml (ours), .nff (Neutral File Format) or .obj
+    /// (Wavefront, with its .mtl). Without one, the built-in scene is
+    /// rendered.
     scene: Option<PathBuf>,
 
     /// Output image: .png, .exr or .pfm.
@@ -68,9 +71,39 @@ pub struct RenderArgs {
     #[arg(long, value_name = "NAME=FILE")]
     aov: Vec<String>,
 
+    /// Put the camera's eye here (replaces the scene's).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    eye: Option<Vec3>,
+
+    /// Point the camera at this point (replaces the scene's).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    look_at: Option<Vec3>,
+
+    /// The direction that is up on the image (replaces the scene's).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    up: Option<Vec3>,
+
+    /// Vertical field of view in degrees, top edge to bottom edge
+    /// (replaces the scene's).
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    fov: Option<f64>,
+
     /// Print nothing but errors.
     #[arg(short, long)]
     quiet: bool,
+}
+
+/// Parses `X,Y,Z` into a vector of three finite numbers.
+fn parse_vec3(text: &str) -> Result<Vec3, String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let numbers: Vec<f64> = parts
+        .iter()
+        .filter_map(|p| p.parse::<f64>().ok().filter(|x| x.is_finite()))
+        .collect();
+    match numbers.as_slice() {
+        &[x, y, z] if parts.len() == 3 => Ok(Vec3::new(x, y, z)),
+        _ => Err("expected three finite numbers separated by commas, like 1,2.5,-3".to_string()),
+    }
 }
 
 /// Parses the name of an acceleration structure.
@@ -131,9 +164,39 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         .collect::<Result<Vec<_>, _>>()?;
     check_destinations(&args.output, &aov_outputs)?;
 
+    let options = LoadOptions {
+        camera: CameraOverride {
+            eye: args.eye,
+            look_at: args.look_at,
+            up: args.up,
+            fov_degrees: args.fov,
+        },
+    };
     let mut scene = match &args.scene {
-        Some(path) => load_any(path).map_err(|e| e.to_string())?,
-        None => Scene::default_scene(),
+        Some(path) => {
+            let start = Instant::now();
+            let loaded = load_any_with(path, &options).map_err(|e| e.to_string())?;
+            for warning in &loaded.warnings {
+                eprintln!("{warning}\n");
+            }
+            if !args.quiet {
+                eprintln!(
+                    "{}: read in {:.3} s, {} primitives",
+                    path.display(),
+                    start.elapsed().as_secs_f64(),
+                    loaded.scene.primitive_count()
+                );
+            }
+            loaded.scene
+        }
+        None => {
+            let mut scene = Scene::default_scene();
+            scene.camera = options
+                .camera
+                .apply(&scene.camera)
+                .map_err(|e| format!("the camera asked for is invalid: {e}"))?;
+            scene
+        }
     };
     let settings = &mut scene.settings;
     settings.width = args.width.unwrap_or(settings.width);

@@ -116,7 +116,7 @@ fn a_scene_of_an_unknown_format_is_refused_naming_the_formats() {
     let out = whitted(&["render", "scene.rib"], dir.path());
     assert_eq!(out.status.code(), Some(1));
     assert!(
-        stderr(&out).contains("expected a file ending in .toml or .nff"),
+        stderr(&out).contains("expected a file ending in .toml, .nff or .obj"),
         "{}",
         stderr(&out)
     );
@@ -301,4 +301,73 @@ fn outputs_into_missing_folders_or_the_same_file_are_refused_before_rendering() 
     let out = whitted(&["render", "--aov", "depth=missing/d.pfm"], dir.path());
     assert!(!out.status.success());
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+#[test]
+fn camera_overrides_replace_parts_of_the_scene_camera_and_bad_ones_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let small = ["render", "--width", "8", "--height", "6", "--quiet"];
+    let args = [
+        &small[..],
+        &[
+            "--eye",
+            "0,1,-8",
+            "--look-at",
+            "0,0,0",
+            "--up",
+            "0,1,0",
+            "--fov",
+            "30",
+        ],
+    ]
+    .concat();
+    let out = whitted(&args, dir.path());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let moved = std::fs::read(dir.path().join("whitted.png")).unwrap();
+    let out = whitted(&small, dir.path());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let original = std::fs::read(dir.path().join("whitted.png")).unwrap();
+    assert_ne!(moved, original);
+
+    let out = whitted(&[&small[..], &["--eye", "1,2"]].concat(), dir.path());
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("expected three finite numbers separated by commas"),
+        "{}",
+        stderr(&out)
+    );
+    let out = whitted(&[&small[..], &["--fov", "200"]].concat(), dir.path());
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("the camera asked for is invalid: the field of view must be between 0 and 180 degrees, got 200"), "{}", stderr(&out));
+}
+
+#[test]
+fn an_obj_model_renders_with_its_warnings_printed() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("tri.obj");
+    std::fs::write(
+        &model,
+        "mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let out = whitted(
+        &[
+            "render",
+            "tri.obj",
+            "--width",
+            "8",
+            "--height",
+            "6",
+            "--eye",
+            "0.3,0.3,3",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("tri.obj:1:8: warning: cannot read the material library"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(dir.path().join("whitted.png").exists());
 }

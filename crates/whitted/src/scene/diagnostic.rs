@@ -37,6 +37,9 @@ pub enum SceneError {
         /// The file.
         path: PathBuf,
     },
+    /// The camera asked for (by replacing parts of the scene's) is invalid.
+    #[error("the camera asked for is invalid: {0}")]
+    Camera(#[from] crate::camera::CameraError),
     /// The file was read but what it says is wrong: every problem found, in
     /// the order they appear in the file.
     #[error("{}", summary(diagnostics))]
@@ -74,9 +77,20 @@ fn summary(diagnostics: &[Diagnostic]) -> String {
     text
 }
 
+/// How serious a [`Diagnostic`] is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Severity {
+    /// The file cannot be used as it is.
+    Error,
+    /// The file is read, but something in it is ignored or replaced.
+    Warning,
+}
+
 /// One problem in a scene file, with where it is.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Diagnostic {
+    /// An error or a warning.
+    pub severity: Severity,
     /// The file, as it was named to the reader.
     pub path: PathBuf,
     /// Line of the problem, from 1.
@@ -116,6 +130,7 @@ impl Diagnostic {
             end += 1;
         }
         Self {
+            severity: Severity::Error,
             path: path.to_path_buf(),
             line: source[..line_start].matches('\n').count() + 1,
             column: source[line_start..start].chars().count() + 1,
@@ -124,6 +139,21 @@ impl Diagnostic {
                 .trim_end_matches('\r')
                 .to_string(),
             width: source[start..end].chars().count().max(1),
+        }
+    }
+}
+
+impl Diagnostic {
+    /// Like [`Diagnostic::new`], but a warning: the file is still read.
+    pub fn warning(
+        path: &Path,
+        source: &str,
+        span: Range<usize>,
+        message: impl Into<String>,
+    ) -> Self {
+        Self {
+            severity: Severity::Warning,
+            ..Self::new(path, source, span, message)
         }
     }
 }
@@ -139,9 +169,13 @@ impl fmt::Display for Diagnostic {
             .take(self.column.saturating_sub(1))
             .map(|c| if c == '\t' { '\t' } else { ' ' })
             .collect();
+        let severity = match self.severity {
+            Severity::Error => "error",
+            Severity::Warning => "warning",
+        };
         writeln!(
             f,
-            "{}:{}:{}: error: {}",
+            "{}:{}:{}: {severity}: {}",
             self.path.display(),
             self.line,
             self.column,
@@ -208,6 +242,12 @@ mod tests {
         assert_eq!((d.column, d.width), (9, 1));
         let d = at("é", 1..1);
         assert_eq!(d.column, 1);
+    }
+
+    #[test]
+    fn warnings_say_so() {
+        let d = Diagnostic::warning(Path::new("a.obj"), "x 1", 0..1, "ignored");
+        assert!(d.to_string().starts_with("a.obj:1:1: warning: ignored\n"));
     }
 
     #[test]

@@ -1,15 +1,19 @@
 //! The scene: what to render, independent of the file format it came from.
 //!
-//! Every reader (our TOML format, NFF, and OBJ later) produces the same
+//! Every reader (our TOML format, NFF and Wavefront OBJ) produces the same
 //! [`Scene`]; the renderer only ever sees this. [`load_any`] picks the
 //! reader by the file's extension.
 
+mod camera_override;
 mod diagnostic;
 mod nff;
+pub mod obj;
 mod toml_format;
 
-pub use diagnostic::{Diagnostic, SceneError};
+pub use camera_override::CameraOverride;
+pub use diagnostic::{Diagnostic, SceneError, Severity};
 pub use nff::{load_nff, parse_nff};
+pub use obj::{load_obj, parse_obj};
 pub use toml_format::{load_scene, parse_scene};
 
 use std::path::Path;
@@ -24,21 +28,61 @@ use crate::shape::Shape;
 
 /// The scene formats [`load_any`] reads, by file extension (compared
 /// without regard to case).
-pub const SCENE_EXTENSIONS: &[&str] = &["toml", "nff"];
+pub const SCENE_EXTENSIONS: &[&str] = &["toml", "nff", "obj"];
 
-/// Reads a scene file in the format its extension names: `.toml` (ours) or
-/// `.nff` (Eric Haines' Neutral File Format).
+/// A scene read from a file, with the warnings of its reader (things in
+/// the file that were ignored or replaced).
+#[derive(Clone, Debug)]
+pub struct LoadedScene {
+    /// The scene.
+    pub scene: Scene,
+    /// Warnings, in the order of the files and lines they point at.
+    pub warnings: Vec<Diagnostic>,
+}
+
+/// What to change in a scene as it is loaded.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LoadOptions {
+    /// Parts of the camera to replace.
+    pub camera: CameraOverride,
+}
+
+/// Reads a scene file in the format its extension names: `.toml` (ours),
+/// `.nff` (Eric Haines' Neutral File Format) or `.obj` (Wavefront); its
+/// warnings are dropped (see [`load_any_with`]).
 pub fn load_any(path: &Path) -> Result<Scene, SceneError> {
+    load_any_with(path, &LoadOptions::default()).map(|loaded| loaded.scene)
+}
+
+/// Reads a scene file like [`load_any`], keeping the reader's warnings, and
+/// applies `options`. The light of a bare OBJ model follows a replaced
+/// camera's eye.
+pub fn load_any_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene, SceneError> {
     let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
-    if extension.eq_ignore_ascii_case("nff") {
-        load_nff(path)
-    } else if extension.eq_ignore_ascii_case("toml") {
-        load_scene(path)
+    let is = |name: &str| extension.eq_ignore_ascii_case(name);
+    let mut loaded = if is("nff") {
+        LoadedScene {
+            scene: load_nff(path)?,
+            warnings: Vec::new(),
+        }
+    } else if is("toml") {
+        LoadedScene {
+            scene: load_scene(path)?,
+            warnings: Vec::new(),
+        }
+    } else if is("obj") {
+        load_obj(path)?
     } else {
-        Err(SceneError::UnknownFormat {
+        return Err(SceneError::UnknownFormat {
             path: path.to_path_buf(),
-        })
+        });
+    };
+    let scene = &mut loaded.scene;
+    scene.camera = options.camera.apply(&scene.camera)?;
+    if is("obj") {
+        scene.lights = vec![obj::headlight(&scene.camera)];
     }
+    Ok(loaded)
 }
 
 /// Index of a transform in [`Scene::transforms`].
@@ -228,11 +272,11 @@ mod tests {
         let toml = folder.path().join("scene.toml");
         std::fs::write(&toml, DEFAULT_SCENE).unwrap();
         assert_eq!(load_any(&toml).unwrap(), Scene::default_scene());
-        let error = load_any(Path::new("mesh.obj")).unwrap_err();
+        let error = load_any(Path::new("mesh.ply")).unwrap_err();
         assert!(matches!(error, SceneError::UnknownFormat { .. }));
         assert_eq!(
             error.to_string(),
-            "cannot read `mesh.obj`: unknown scene format; expected a file ending in .toml or .nff"
+            "cannot read `mesh.ply`: unknown scene format; expected a file ending in .toml, .nff or .obj"
         );
         assert!(load_any(Path::new("no_extension")).is_err());
     }

@@ -1,0 +1,151 @@
+//! Faces to meshes: one [`TriangleMesh`] per material, each vertex (a
+//! distinct position / texture coordinate / normal combination) stored
+//! once, polygons triangulated by ear clipping, and missing normals
+//! computed per smoothing group.
+
+use std::collections::HashMap;
+
+use super::reader::{Corner, NONE, ObjData};
+use super::triangulate::triangulate;
+use crate::math::{DVec2, Vec3};
+use crate::mesh::{MeshError, TriangleMesh};
+
+/// How a vertex gets its normal; part of what makes two corners the same
+/// vertex.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum NormalSource {
+    /// The file's normal, by index.
+    Given(u32),
+    /// Averaged over the faces of this smoothing group around the vertex.
+    Smooth(u32),
+    /// The normal of this face alone (smoothing off).
+    Flat(u32),
+}
+
+/// A mesh being collected.
+#[derive(Default)]
+struct MeshBuilder {
+    vertices: HashMap<(u32, u32, NormalSource), u32>,
+    corners: Vec<(Corner, NormalSource)>,
+    triangles: Vec<[u32; 3]>,
+}
+
+impl MeshBuilder {
+    fn vertex(&mut self, corner: Corner, source: NormalSource) -> u32 {
+        let next = self.corners.len() as u32;
+        *self
+            .vertices
+            .entry((corner.position, corner.uv, source))
+            .or_insert_with(|| {
+                self.corners.push((corner, source));
+                next
+            })
+    }
+}
+
+/// One mesh for each material slot that has faces: the slot (an index
+/// into [`ObjData::material_uses`], or [`NONE`]) and its mesh.
+pub(super) fn build_meshes(data: &ObjData) -> Result<Vec<(u32, TriangleMesh)>, MeshError> {
+    let mut builders: Vec<(u32, MeshBuilder)> = Vec::new();
+    let mut points = Vec::new();
+    for (face_index, face) in data.faces.iter().enumerate() {
+        let corners = &data.corners[face.first as usize..(face.first + face.count) as usize];
+        let slot = match builders.iter().position(|(slot, _)| *slot == face.material) {
+            Some(i) => i,
+            None => {
+                builders.push((face.material, MeshBuilder::default()));
+                builders.len() - 1
+            }
+        };
+        let builder = &mut builders[slot].1;
+        let smoothing = if data.smoothing_given {
+            face.smoothing
+        } else {
+            1
+        };
+        let indices: Vec<u32> = corners
+            .iter()
+            .map(|&c| {
+                let source = if c.normal != NONE {
+                    NormalSource::Given(c.normal)
+                } else if smoothing != 0 {
+                    NormalSource::Smooth(smoothing)
+                } else {
+                    NormalSource::Flat(face_index as u32)
+                };
+                builder.vertex(c, source)
+            })
+            .collect();
+        points.clear();
+        points.extend(corners.iter().map(|c| data.positions[c.position as usize]));
+        for [a, b, c] in triangulate(&points) {
+            builder.triangles.push([indices[a], indices[b], indices[c]]);
+        }
+    }
+    builders
+        .into_iter()
+        .map(|(slot, builder)| Ok((slot, finish(data, builder)?)))
+        .collect()
+}
+
+/// The mesh of a builder, with texture coordinates if any corner has them
+/// and normals unless every face is flat and none has normals given.
+fn finish(data: &ObjData, builder: MeshBuilder) -> Result<TriangleMesh, MeshError> {
+    let corners = builder.corners;
+    let positions: Vec<Vec3> = corners
+        .iter()
+        .map(|(c, _)| data.positions[c.position as usize])
+        .collect();
+    let any_uv = corners.iter().any(|(c, _)| c.uv != NONE);
+    let any_normal = corners
+        .iter()
+        .any(|(_, source)| !matches!(source, NormalSource::Flat(_)));
+    let normals =
+        any_normal.then(|| vertex_normals(data, &corners, &positions, &builder.triangles));
+    let mut mesh = TriangleMesh::new(positions, builder.triangles)?;
+    if let Some(normals) = normals {
+        mesh = mesh.with_normals(normals)?;
+    }
+    if any_uv {
+        let uvs = corners
+            .iter()
+            .map(|(c, _)| data.uvs.get(c.uv as usize).copied().unwrap_or(DVec2::ZERO))
+            .collect();
+        mesh = mesh.with_uvs(uvs)?;
+    }
+    Ok(mesh)
+}
+
+/// The file's normals where given; elsewhere the average of the normals of
+/// the triangles around the vertex, each weighted by its angle there (so a
+/// polygon split into many triangles counts as much as one).
+fn vertex_normals(
+    data: &ObjData,
+    corners: &[(Corner, NormalSource)],
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+) -> Vec<Vec3> {
+    let mut sums = vec![Vec3::ZERO; positions.len()];
+    for triangle in triangles {
+        let p = triangle.map(|v| positions[v as usize]);
+        let Some(normal) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else {
+            continue;
+        };
+        for k in 0..3 {
+            let edge_a = p[(k + 1) % 3] - p[k];
+            let edge_b = p[(k + 2) % 3] - p[k];
+            let angle = edge_a.angle_between(edge_b);
+            if angle.is_finite() {
+                sums[triangle[k] as usize] += angle * normal;
+            }
+        }
+    }
+    corners
+        .iter()
+        .zip(sums)
+        .map(|((_, source), sum)| match source {
+            NormalSource::Given(n) => data.normals[*n as usize],
+            _ => sum.try_normalize().unwrap_or(Vec3::ZERO),
+        })
+        .collect()
+}

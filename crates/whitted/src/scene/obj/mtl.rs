@@ -1,0 +1,268 @@
+//! MTL material libraries: tobj reads the statements; we check the numbers
+//! first (tobj's errors carry no place), read what tobj leaves aside (`Tf`,
+//! `Tr`), and map each material onto our Whitted material by its `illum`.
+
+use std::collections::HashMap;
+use std::ops::Range;
+use std::path::Path;
+
+use super::text::lines;
+use crate::material::Material;
+use crate::math::Color;
+use crate::scene::Diagnostic;
+
+/// The materials of one library by name, or its errors; with its warnings.
+pub(super) struct Library {
+    pub(super) materials: HashMap<String, Material>,
+    pub(super) diagnostics: Vec<Diagnostic>,
+}
+
+/// Statements taking colours (three numbers) and single numbers.
+const COLORS: &[&str] = &["Ka", "Kd", "Ks", "Ke", "Tf"];
+const NUMBERS: &[&str] = &["Ns", "Ni", "d", "Tr", "illum", "sharpness"];
+
+/// Reads the library text `source`, named `path` in messages.
+pub(super) fn read_library(source: &str, path: &Path) -> Library {
+    let mut diagnostics = check(source, path);
+    if diagnostics.iter().any(is_error) {
+        return Library {
+            materials: HashMap::new(),
+            diagnostics,
+        };
+    }
+    let mut materials = HashMap::new();
+    match tobj::load_mtl_buf(&mut source.as_bytes()) {
+        Ok((parsed, _)) => {
+            let extras = extras(source);
+            for m in parsed {
+                let extra = extras.get(&m.name).cloned().unwrap_or_default();
+                materials.insert(m.name.clone(), whitted_material(&m, &extra));
+            }
+        }
+        Err(error) => diagnostics.push(Diagnostic::new(
+            path,
+            source,
+            0..0,
+            format!("cannot read the material library: {error}"),
+        )),
+    }
+    Library {
+        materials,
+        diagnostics,
+    }
+}
+
+fn is_error(d: &Diagnostic) -> bool {
+    d.severity == crate::scene::Severity::Error
+}
+
+/// Every malformed number, with its place; a warning for texture maps.
+fn check(source: &str, path: &Path) -> Vec<Diagnostic> {
+    let mut diagnostics = Vec::new();
+    let mut maps: Option<(Range<usize>, usize)> = None;
+    for line in lines(source) {
+        let mut words = line.words();
+        let Some((keyword, at)) = words.next() else {
+            continue;
+        };
+        let wanted = if COLORS.contains(&keyword) {
+            3
+        } else if NUMBERS.contains(&keyword) {
+            1
+        } else {
+            if keyword.starts_with("map_") || ["bump", "disp", "decal", "refl"].contains(&keyword) {
+                maps.get_or_insert((at, 0)).1 += 1;
+            }
+            continue;
+        };
+        let mut found = 0;
+        for (word, span) in words.take(wanted) {
+            let ok = if keyword == "illum" {
+                word.parse::<u8>().is_ok_and(|i| i <= 10)
+            } else {
+                word.parse::<f64>().is_ok_and(f64::is_finite)
+            };
+            if !ok {
+                let what = if keyword == "illum" {
+                    "an illumination model 0 to 10"
+                } else {
+                    "a number"
+                };
+                diagnostics.push(Diagnostic::new(
+                    path,
+                    source,
+                    span,
+                    format!("expected {what} after `{keyword}`, found `{word}`"),
+                ));
+                found = wanted;
+                break;
+            }
+            found += 1;
+        }
+        if found < wanted {
+            let message = format!(
+                "`{keyword}` needs {wanted} number{}",
+                if wanted == 1 { "" } else { "s" }
+            );
+            diagnostics.push(Diagnostic::new(path, source, at, message));
+        }
+    }
+    if let Some((at, count)) = maps {
+        let message = format!(
+            "{count} texture map{} in this library: image textures are not applied yet; \
+             the materials use their constant colours",
+            if count == 1 { "" } else { "s" }
+        );
+        diagnostics.push(Diagnostic::warning(path, source, at, message));
+    }
+    diagnostics
+}
+
+/// `Tf` and `Tr`, which tobj keeps as text, by material name.
+#[derive(Clone, Copy, Debug, Default)]
+struct Extra {
+    transmission_filter: Option<Color>,
+    transparency: Option<f64>,
+}
+
+fn extras(source: &str) -> HashMap<String, Extra> {
+    let mut extras: HashMap<String, Extra> = HashMap::new();
+    let mut current = String::new();
+    for line in lines(source) {
+        let mut words = line.words();
+        let Some((keyword, _)) = words.next() else {
+            continue;
+        };
+        let numbers: Vec<f64> = words.filter_map(|(w, _)| w.parse().ok()).collect();
+        match (keyword, numbers.as_slice()) {
+            ("newmtl", _) => current = line.rest().0.to_string(),
+            ("Tf", &[r, g, b, ..]) => {
+                extras
+                    .entry(current.clone())
+                    .or_default()
+                    .transmission_filter = Some(Color::new(r, g, b));
+            }
+            ("Tr", &[tr, ..]) => extras.entry(current.clone()).or_default().transparency = Some(tr),
+            _ => {}
+        }
+    }
+    extras
+}
+
+fn color(c: Option<[f64; 3]>, default: Color) -> Color {
+    c.map_or(default, Color::from)
+}
+
+/// Our material for an MTL material, by its illumination model (see
+/// `docs/obj.md`).
+fn whitted_material(m: &tobj::Material, extra: &Extra) -> Material {
+    let kd = color(m.diffuse, Color::splat(0.8));
+    let ka = color(m.ambient, Color::ZERO);
+    let ks = color(m.specular, Color::ZERO);
+    let ke = color(m.emissive, Color::ZERO);
+    let dissolve = m
+        .dissolve
+        .or(extra.transparency.map(|tr| 1.0 - tr))
+        .unwrap_or(1.0)
+        .clamp(0.0, 1.0);
+    let illum = m.illumination_model.unwrap_or(2);
+    let mut material = Material {
+        ambient: ka.into(),
+        diffuse: kd.into(),
+        specular: Color::ZERO.into(),
+        shininess: m.shininess.unwrap_or(32.0).max(1.0),
+        reflection: Color::ZERO.into(),
+        transmission: Color::splat(1.0 - dissolve).into(),
+        emission: ke.into(),
+        ior: 1.0,
+        fresnel: false,
+    };
+    if illum == 0 {
+        material.ambient = Color::ZERO.into();
+        material.diffuse = Color::ZERO.into();
+        material.emission = (kd + ke).into();
+    }
+    if illum >= 2 {
+        material.specular = ks.into();
+    }
+    if (3..=7).contains(&illum) {
+        material.reflection = ks.into();
+    }
+    if illum == 4 {
+        let filter = extra.transmission_filter.unwrap_or(Color::ONE);
+        material.transmission = (filter * (1.0 - dissolve)).into();
+    }
+    if matches!(illum, 6 | 7) {
+        let fallback = if dissolve < 1.0 {
+            Color::splat(1.0 - dissolve)
+        } else {
+            Color::ONE
+        };
+        material.transmission = extra.transmission_filter.unwrap_or(fallback).into();
+        material.ior = m.optical_density.filter(|n| *n > 0.0).unwrap_or(1.0);
+        material.fresnel = illum == 7;
+    }
+    material
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::texture::Texture;
+
+    fn read(source: &str) -> Library {
+        read_library(source, Path::new("m.mtl"))
+    }
+
+    #[test]
+    fn illum_models_map_onto_our_material() {
+        let lib = read(
+            "newmtl flat\nKd 1 0 0\nillum 0\n\
+             newmtl matte\nKa 0.1 0.1 0.1\nKd 0 1 0\nKs 1 1 1\nillum 1\n\
+             newmtl mirror\nKs 0.5 0.5 0.5\nNs 200\nillum 3\n\
+             newmtl dark glass\nKs 1 1 1\nTf 0.9 0.8 0.7\nNi 1.5\nillum 7\n\
+             newmtl half\nTr 0.25\nillum 2\n",
+        );
+        assert!(lib.diagnostics.is_empty(), "{:?}", lib.diagnostics);
+        let m = &lib.materials;
+        assert_eq!(
+            m["flat"].emission,
+            Texture::Constant(Color::new(1.0, 0.0, 0.0))
+        );
+        assert!(m["flat"].diffuse.is_black());
+        assert!(m["matte"].specular.is_black() && m["matte"].reflection.is_black());
+        assert_eq!(m["mirror"].reflection, Texture::Constant(Color::splat(0.5)));
+        assert_eq!(m["mirror"].shininess, 200.0);
+        let glass = &m["dark glass"];
+        assert_eq!(
+            glass.transmission,
+            Texture::Constant(Color::new(0.9, 0.8, 0.7))
+        );
+        assert!(glass.fresnel && glass.ior == 1.5);
+        assert_eq!(
+            m["half"].transmission,
+            Texture::Constant(Color::splat(0.25))
+        );
+    }
+
+    #[test]
+    fn bad_numbers_are_located_and_texture_maps_warned_about() {
+        let lib = read("newmtl a\nKd 1 x 0\nmap_Kd wood.png\nNs\n");
+        let text: Vec<String> = lib.diagnostics.iter().map(ToString::to_string).collect();
+        assert!(
+            text[0].starts_with("m.mtl:2:6: error: expected a number after `Kd`, found `x`"),
+            "{}",
+            text[0]
+        );
+        assert!(
+            text[1].starts_with("m.mtl:4:1: error: `Ns` needs 1 number"),
+            "{}",
+            text[1]
+        );
+        assert!(
+            text[2].starts_with("m.mtl:3:1: warning: 1 texture map in this library"),
+            "{}",
+            text[2]
+        );
+    }
+}

@@ -1,0 +1,56 @@
+use std::path::Path;
+
+use super::*;
+use crate::math::Vec3;
+
+fn parse(source: &str) -> LoadedScene {
+    parse_obj(source, Path::new("model.obj")).unwrap()
+}
+
+#[test]
+fn vertices_are_shared_and_one_mesh_is_made_per_material() {
+    let loaded = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n");
+    let scene = loaded.scene;
+    assert_eq!(scene.meshes.len(), 1);
+    assert_eq!(scene.meshes[0].positions().len(), 4);
+    assert_eq!(scene.meshes[0].len(), 2);
+    assert_eq!(scene.materials, vec![Material::default()]);
+    assert!(loaded.warnings.is_empty());
+}
+
+#[test]
+fn a_bare_model_is_framed_and_lit_from_the_eye() {
+    let scene = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").scene;
+    assert_eq!((scene.settings.width, scene.settings.height), (640, 480));
+    assert_eq!(scene.camera.fov_degrees(), DEFAULT_FOV_DEGREES);
+    assert_eq!(scene.lights, vec![headlight(&scene.camera)]);
+    assert_eq!(scene.ambient, Color::splat(AMBIENT));
+}
+
+#[test]
+fn unknown_statements_and_lines_are_warned_about_once() {
+    let loaded = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 2 3\ncstype bezier\nf 1 2 3\n");
+    let text: Vec<String> = loaded.warnings.iter().map(ToString::to_string).collect();
+    assert_eq!(text.len(), 2, "{text:?}");
+    assert!(text[0].starts_with("model.obj:4:1: warning: points and lines (`l`) are not rendered"));
+    assert!(text[1].starts_with("model.obj:6:1: warning: unknown statement `cstype`"));
+}
+
+#[test]
+fn a_file_without_s_is_smoothed_and_given_normals_are_kept() {
+    let roof = "v -1 0 0\nv 0 1 0\nv 1 0 0\nv -1 0 1\nv 0 1 1\nv 1 0 1\nf 1 4 5 2\nf 2 5 6 3\n";
+    let scene = parse(roof).scene;
+    assert_eq!(scene.meshes[0].positions().len(), 6);
+    let normals = parse(&format!("{roof}vn 0 0 1\nf 1//1 2//1 3//1\n")).scene;
+    assert_eq!(normals.meshes[0].positions().len(), 9);
+    let ridge = Vec3::new(0.0, 1.0, 0.5);
+    let ray = crate::math::Ray::new(Vec3::new(0.0, 5.0, 0.5), -Vec3::Y);
+    let mesh = &scene.meshes[0];
+    let shear = crate::shape::RayShear::new(&ray);
+    let (i, hit) = (0..mesh.len() as u32)
+        .find_map(|i| mesh.intersect(i, &ray, &shear).map(|h| (i, h)))
+        .unwrap();
+    let surface = mesh.surface(i, &ray, &hit);
+    assert!((surface.local.point - ridge).length() < 1e-9);
+    assert!((surface.shading_normal - Vec3::Y).length() < 1e-9);
+}
