@@ -79,6 +79,9 @@ pub struct Geometry<'a> {
     /// Per structure slot, the corners of an untransformed mesh triangle:
     /// the hot case reaches its vertices without going through `refs`, the
     /// instance and the mesh's index array (same test, same result).
+    /// Tried and not kept: renumbering the BVH's primitives to leaf order
+    /// so a leaf's corners are contiguous here: no measurable change on the
+    /// bunny (10.5/3.4/2.65 Mrays/s either way), a slower build.
     slot_triangles: Vec<Option<[Vec3; 3]>>,
     unbounded: Vec<u32>,
 }

@@ -1,6 +1,6 @@
 //! Ray queries: an iterative walk over the four-wide nodes with a fixed
-//! stack, testing a node's four child boxes at once in `f32` SIMD and
-//! visiting the children the ray meets nearest first.
+//! stack, testing a node's four child boxes at once in `f32` SIMD; the
+//! closest-hit query visits the children the ray meets nearest first.
 //!
 //! # Why the `f32` test never culls a box the `f64` ray meets
 //!
@@ -132,6 +132,7 @@ struct Slabs {
 }
 
 impl Slabs {
+    #[inline(always)]
     fn new(ray: &Ray) -> Self {
         let mut slabs = Self {
             entry_origin: [Vec4::ZERO; 3],
@@ -337,7 +338,21 @@ impl Bvh {
                 let (mask, near) = slabs.test(node, far);
                 if mask != 0 {
                     // All but the nearest stay on the stack.
-                    depth += push_hits(node, mask, &near, &mut stack, depth) - 1;
+                    // In slot order, unsorted: any hit will do, and on the
+                    // bunny's shadow rays nearest first visited more nodes
+                    // (14.9 against 14.7 a ray) and ran about 10% slower.
+                    let mut bits = mask;
+                    while bits != 0 {
+                        let slot = bits.trailing_zeros() as usize;
+                        bits &= bits - 1;
+                        stack[depth] = Entry {
+                            child: node.children[slot],
+                            count: node.counts[slot],
+                            t: near[slot],
+                        };
+                        depth += 1;
+                    }
+                    depth -= 1;
                     current = stack[depth];
                     continue;
                 }
