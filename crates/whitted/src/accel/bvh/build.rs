@@ -144,20 +144,13 @@ impl Builder<'_> {
         let (bounds, centroid_bounds) = self.bounds(task.prims);
         let mid = match self.split(task.prims, task.depth, &bounds, &centroid_bounds, bins) {
             Split::Leaf => {
-                *task.node = BinaryNode {
-                    bounds,
-                    first: task.first_prim as u32,
-                    count: task.prims.len() as u32,
-                };
+                *task.node =
+                    BinaryNode::new(&bounds, task.first_prim as u32, task.prims.len() as u32);
                 return;
             }
             Split::At(mid) => mid,
         };
-        *task.node = BinaryNode {
-            bounds,
-            first: task.first_below as u32,
-            count: 0,
-        };
+        *task.node = BinaryNode::new(&bounds, task.first_below as u32, 0);
         let (pair, rest) = task.below.split_at_mut(2);
         let (left_node, right_node) = pair.split_at_mut(1);
         let (left_below, right_below) = rest.split_at_mut(2 * mid - 2);

@@ -30,7 +30,7 @@ pub(super) fn collapse(scratch: &[BinaryNode]) -> (Vec<BvhNode>, usize) {
                     (0..used)
                         .filter(|&i| !scratch[slots[i]].is_leaf())
                         .max_by(|&a, &b| {
-                            let area = |i: usize| scratch[slots[i]].bounds.surface_area();
+                            let area = |i: usize| scratch[slots[i]].bounds().surface_area();
                             area(a).total_cmp(&area(b))
                         });
                 let Some(i) = widest else { break };
@@ -43,11 +43,11 @@ pub(super) fn collapse(scratch: &[BinaryNode]) -> (Vec<BvhNode>, usize) {
         for (slot, &index) in slots[..used].iter().enumerate() {
             let child = &scratch[index];
             if child.is_leaf() {
-                nodes[wide].set_child(slot, &child.bounds, child.first, child.count);
+                nodes[wide].set_child(slot, &child.bounds(), child.first, child.count);
             } else {
                 let at = nodes.len();
                 nodes.push(BvhNode::default());
-                nodes[wide].set_child(slot, &child.bounds, at as u32, 0);
+                nodes[wide].set_child(slot, &child.bounds(), at as u32, 0);
                 todo.push((at, index, depth + 1));
             }
         }
