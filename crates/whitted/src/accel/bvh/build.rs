@@ -5,11 +5,12 @@
 //! slot plus a region of `2n - 2` slots for its descendants (a binary tree
 //! with `n` non-empty leaves never needs more), so the two halves of a split
 //! write to disjoint slices and the result is the same whatever the number
-//! of threads. A final depth-first pass packs the nodes densely, sibling
-//! pairs adjacent.
+//! of threads. The binary tree is then collapsed into four-wide nodes
+//! (`collapse`).
 
 use super::MAX_DEPTH;
-use super::node::BvhNode;
+use super::collapse::collapse;
+use super::node::{BinaryNode, BvhNode};
 use crate::math::{Aabb, Vec3};
 
 /// How a node's primitives are divided between its two children.
@@ -94,7 +95,7 @@ pub(super) fn build(boxes: &[Aabb], params: &BvhBuildParams) -> (Vec<BvhNode>, V
         },
     };
     let mut indices: Vec<u32> = (0..n as u32).collect();
-    let mut scratch = vec![BvhNode::default(); 2 * n - 1];
+    let mut scratch = vec![BinaryNode::default(); 2 * n - 1];
     let (root, below) = scratch.split_at_mut(1);
     let task = Subtree {
         prims: &mut indices,
@@ -105,7 +106,7 @@ pub(super) fn build(boxes: &[Aabb], params: &BvhBuildParams) -> (Vec<BvhNode>, V
         first_below: 1,
     };
     builder.subtree(task, &mut Bins::default());
-    let (nodes, max_depth) = pack(&scratch);
+    let (nodes, max_depth) = collapse(&scratch);
     (nodes, indices, max_depth)
 }
 
@@ -124,9 +125,9 @@ struct Subtree<'s> {
     first_prim: usize,
     depth: usize,
     /// Its root's slot.
-    node: &'s mut BvhNode,
+    node: &'s mut BinaryNode,
     /// The `2 * prims.len() - 2` slots reserved for its descendants.
-    below: &'s mut [BvhNode],
+    below: &'s mut [BinaryNode],
     /// Position of `below` in the scratch node array.
     first_below: usize,
 }
@@ -144,12 +145,12 @@ impl Builder<'_> {
         let mid = match self.split(task.prims, task.depth, &bounds, &centroid_bounds, bins) {
             Split::Leaf => {
                 *task.node =
-                    BvhNode::leaf(&bounds, task.first_prim as u32, task.prims.len() as u32);
+                    BinaryNode::new(&bounds, task.first_prim as u32, task.prims.len() as u32);
                 return;
             }
             Split::At(mid) => mid,
         };
-        *task.node = BvhNode::interior(&bounds, task.first_below as u32);
+        *task.node = BinaryNode::new(&bounds, task.first_below as u32, 0);
         let (pair, rest) = task.below.split_at_mut(2);
         let (left_node, right_node) = pair.split_at_mut(1);
         let (left_below, right_below) = rest.split_at_mut(2 * mid - 2);
@@ -363,26 +364,4 @@ impl Bins {
             }
         }
     }
-}
-
-/// Packs the scratch tree depth first, each sibling pair allocated when its
-/// parent is reached; returns the nodes and the deepest leaf's depth.
-fn pack(scratch: &[BvhNode]) -> (Vec<BvhNode>, usize) {
-    let mut nodes = vec![scratch[0]];
-    let mut todo = vec![(0, 0, 0)];
-    let mut max_depth = 0;
-    while let Some((packed, old, depth)) = todo.pop() {
-        max_depth = max_depth.max(depth);
-        let node = scratch[old];
-        if node.is_leaf() {
-            continue;
-        }
-        let child = node.first as usize;
-        let at = nodes.len();
-        nodes.extend_from_slice(&scratch[child..child + 2]);
-        nodes[packed].first = at as u32;
-        todo.push((at + 1, child + 1, depth + 1));
-        todo.push((at, child, depth + 1));
-    }
-    (nodes, max_depth)
 }

@@ -1,18 +1,81 @@
-//! The flattened node: an `f32` box and a pair of `u32`, 32 bytes.
+//! The nodes: the 128-byte four-wide node the queries walk, the 32-byte
+//! binary node the build works in, and the outward rounding of their `f32`
+//! boxes.
 //!
 //! Boxes are rounded outward from `f64` to `f32`, so a node always contains
 //! the exact boxes below it and culling against it stays conservative.
 
 use crate::math::{Aabb, Vec3};
 
-/// One node of a [`super::Bvh`], interior or leaf.
+/// One node of a [`super::Bvh`]: up to four children, their boxes stored
+/// axis by axis so one SIMD slab test covers all four.
+///
+/// Child slot `i` is a leaf when `counts[i] > 0` (the primitives listed at
+/// `children[i]..children[i] + counts[i]` of the BVH's index array), an
+/// interior node at `children[i]` otherwise. An unused slot has count 0,
+/// child [`u32::MAX`] and the empty box (`+∞` minimum, `−∞` maximum), which
+/// no ray meets.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(64))]
+pub struct BvhNode {
+    /// `[min_x, min_y, min_z, max_x, max_y, max_z]`, each per child slot;
+    /// minima rounded down, maxima up.
+    pub bounds: [[f32; 4]; 6],
+    /// Interior: the child node's index. Leaf: its first index-array entry.
+    pub children: [u32; 4],
+    /// Primitives of a leaf slot; 0 for an interior or unused slot.
+    pub counts: [u32; 4],
+}
+
+const _: () = assert!(size_of::<BvhNode>() == 128);
+
+impl Default for BvhNode {
+    /// Four unused slots.
+    fn default() -> Self {
+        let (min, max) = ([f32::INFINITY; 4], [f32::NEG_INFINITY; 4]);
+        Self {
+            bounds: [min, min, min, max, max, max],
+            children: [u32::MAX; 4],
+            counts: [0; 4],
+        }
+    }
+}
+
+impl BvhNode {
+    /// Puts a child with box `bounds` in slot `slot`.
+    pub(super) fn set_child(&mut self, slot: usize, bounds: &Aabb, child: u32, count: u32) {
+        for axis in 0..3 {
+            self.bounds[axis][slot] = round_down(bounds.min[axis]);
+            self.bounds[axis + 3][slot] = round_up(bounds.max[axis]);
+        }
+        self.children[slot] = child;
+        self.counts[slot] = count;
+    }
+
+    /// Slot `slot`'s box, exactly, in `f64` (empty for an unused slot).
+    pub fn child_bounds(&self, slot: usize) -> Aabb {
+        let coordinate = |axis: usize| f64::from(self.bounds[axis][slot]);
+        Aabb {
+            min: Vec3::new(coordinate(0), coordinate(1), coordinate(2)),
+            max: Vec3::new(coordinate(3), coordinate(4), coordinate(5)),
+        }
+    }
+
+    /// True when slot `slot` holds a child (leaf or interior).
+    pub fn is_used(&self, slot: usize) -> bool {
+        self.counts[slot] > 0 || self.children[slot] != u32::MAX
+    }
+}
+
+/// A node of the binary tree the build makes before collapsing it: 32
+/// bytes, its box already rounded outward to `f32` (half the scratch memory
+/// of an `f64` box, which made the build slower).
 ///
 /// An interior node (`count == 0`) has its two children at `first` and
 /// `first + 1`; a leaf holds the `count` primitives listed at
-/// `first..first + count` of the BVH's reordered index array.
+/// `first..first + count` of the reordered index array.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-#[repr(C)]
-pub struct BvhNode {
+pub(super) struct BinaryNode {
     /// Smallest corner, rounded down.
     pub min: [f32; 3],
     /// Largest corner, rounded up.
@@ -23,11 +86,11 @@ pub struct BvhNode {
     pub count: u32,
 }
 
-const _: () = assert!(size_of::<BvhNode>() == 32);
+const _: () = assert!(size_of::<BinaryNode>() == 32);
 
-impl BvhNode {
-    /// A leaf over index-array entries `first..first + count` (`count > 0`).
-    pub fn leaf(bounds: &Aabb, first: u32, count: u32) -> Self {
+impl BinaryNode {
+    /// A node over `bounds`, rounded outward.
+    pub fn new(bounds: &Aabb, first: u32, count: u32) -> Self {
         Self {
             min: bounds.min.to_array().map(round_down),
             max: bounds.max.to_array().map(round_up),
@@ -36,13 +99,7 @@ impl BvhNode {
         }
     }
 
-    /// An interior node whose children are at `first` and `first + 1`.
-    pub fn interior(bounds: &Aabb, first: u32) -> Self {
-        Self::leaf(bounds, first, 0)
-    }
-
     /// True for a leaf.
-    #[inline(always)]
     pub fn is_leaf(&self) -> bool {
         self.count != 0
     }
@@ -73,8 +130,9 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_node_is_32_bytes() {
-        assert_eq!(size_of::<BvhNode>(), 32);
+    fn a_node_is_128_bytes_on_a_cache_line_boundary() {
+        assert_eq!(size_of::<BvhNode>(), 128);
+        assert_eq!(align_of::<BvhNode>(), 64);
     }
 
     #[test]
@@ -93,12 +151,15 @@ mod tests {
     }
 
     #[test]
-    fn node_box_contains_the_exact_box() {
+    fn child_box_contains_the_exact_box() {
         let exact = Aabb::new(
             Vec3::new(0.1, -0.3, 1e-9),
             Vec3::new(0.7, 2.0 / 3.0, 1e9 + 1.0),
         );
-        let node = BvhNode::leaf(&exact, 0, 1).bounds();
-        assert!(node.min.cmple(exact.min).all() && node.max.cmpge(exact.max).all());
+        let mut node = BvhNode::default();
+        node.set_child(2, &exact, 0, 1);
+        let rounded = node.child_bounds(2);
+        assert!(rounded.min.cmple(exact.min).all() && rounded.max.cmpge(exact.max).all());
+        assert!(node.is_used(2) && !node.is_used(1));
     }
 }

@@ -1,80 +1,231 @@
-//! Ray queries: an iterative walk with a fixed stack, nearer child first.
+//! Ray queries: an iterative walk over the four-wide nodes with a fixed
+//! stack, testing a node's four child boxes at once in `f32` SIMD; the
+//! closest-hit query visits the children the ray meets nearest first.
 //!
-//! The slab test runs in `f64` on the node's `f32` box converted exactly,
-//! with the same formula and the same far-side widening as
-//! [`Aabb::intersect_ray`](crate::math::Aabb::intersect_ray). Both
-//! subtraction and multiplication round monotonically, and a node's box
-//! contains its primitives' boxes, so whenever the brute force would test a
-//! primitive the walk reaches its leaf: culling is conservative.
+//! # Why the `f32` test never culls a box the `f64` ray meets
 //!
-//! Tried and not kept, on camera rays and random rays over a 200k-triangle
-//! mesh (interleaved runs, best of 8): testing both children at once, in
-//! `f64` or in `f32` with glam's SIMD `Vec3A` (and that without the padding
-//! it would need to stay conservative). Both ran at 0.88 to 0.93 times the
-//! speed of this loop: the time goes to memory and to the primitives, not
-//! to the slab arithmetic.
+//! Primitives are tested with the exact `f64` ray; the slab test runs in
+//! `f32` on the nodes' boxes (rounded outward, so they contain the exact
+//! boxes). A child may be culled only when the `f64` slab test of
+//! [`Aabb::intersect_ray`](crate::math::Aabb::intersect_ray) (and of the
+//! binary BVH this replaced), which widens both ends by 2γ(3), would cull
+//! it. Along one axis, with `p` a box plane and `o`, `i` the ray's origin
+//! and inverse direction in `f64`, that test's parameter is `(p − o)·i`.
+//!
+//! - **Origin.** The `f32` origin is rounded per axis and per end instead of
+//!   to nearest: for the entry, whichever of the `f32` values just below and
+//!   just above `o` makes `(p − o′)·i` no larger than `(p − o)·i` (the one
+//!   above when `i > 0`, below when `i < 0`); for the exit the other one.
+//!   This moves each end outward by at least the conversion's error
+//!   `|o − o′|·|i|`, exactly, with no extra arithmetic per node, and stays
+//!   valid when `o` lies beyond the `f32` range (`o′ = ±∞`).
+//! - **Rounding.** The computed entry `fl(fl(p − o′)·fl₃₂(i))` differs from
+//!   `(p − o′)·i` by the relative error of three `f32` roundings (the
+//!   subtraction, `i` to `f32`, the product), under `3u` with `u = 2⁻²⁴`;
+//!   the `f64` test's own roundings and its 2γ(3) are below `2⁻⁴⁹`. After the
+//!   three axes are combined with `t_min` and `t_max` (by comparisons, which
+//!   are exact), the entry is multiplied by `1 ∓ 8u` and the exit by
+//!   `1 ± 8u` (the sign chosen to move away from the interval, so negative
+//!   parameters are widened too). That product rounds once more: `k = 8`
+//!   covers the `4u` (plus under `2⁻⁴⁹`) needed with room to spare, and both
+//!   factors are exact in `f32`. `t_min` is rounded down and `t_max` up.
+//!   Every rounding is monotone, so a plane beyond the `f32` range rounds to
+//!   `±∞` on the safe side; results below `2⁻¹²⁶` round with an absolute
+//!   error under `2⁻¹⁴⁹`, the one case the relative factor does not cover
+//!   (it would need a box and `t_min` both within `10⁻⁴⁴` of the origin).
+//! - **Parallel rays.** A direction component of `±0` gives `i = ±∞`:
+//!   the parameter is `±∞` outside or inside the
+//!   slab, or NaN (`0·∞`) with the origin on a face, which counts as inside.
+//!   With directed origins, `p − o′ = 0` only when `o` lies on the face or
+//!   between it and `o′`, where inside is the conservative answer. The
+//!   combining comparisons are written so that a NaN never narrows the
+//!   interval (`a > b ? a : b` keeps `b` when `a` is NaN), as in
+//!   `Aabb::intersect_ray`; an `∞ − ∞` from an infinite box or origin is a
+//!   NaN handled the same way. A component so small (below about
+//!   `3·10⁻³⁹`) that `i` is finite in `f64` but not in `f32` would make an
+//!   entry `+∞` where the exact one is finite: such an axis is made not to
+//!   cull (entry origin `f32::MAX`, exit origin `−f32::MAX`, `i = 2¹⁰⁰`, so
+//!   entries are `−∞` and exits `+∞` for every plane but `±f32::MAX` and the
+//!   empty box's `±∞`).
+//!
+//! Unused slots hold the empty box (`+∞` minimum, `−∞` maximum): their
+//! entry is `+∞` on every axis for any ray with a finite origin, so they are
+//! never entered; a ray with a NaN origin enters every slot, and the walk
+//! skips the unused ones' out-of-range child index.
+//!
+//! `counters.nodes` counts the wide nodes and the leaves the walk enters.
+//!
+//! Measured on the Stanford bunny (69k triangles) with the Embree harness's
+//! rays, 1 thread, interleaved runs: the binary BVH with a scalar `f64`
+//! slab test this replaced ran primary/shadow/diffuse rays at 7.1/2.1/1.6
+//! Mrays/s, this walk (with the triangle corners kept per slot in
+//! `Geometry`) at 10.8/3.85/2.6. Tried and not kept: on the binary tree,
+//! testing both children at once in `f64` or `f32` SIMD (0.88 to 0.93
+//! times the scalar loop); here, sorting the hit children in a separate
+//! array and copying them to the stack (store-forwarding stalls; removing
+//! them, with `maxps` and an inlined ray setup, took primary rays from 7.7
+//! to 9.3 Mrays/s); a stack sized for [`MAX_DEPTH`] for every tree
+//! (8% of the time went to clearing it); an SAH traversal cost of 0.5
+//! instead of 1 for smaller leaves (3.4 instead of 3.9 triangles per shadow
+//! ray, no faster).
 
-use super::node::BvhNode;
+use glam::Vec4;
+
+use super::node::{BvhNode, round_down, round_up};
 use super::{Bvh, MAX_DEPTH};
 use crate::accel::TraversalCounters;
-use crate::math::{Ray, gamma};
+use crate::math::Ray;
 
-/// Widening of a box's exit parameter, as in `Aabb::intersect_ray`.
-const FAR_WIDENING: f64 = 1.0 + 2.0 * gamma(3);
+/// Entries the stack needs for a tree whose leaves lie at most `depth` deep:
+/// a node at depth `d` finds at most `3d` entries pending and pushes its
+/// (at most four) children before it pops the nearest.
+const fn stack_size(depth: usize) -> usize {
+    3 * depth + 4
+}
 
-/// Widening of a box's entry parameter, as in `Aabb::intersect_ray`: a
-/// primitive's hit may lie an ulp before its box's computed entry.
-const NEAR_WIDENING: f64 = 1.0 - 2.0 * gamma(3);
+/// Trees at most this deep use a short stack: initialising the one for
+/// [`MAX_DEPTH`] took 8% of the time on the bunny.
+const SHALLOW: usize = 15;
+
+/// `1 − 8u` and `1 + 8u` with `u = 2⁻²⁴`: the widening factors (see the
+/// module documentation), exact in `f32`.
+const SHRINK: f32 = 1.0 - 1.0 / (1 << 21) as f32;
+const GROW: f32 = 1.0 + 1.0 / (1 << 21) as f32;
+
+/// The inverse direction of an axis that must not cull (see the module
+/// documentation).
+const NEVER_CULLS: f32 = (1u128 << 100) as f32;
+
+/// `a > b ? a : b` per lane: `b` when `a` is NaN. On x86-64 glam's `max`
+/// is `maxps`, which is exactly that (and its scalar fallback returns the
+/// number too); a `select` written out was not turned into `maxps`.
+#[inline(always)]
+fn max_keeping(a: Vec4, b: Vec4) -> Vec4 {
+    if cfg!(target_arch = "x86_64") {
+        a.max(b)
+    } else {
+        Vec4::select(a.cmpgt(b), a, b)
+    }
+}
+
+/// `a < b ? a : b` per lane: `b` when `a` is NaN (`minps` on x86-64).
+#[inline(always)]
+fn min_keeping(a: Vec4, b: Vec4) -> Vec4 {
+    if cfg!(target_arch = "x86_64") {
+        a.min(b)
+    } else {
+        Vec4::select(a.cmplt(b), a, b)
+    }
+}
+
+/// A child to visit: a node (`count == 0`) or a leaf, and a lower bound on
+/// the parameter where the ray enters its box.
+#[derive(Clone, Copy, Debug, Default)]
+struct Entry {
+    child: u32,
+    count: u32,
+    t: f32,
+}
 
 /// What the slab test needs of a ray, computed once per ray.
 struct Slabs {
-    origin: [f64; 3],
-    inv_dir: [f64; 3],
+    /// Per axis, the origin rounded for the entry and for the exit.
+    entry_origin: [Vec4; 3],
+    exit_origin: [Vec4; 3],
+    inv_dir: [Vec4; 3],
     /// Per axis: the ray enters through the box's max face.
     negative: [bool; 3],
-    t_min: f64,
+    t_min: Vec4,
 }
 
 impl Slabs {
+    #[inline(always)]
     fn new(ray: &Ray) -> Self {
-        let inv_dir = ray.inv_dir.to_array();
-        Self {
-            origin: ray.origin.to_array(),
-            inv_dir,
-            negative: inv_dir.map(f64::is_sign_negative),
-            t_min: ray.t_min,
+        let mut slabs = Self {
+            entry_origin: [Vec4::ZERO; 3],
+            exit_origin: [Vec4::ZERO; 3],
+            inv_dir: [Vec4::ZERO; 3],
+            negative: [false; 3],
+            t_min: Vec4::splat(round_down(ray.t_min)),
+        };
+        for axis in 0..3 {
+            let (o, i) = (ray.origin[axis], ray.inv_dir[axis]);
+            let (down, up, negative) = (round_down(o), round_up(o), i.is_sign_negative());
+            let (entry, exit, inv) = if i.is_finite() && i.abs() > f64::from(f32::MAX) {
+                // Beyond `f32`: an axis that culls only the empty box.
+                (f32::MAX, -f32::MAX, NEVER_CULLS)
+            } else if negative {
+                (down, up, i as f32)
+            } else {
+                (up, down, i as f32)
+            };
+            slabs.entry_origin[axis] = Vec4::splat(entry);
+            slabs.exit_origin[axis] = Vec4::splat(exit);
+            slabs.inv_dir[axis] = Vec4::splat(inv);
+            slabs.negative[axis] = negative && inv < 0.0;
         }
+        slabs
     }
 
-    /// The parameter where the ray enters the node's box, if it meets the
-    /// box within `(t_min, t_max]`.
-    ///
-    /// Along an axis the ray is parallel to, a parameter is ±∞ (outside or
-    /// inside the slab) or NaN (`0 · ∞`: on a face, which counts as
-    /// inside); the comparisons below are false for NaN, so a NaN never
-    /// narrows the interval, as in `Aabb::intersect_ray`.
+    /// Which of the node's children the ray may meet within
+    /// `(t_min, t_max]` (bit `i` for slot `i`), and lower bounds on where it
+    /// enters them.
     #[inline(always)]
-    fn entry(&self, node: &BvhNode, t_max: f64) -> Option<f64> {
+    fn test(&self, node: &BvhNode, t_max: Vec4) -> (u32, [f32; 4]) {
         let mut near = self.t_min;
         let mut far = t_max;
         for axis in 0..3 {
+            let (min, max) = (
+                Vec4::from_array(node.bounds[axis]),
+                Vec4::from_array(node.bounds[axis + 3]),
+            );
             let (enter, exit) = if self.negative[axis] {
-                (node.max[axis], node.min[axis])
+                (max, min)
             } else {
-                (node.min[axis], node.max[axis])
+                (min, max)
             };
-            let t_enter =
-                (f64::from(enter) - self.origin[axis]) * self.inv_dir[axis] * NEAR_WIDENING;
-            let t_exit = (f64::from(exit) - self.origin[axis]) * self.inv_dir[axis] * FAR_WIDENING;
-            if t_enter > near {
-                near = t_enter;
-            }
-            if t_exit < far {
-                far = t_exit;
-            }
+            let t_enter = (enter - self.entry_origin[axis]) * self.inv_dir[axis];
+            let t_exit = (exit - self.exit_origin[axis]) * self.inv_dir[axis];
+            near = max_keeping(t_enter, near);
+            far = min_keeping(t_exit, far);
         }
-        (near <= far).then_some(near)
+        let near = (near * SHRINK).min(near * GROW);
+        let far = (far * SHRINK).max(far * GROW);
+        (near.cmple(far).bitmask(), near.to_array())
     }
+}
+
+/// Pushes the children in `mask` on `stack` at `depth`, farthest first;
+/// returns how many. Sorting them in place on the stack: building them in a
+/// separate array and copying it over stalled on store forwarding (16% of
+/// the walk's samples on the bunny).
+#[inline(always)]
+fn push_hits(
+    node: &BvhNode,
+    mask: u32,
+    near: &[f32; 4],
+    stack: &mut [Entry],
+    depth: usize,
+) -> usize {
+    let mut n = 0;
+    let mut bits = mask;
+    while bits != 0 {
+        let slot = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        let entry = Entry {
+            child: node.children[slot],
+            count: node.counts[slot],
+            t: near[slot],
+        };
+        let mut j = depth + n;
+        while j > depth && stack[j - 1].t < entry.t {
+            stack[j] = stack[j - 1];
+            j -= 1;
+        }
+        stack[j] = entry;
+        n += 1;
+    }
+    n
 }
 
 impl Bvh {
@@ -84,54 +235,55 @@ impl Bvh {
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
+        hit: impl FnMut(u32, f64) -> Option<f64>,
+    ) -> Option<f64> {
+        if self.nodes.is_empty() {
+            None
+        } else if self.max_depth <= SHALLOW {
+            self.closest::<{ stack_size(SHALLOW) }>(ray, counters, hit)
+        } else {
+            self.closest::<{ stack_size(MAX_DEPTH) }>(ray, counters, hit)
+        }
+    }
+
+    /// [`Self::intersect`] with a stack of `N` entries.
+    #[inline(always)]
+    fn closest<const N: usize>(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
         mut hit: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<f64> {
-        let root = self.nodes.first()?;
         let slabs = Slabs::new(ray);
         let mut closest = ray.t_max;
-        slabs.entry(root, closest)?;
+        let mut far = Vec4::splat(round_up(closest));
         let mut found = None;
         let mut work = TraversalCounters::default();
-        let mut stack = [(root, 0.0); MAX_DEPTH];
+        let mut stack = [Entry::default(); N];
         let mut depth = 0;
-        let mut node = root;
+        let mut current = Entry::default();
         loop {
             work.nodes += 1;
-            let first = node.first as usize;
-            if node.is_leaf() {
-                for &prim in &self.indices[first..first + node.count as usize] {
+            let first = current.child as usize;
+            if current.count > 0 {
+                for &prim in &self.indices[first..first + current.count as usize] {
                     work.primitives += 1;
                     if let Some(t) = hit(prim, closest) {
                         closest = t;
                         found = Some(t);
                     }
                 }
-            } else {
-                let (left, right) = (&self.nodes[first], &self.nodes[first + 1]);
-                match (slabs.entry(left, closest), slabs.entry(right, closest)) {
-                    (Some(t_left), Some(t_right)) => {
-                        let (near, far, t_far) = if t_left <= t_right {
-                            (left, right, t_right)
-                        } else {
-                            (right, left, t_left)
-                        };
-                        stack[depth] = (far, t_far);
-                        depth += 1;
-                        node = near;
-                        continue;
-                    }
-                    (Some(_), None) => {
-                        node = left;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        node = right;
-                        continue;
-                    }
-                    (None, None) => {}
+                far = Vec4::splat(round_up(closest));
+            } else if let Some(node) = self.nodes.get(first) {
+                let (mask, near) = slabs.test(node, far);
+                if mask != 0 {
+                    // All but the nearest stay on the stack.
+                    depth += push_hits(node, mask, &near, &mut stack, depth) - 1;
+                    current = stack[depth];
+                    continue;
                 }
             }
-            // Resume with the nearest pending node the closest hit has not
+            // Resume with the nearest pending child the closest hit has not
             // yet put out of reach.
             loop {
                 if depth == 0 {
@@ -139,9 +291,8 @@ impl Bvh {
                     return found;
                 }
                 depth -= 1;
-                let (pending, t_enter) = stack[depth];
-                if t_enter <= closest {
-                    node = pending;
+                current = stack[depth];
+                if f64::from(current.t) <= closest {
                     break;
                 }
             }
@@ -154,60 +305,70 @@ impl Bvh {
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
+        occludes: impl FnMut(u32) -> bool,
+    ) -> bool {
+        if self.nodes.is_empty() {
+            false
+        } else if self.max_depth <= SHALLOW {
+            self.any::<{ stack_size(SHALLOW) }>(ray, counters, occludes)
+        } else {
+            self.any::<{ stack_size(MAX_DEPTH) }>(ray, counters, occludes)
+        }
+    }
+
+    /// [`Self::occluded`] with a stack of `N` entries.
+    #[inline(always)]
+    fn any<const N: usize>(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
         mut occludes: impl FnMut(u32) -> bool,
     ) -> bool {
-        let Some(root) = self.nodes.first() else {
-            return false;
-        };
         let slabs = Slabs::new(ray);
-        if slabs.entry(root, ray.t_max).is_none() {
-            return false;
-        }
+        let far = Vec4::splat(round_up(ray.t_max));
         let mut work = TraversalCounters::default();
-        let mut stack = [root; MAX_DEPTH];
+        let mut stack = [Entry::default(); N];
         let mut depth = 0;
-        let mut node = root;
+        let mut current = Entry::default();
         let occluded = loop {
             work.nodes += 1;
-            let first = node.first as usize;
-            if node.is_leaf() {
-                let prims = &self.indices[first..first + node.count as usize];
+            let first = current.child as usize;
+            if current.count > 0 {
+                let prims = &self.indices[first..first + current.count as usize];
                 if prims.iter().any(|&prim| {
                     work.primitives += 1;
                     occludes(prim)
                 }) {
                     break true;
                 }
-            } else {
-                let (left, right) = (&self.nodes[first], &self.nodes[first + 1]);
-                match (slabs.entry(left, ray.t_max), slabs.entry(right, ray.t_max)) {
-                    (Some(t_left), Some(t_right)) => {
-                        let (near, far) = if t_left <= t_right {
-                            (left, right)
-                        } else {
-                            (right, left)
+            } else if let Some(node) = self.nodes.get(first) {
+                let (mask, near) = slabs.test(node, far);
+                if mask != 0 {
+                    // All but the nearest stay on the stack.
+                    // In slot order, unsorted: any hit will do, and on the
+                    // bunny's shadow rays nearest first visited more nodes
+                    // (14.9 against 14.7 a ray) and ran about 10% slower.
+                    let mut bits = mask;
+                    while bits != 0 {
+                        let slot = bits.trailing_zeros() as usize;
+                        bits &= bits - 1;
+                        stack[depth] = Entry {
+                            child: node.children[slot],
+                            count: node.counts[slot],
+                            t: near[slot],
                         };
-                        stack[depth] = far;
                         depth += 1;
-                        node = near;
-                        continue;
                     }
-                    (Some(_), None) => {
-                        node = left;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        node = right;
-                        continue;
-                    }
-                    (None, None) => {}
+                    depth -= 1;
+                    current = stack[depth];
+                    continue;
                 }
             }
             if depth == 0 {
                 break false;
             }
             depth -= 1;
-            node = stack[depth];
+            current = stack[depth];
         };
         *counters += work;
         occluded
@@ -218,6 +379,7 @@ impl Bvh {
 mod tests {
     use crate::accel::{Bvh, Linear, TraversalCounters};
     use crate::math::{Aabb, Ray, Vec3};
+    use crate::random::Rng;
 
     /// Unit cubes at x = 0, 2, 4, ...
     fn row(n: u32) -> Vec<Aabb> {
@@ -303,6 +465,135 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The BVH finds the same closest box entry as brute force, and the
+    /// same answer to any hit, for every ray; returns how many rays hit.
+    fn assert_agrees_with_brute_force(boxes: &[Aabb], rays: &[Ray]) -> usize {
+        let bvh = Bvh::build(boxes);
+        bvh.validate(boxes).unwrap();
+        let linear = Linear::build(boxes);
+        let mut counters = TraversalCounters::default();
+        let mut hits = 0;
+        for ray in rays {
+            let expected = linear.intersect(ray, &mut counters, |i, t| box_entry(boxes, ray, i, t));
+            let actual = bvh.intersect(ray, &mut counters, |i, t| box_entry(boxes, ray, i, t));
+            assert_eq!(actual, expected, "{ray:?}");
+            let occluded = |i: u32| box_entry(boxes, ray, i, ray.t_max).is_some();
+            assert_eq!(
+                bvh.occluded(ray, &mut counters, occluded),
+                expected.is_some(),
+                "{ray:?}"
+            );
+            hits += usize::from(expected.is_some());
+        }
+        hits
+    }
+
+    #[test]
+    fn far_from_the_origin_tiny_boxes_are_never_missed() {
+        // Boxes of 1e-9 to 1e-3 around points 1e4 to 1e6 from the origin,
+        // where an f32 ulp is 1e-3 to 0.06: rays from far away aimed at
+        // their centres, corners and edges, and rays starting inside them.
+        let mut rng = Rng::new(41);
+        for scale in [1e4, 1e5, 1e6] {
+            let centre = Vec3::new(scale, -0.7 * scale, 0.3 * scale);
+            let boxes: Vec<Aabb> = (0..200)
+                .map(|_| {
+                    let c = centre + rng.point_in(Vec3::splat(-1.0), Vec3::ONE);
+                    let half = Vec3::splat(10f64.powf(rng.range(-9.0, -3.0)));
+                    Aabb::new(c - half, c + half)
+                })
+                .collect();
+            let mut rays = Vec::new();
+            for b in &boxes {
+                let from = centre + rng.unit_vector() * rng.range(1.0, 2.0) * scale;
+                for target in [
+                    b.centroid(),
+                    b.min,
+                    b.max,
+                    Vec3::new(b.min.x, b.max.y, b.min.z),
+                ] {
+                    rays.push(Ray::new(from, target - from));
+                    rays.push(Ray::segment(from, target - from, 1.0));
+                }
+                rays.push(Ray::new(b.centroid(), rng.unit_vector()));
+            }
+            let hits = assert_agrees_with_brute_force(&boxes, &rays);
+            assert!(hits > rays.len() / 2, "{hits} of {}", rays.len());
+        }
+    }
+
+    #[test]
+    fn axis_parallel_rays_on_box_faces_far_from_the_origin() {
+        // Boxes with faces at coordinates f32 cannot hold, 1e5 from the
+        // origin; rays along each axis whose origins lie exactly in face
+        // planes (and on edges), with either sign of zero elsewhere.
+        let corner = |i: u32| {
+            Vec3::new(
+                1e5 + 0.1 * f64::from(i % 4),
+                -2e5 + 0.1 * f64::from(i / 4 % 4),
+                3e5 + 0.1 * f64::from(i / 16),
+            )
+        };
+        let size = Vec3::new(0.07, 0.03, 0.05);
+        let boxes: Vec<Aabb> = (0..64)
+            .map(|i| Aabb::new(corner(i), corner(i) + size))
+            .collect();
+        let mut rays = Vec::new();
+        for b in boxes.iter().step_by(5) {
+            for axis in 0..3 {
+                let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+                for (pu, pv) in [
+                    (b.min[u], b.min[v]),
+                    (b.max[u], b.max[v]),
+                    (b.min[u], b.centroid()[v]),
+                    (b.centroid()[u], b.max[v]),
+                ] {
+                    for sign in [1.0, -1.0] {
+                        for zeros in [0.0, -0.0] {
+                            let mut dir = Vec3::splat(zeros);
+                            dir[axis] = sign;
+                            let mut origin = b.centroid() - dir * 10.0;
+                            origin[u] = pu;
+                            origin[v] = pv;
+                            rays.push(Ray::new(origin, dir));
+                        }
+                    }
+                }
+            }
+        }
+        let hits = assert_agrees_with_brute_force(&boxes, &rays);
+        assert_eq!(hits, rays.len());
+    }
+
+    #[test]
+    fn directions_too_small_for_f32_and_nan_origins() {
+        let boxes: Vec<Aabb> = (0..100)
+            .map(|i| {
+                let p = Vec3::new(f64::from(i % 10), f64::from(i / 10), 0.0) * 1e-30;
+                Aabb::new(p, p + Vec3::splat(3e-31))
+            })
+            .collect();
+        let mut rays = Vec::new();
+        for i in 0..10 {
+            // Above box (i, 5), 1e-30 below it: it is reached at t = 1e9
+            // or 1e10.
+            let origin = Vec3::new(f64::from(i) * 1e-30 + 1.5e-31, 5.15e-30, -1e-30);
+            for dir in [
+                Vec3::new(1e-41, -1e-41, 1e-39),
+                Vec3::new(-1e-45, 0.0, 1e-40),
+            ] {
+                rays.push(Ray::new(origin, dir));
+                rays.push(Ray::segment(origin, dir, 2e10));
+            }
+        }
+        assert_eq!(assert_agrees_with_brute_force(&boxes, &rays), rays.len());
+        let bvh = Bvh::build(&boxes);
+        let nan = Ray::new(Vec3::new(f64::NAN, 0.0, 0.0), Vec3::X);
+        let mut counters = TraversalCounters::default();
+        assert_eq!(bvh.intersect(&nan, &mut counters, |_, _| None), None);
+        assert!(!bvh.occluded(&nan, &mut counters, |_| false));
     }
 
     #[test]

@@ -11,9 +11,10 @@ fn contains(outer: &Aabb, inner: &Aabb) -> bool {
 
 impl Bvh {
     /// Checks that every node is reached once, every primitive is referenced
-    /// exactly once, children's boxes lie inside their parent's, every
-    /// leaf's box contains its primitives' boxes, and no leaf is deeper than
-    /// the traversal stack.
+    /// exactly once, a node's child boxes lie inside the box its parent
+    /// keeps for it, every leaf's box contains its primitives' boxes, unused
+    /// slots hold the empty box, and no leaf is deeper than the traversal
+    /// stack allows.
     pub fn validate(&self, boxes: &[Aabb]) -> Result<(), String> {
         if self.indices.len() != boxes.len() {
             return Err(format!(
@@ -30,9 +31,9 @@ impl Bvh {
         }
         let mut node_seen = vec![false; self.nodes.len()];
         let mut prim_seen = vec![false; boxes.len()];
-        let mut todo = vec![(0, 0)];
+        let mut todo = vec![(0, 0, None)];
         let mut max_depth = 0;
-        while let Some((i, depth)) = todo.pop() {
+        while let Some((i, depth, parent_box)) = todo.pop() {
             if std::mem::replace(&mut node_seen[i], true) {
                 return Err(format!("node {i} is reached twice"));
             }
@@ -43,34 +44,47 @@ impl Bvh {
             }
             max_depth = max_depth.max(depth);
             let node = &self.nodes[i];
-            let bounds = node.bounds();
-            let first = node.first as usize;
-            if node.is_leaf() {
-                let Some(prims) = self.indices.get(first..first + node.count as usize) else {
-                    return Err(format!("leaf {i} lists primitives beyond the index array"));
+            for slot in 0..4 {
+                let bounds = node.child_bounds(slot);
+                if !node.is_used(slot) {
+                    if !bounds.is_empty() || node.counts[slot] != 0 {
+                        return Err(format!("unused slot {slot} of node {i} is not empty"));
+                    }
+                    continue;
+                }
+                if let Some(parent_box) = &parent_box
+                    && !contains(parent_box, &bounds)
+                {
+                    return Err(format!("slot {slot} of node {i} sticks out of its parent"));
+                }
+                let first = node.children[slot] as usize;
+                if node.counts[slot] == 0 {
+                    if first >= self.nodes.len() {
+                        return Err(format!("node {i} has a child beyond the node array"));
+                    }
+                    todo.push((first, depth + 1, Some(bounds)));
+                    continue;
+                }
+                let Some(prims) = self.indices.get(first..first + node.counts[slot] as usize)
+                else {
+                    return Err(format!(
+                        "leaf in node {i} lists primitives beyond the index array"
+                    ));
                 };
                 for &p in prims {
                     let Some(seen) = prim_seen.get_mut(p as usize) else {
                         return Err(format!(
-                            "leaf {i} holds primitive {p}, which does not exist"
+                            "a leaf in node {i} holds primitive {p}, which does not exist"
                         ));
                     };
                     if std::mem::replace(seen, true) {
                         return Err(format!("primitive {p} is referenced twice"));
                     }
                     if !contains(&bounds, &boxes[p as usize]) {
-                        return Err(format!("leaf {i} does not contain primitive {p}'s box"));
+                        return Err(format!(
+                            "a leaf in node {i} does not contain primitive {p}'s box"
+                        ));
                     }
-                }
-            } else {
-                if first + 1 >= self.nodes.len() {
-                    return Err(format!("node {i} has children beyond the node array"));
-                }
-                for child in [first, first + 1] {
-                    if !contains(&bounds, &self.nodes[child].bounds()) {
-                        return Err(format!("child {child} sticks out of its parent {i}"));
-                    }
-                    todo.push((child, depth + 1));
                 }
             }
         }
