@@ -192,6 +192,49 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn jpeg_is_decoded_and_srgb_linearised() {
+        // 16 x 8: the left half sRGB (200, 100, 50), the right half 128 grey.
+        let bytes = include_bytes!("../../tests/textures/two_blocks.jpg");
+        let image = decode_image(bytes).unwrap();
+        assert_eq!((image.width(), image.height()), (16, 8));
+        let t = super::super::ImageTexture::new(Arc::new(image));
+        let left = t.at(crate::math::DVec2::new(0.25, 0.5));
+        let right = t.at(crate::math::DVec2::new(0.75, 0.5));
+        // JPEG is lossy: allow about one 8-bit step.
+        let expected = [200, 100, 50].map(|c| f64::from(srgb_to_linear(c as f32 / 255.0)));
+        assert!(
+            (left - crate::math::Color::from(expected))
+                .abs()
+                .max_element()
+                < 0.01,
+            "{left}"
+        );
+        assert!(
+            (right - crate::math::Color::splat(0.215_860_5))
+                .abs()
+                .max_element()
+                < 0.01
+        );
+    }
+
+    #[test]
+    fn sixteen_bit_grey_png_gives_grey_texels() {
+        let mut out = Vec::new();
+        let mut encoder = png::Encoder::new(&mut out, 1, 1);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Sixteen);
+        let mut writer = encoder.write_header().unwrap();
+        writer.write_image_data(&65535u16.to_be_bytes()).unwrap();
+        writer.finish().unwrap();
+        let image = decode_image(&out).unwrap();
+        let t = super::super::ImageTexture::new(Arc::new(image));
+        assert_eq!(
+            t.at(crate::math::DVec2::splat(0.5)),
+            crate::math::Color::ONE
+        );
+    }
+
+    #[test]
     fn a_file_named_twice_is_decoded_once() {
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(dir.path().join("a.png"), png_bytes(1, 1, &[10, 20, 30])).unwrap();

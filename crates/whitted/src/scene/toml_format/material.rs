@@ -124,7 +124,7 @@ fn texture(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Texture> 
     if f.get("image").is_some() {
         return image(r, &f);
     }
-    let keys = r.check_keys(&f, &["checker"]);
+    let keys = r.check_keys(&f, &["checker", "image"]);
     let checker = r.require(&f, "checker", checker);
     keys?;
     checker
@@ -329,7 +329,7 @@ mod tests {
                 "unknown key `glow` in material `bad`; expected one of: ambient, diffuse, \
                  specular, reflection, transmission, emission, shininess, ior, fresnel",
                 "missing required key `checker` in `ambient`",
-                "unknown key `chequer` in `ambient`; expected one of: checker",
+                "unknown key `chequer` in `ambient`; expected one of: checker, image",
                 "missing required key `odd` in checker",
                 "`size` must be greater than 0, got -2",
             ]
