@@ -321,6 +321,30 @@ mod tests {
     }
 
     #[test]
+    fn maps_fill_their_slots_and_one_file_is_shared() {
+        let dir = tempfile::tempdir().unwrap();
+        let png = crate::texture::png_bytes(1, 1, &[255, 0, 0]);
+        std::fs::write(dir.path().join("red.png"), png).unwrap();
+        let source = "newmtl shiny\nKs 0.5 0.5 0.5\nillum 3\nmap_Ks -o 0.5 0.25 red.png\n\
+                      map_Ka red.png\nnewmtl lamp\nillum 0\nmap_Kd .\\red.png\n";
+        let mut images = ImageCache::default();
+        let lib = read_library(source, &dir.path().join("m.mtl"), &mut images);
+        assert!(lib.diagnostics.is_empty(), "{:?}", lib.diagnostics);
+        let shiny = &lib.materials["shiny"];
+        let Texture::Image(ks) = &shiny.specular else {
+            panic!("{:?}", shiny.specular);
+        };
+        assert_eq!(ks.offset, crate::math::DVec2::new(0.5, 0.25));
+        assert_eq!(shiny.reflection, shiny.specular);
+        assert!(matches!(shiny.ambient, Texture::Image(_)));
+        let Texture::Image(lamp) = &lib.materials["lamp"].emission else {
+            panic!("the lamp's map is not its emission");
+        };
+        assert!(std::sync::Arc::ptr_eq(&ks.data, &lamp.data));
+        assert_eq!(images.len(), 1);
+    }
+
+    #[test]
     fn bad_numbers_are_located_and_texture_maps_warned_about() {
         let lib = read("newmtl a\nKd 1 x 0\nmap_d wood.png\nNs\n");
         let text: Vec<String> = lib.diagnostics.iter().map(ToString::to_string).collect();
