@@ -2,7 +2,10 @@
 
 use std::path::{Path, PathBuf};
 
-use whitted::math::{Ray, Vec3};
+use whitted::camera::Camera;
+use whitted::math::{Color, Ray, Vec3};
+use whitted::render::{RenderOptions, render};
+use whitted::scene::obj::headlight;
 use whitted::scene::{LoadedScene, Scene, load_obj};
 use whitted::shape::RayShear;
 use whitted::texture::Texture;
@@ -91,4 +94,50 @@ fn the_kitchen_loads_with_its_33_materials() {
     assert_eq!(loaded.scene.materials.len(), 33);
     assert_eq!(loaded.scene.meshes.len(), 33);
     assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+}
+
+#[test]
+fn map_kd_shows_its_texture_under_a_head_on_light() {
+    let loaded = load("textured.obj");
+    let warnings: Vec<String> = loaded.warnings.iter().map(ToString::to_string).collect();
+    assert_eq!(warnings.len(), 2, "{warnings:?}");
+    assert!(
+        warnings[0].contains("textured.mtl:11:15: warning: cannot read the image")
+            && warnings[0].contains("missing.png`")
+            && warnings[0].contains("`Kd` keeps its constant colour"),
+        "{}",
+        warnings[0]
+    );
+    assert!(
+        warnings[1]
+            .contains("textured.mtl:12:1: warning: 1 texture map in this library not applied"),
+        "{}",
+        warnings[1]
+    );
+    let mut scene = loaded.scene;
+    // Eye 5 units in front of the quad; the 4 x 4 image spans exactly the
+    // quad, so pixel centres see (±0.25, ±0.75)-style points.
+    let fov = 2.0 * 0.2f64.atan().to_degrees();
+    scene.camera = Camera::new(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, fov).unwrap();
+    scene.lights = vec![headlight(&scene.camera)];
+    scene.settings.width = 4;
+    scene.settings.height = 4;
+    let film = render(&scene, &RenderOptions::default(), &|_| {})
+        .unwrap()
+        .image;
+    // A corner pixel sees (±0.75, ±0.75, 0): N·L = 5 / |(0.75, 0.75, 5)|.
+    let cosine = 5.0 / (25.0f64 + 2.0 * 0.75 * 0.75).sqrt();
+    for (x, y, texel) in [
+        (0, 0, Color::X),
+        (3, 0, Color::Y),
+        (0, 3, Color::Z),
+        (3, 3, Color::ONE),
+    ] {
+        let p = film.pixel(x, y);
+        let got = Color::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
+        assert!(
+            (got - texel * cosine).abs().max_element() < 1e-5,
+            "pixel ({x}, {y}): {got}"
+        );
+    }
 }

@@ -18,6 +18,7 @@
 //! and a light at the eye.
 
 mod build;
+mod maps;
 mod mtl;
 mod reader;
 mod text;
@@ -34,6 +35,7 @@ use crate::light::{Attenuation, Light};
 use crate::material::{Material, MaterialId};
 use crate::math::{Aabb, Color, Transform};
 use crate::scene::{Diagnostic, LoadedScene, RenderSettings, Scene, SceneError, Severity};
+use crate::texture::ImageCache;
 
 /// The vertical field of view of the camera framing a bare model, degrees.
 pub const DEFAULT_FOV_DEGREES: f64 = 50.0;
@@ -47,11 +49,12 @@ pub fn parse_obj(source: &str, path: &Path) -> Result<LoadedScene, SceneError> {
     let mut data = read_obj(source, path);
     let mut diagnostics = std::mem::take(&mut data.diagnostics);
     let mut materials = HashMap::new();
+    let mut images = ImageCache::default();
     for (name, span) in &data.libraries {
         let file = path.parent().unwrap_or(Path::new("")).join(name);
         match std::fs::read_to_string(&file) {
             Ok(text) => {
-                let library = read_library(&text, &file);
+                let library = read_library(&text, &file, &mut images);
                 diagnostics.extend(library.diagnostics);
                 materials.extend(library.materials);
             }

@@ -4,8 +4,11 @@
 //! [materials.floor]
 //! diffuse = { checker = { even = [1, 0, 0], odd = [1, 1, 0], size = 0.5 } }
 //!
+//! [materials.wood]                # paths are relative to the scene file
+//! diffuse = { image = "textures/wood.png", wrap = "mirror", scale = [2, 2] }
+//!
 //! [materials.glass]
-//! diffuse = 0.05                  # colour slots: [r, g, b], a grey, or a checker
+//! diffuse = 0.05                  # colour slots: [r, g, b], a grey, a checker or an image
 //! specular = 0.8
 //! shininess = 200
 //! transmission = 0.9
@@ -15,14 +18,16 @@
 //!
 //! `diffuse` defaults to a 0.8 grey and `ambient` to the diffuse value; the
 //! other colour slots default to black, `shininess` to 32, `ior` to 1 and
-//! `fresnel` to false. A checker's `size` defaults to 1.
+//! `fresnel` to false. A checker's `size` defaults to 1; an image's `wrap` to
+//! `"repeat"` (or `"clamp"`, `"mirror"`), `scale` to `[1, 1]` and `offset` to
+//! `[0, 0]`.
 
 use toml_span::value::Value;
 
-use super::reader::{Parsed, Reader, all};
+use super::reader::{Fields, Parsed, Reader, all};
 use crate::material::Material;
-use crate::math::Color;
-use crate::texture::{Checker, Texture};
+use crate::math::{Color, DVec2};
+use crate::texture::{Checker, ImageTexture, Texture, Wrap};
 
 /// The keys of a material.
 const KEYS: &[&str] = &[
@@ -102,23 +107,64 @@ fn read_material(r: &mut Reader<'_>, value: &Value<'_>, name: &str) -> Parsed<Ma
     })
 }
 
-/// A colour slot: a colour, or `{ checker = { even, odd, size } }`.
+/// A colour slot: a colour, `{ checker = { even, odd, size } }` or
+/// `{ image = "file", wrap, scale, offset }`.
 fn texture(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Texture> {
     if value.as_table().is_none() {
         if value.as_str().is_some() || value.as_bool().is_some() {
             return Err(r.wrong_type(
                 value,
                 key,
-                "a colour ([r, g, b], a number or { checker = { ... } })",
+                "a colour ([r, g, b], a number, { checker = { ... } } or { image = \"...\" })",
             ));
         }
         return r.color(value, key).map(Texture::Constant);
     }
     let f = r.table(value, key, format!("`{key}`"))?;
-    let keys = r.check_keys(&f, &["checker"]);
+    if f.get("image").is_some() {
+        return image(r, &f);
+    }
+    let keys = r.check_keys(&f, &["checker", "image"]);
     let checker = r.require(&f, "checker", checker);
     keys?;
     checker
+}
+
+/// `{ image = "file", wrap = "repeat", scale = [su, sv], offset = [ou, ov] }`.
+fn image(r: &mut Reader<'_>, f: &Fields<'_, '_>) -> Parsed<Texture> {
+    let keys = r.check_keys(f, &["image", "wrap", "scale", "offset"]);
+    let data = r.require(f, "image", |r, value, key| {
+        let (name, span) = r.string(value, key)?;
+        r.image(name, span)
+    });
+    let wrap = r.or_default(f, "wrap", Wrap::Repeat, wrap);
+    let scale = r.or_default(f, "scale", [1.0, 1.0], |r, v, k| {
+        r.numbers::<2>(v, k, Reader::number)
+    });
+    let offset = r.or_default(f, "offset", [0.0, 0.0], |r, v, k| {
+        r.numbers::<2>(v, k, Reader::number)
+    });
+    keys?;
+    Ok(Texture::Image(ImageTexture {
+        data: data?,
+        wrap: wrap?,
+        scale: DVec2::from_array(scale?),
+        offset: DVec2::from_array(offset?),
+    }))
+}
+
+/// `"repeat"`, `"clamp"` or `"mirror"`.
+fn wrap(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Wrap> {
+    let (name, span) = r.string(value, key)?;
+    match name {
+        "repeat" => Ok(Wrap::Repeat),
+        "clamp" => Ok(Wrap::Clamp),
+        "mirror" => Ok(Wrap::Mirror),
+        _ => Err(r.error(
+            span,
+            format!("unknown wrap mode `{name}`; expected one of: repeat, clamp, mirror"),
+        )),
+    }
 }
 
 /// `{ even = colour, odd = colour, size = s }`.
@@ -138,8 +184,12 @@ fn checker(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Texture> 
 
 #[cfg(test)]
 mod tests {
+    use std::path::Path;
+    use std::sync::Arc;
+
     use super::super::tests::{CAMERA, errors, scene};
     use super::*;
+    use crate::scene::SceneError;
 
     #[test]
     fn defaults_are_a_matte_grey_with_ambient_following_diffuse() {
@@ -200,6 +250,58 @@ mod tests {
     }
 
     #[test]
+    fn image_slots_are_read_relative_to_the_scene_and_decoded_once() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("textures")).unwrap();
+        let png = crate::texture::png_bytes(1, 1, &[255, 255, 255]);
+        std::fs::write(dir.path().join("textures/white.png"), png).unwrap();
+        let source = format!(
+            "{CAMERA}[materials.a]\ndiffuse = {{ image = 'textures/white.png' }}\n\
+             [materials.b]\nemission = {{ image = 'textures/./white.png', wrap = 'mirror', \
+             scale = [2, 3], offset = [0.5, -1] }}\n"
+        );
+        let s = super::super::parse_scene(&source, &dir.path().join("s.toml")).unwrap();
+        let (Texture::Image(a), Texture::Image(b)) =
+            (&s.materials[0].diffuse, &s.materials[1].emission)
+        else {
+            panic!("not images: {:?}", s.materials);
+        };
+        assert!(Arc::ptr_eq(&a.data, &b.data));
+        assert_eq!(
+            (a.wrap, a.scale, a.offset),
+            (Wrap::Repeat, DVec2::ONE, DVec2::ZERO)
+        );
+        assert_eq!(
+            (b.wrap, b.scale, b.offset),
+            (Wrap::Mirror, DVec2::new(2.0, 3.0), DVec2::new(0.5, -1.0))
+        );
+        assert_eq!(a.at(DVec2::splat(0.5)), Color::ONE);
+    }
+
+    #[test]
+    fn a_missing_image_is_an_error_at_its_name() {
+        let source = format!(
+            "{CAMERA}[materials.a]\ndiffuse = {{ image = 'no/such.png', wrap = 'tile' }}\n"
+        );
+        let error = super::super::parse_scene(&source, Path::new("dir/s.toml")).unwrap_err();
+        let SceneError::Invalid { diagnostics } = error else {
+            panic!("{error}");
+        };
+        let text: Vec<String> = diagnostics.iter().map(ToString::to_string).collect();
+        assert!(
+            text[0].starts_with(
+                "dir/s.toml:5:21: error: cannot read the image `dir/no/such.png`: \
+                 No such file or directory (os error 2)"
+            ),
+            "{text:?}"
+        );
+        assert_eq!(
+            diagnostics[1].message,
+            "unknown wrap mode `tile`; expected one of: repeat, clamp, mirror"
+        );
+    }
+
+    #[test]
     fn materials_keep_the_order_of_the_file() {
         let s = scene(&format!(
             "{CAMERA}[materials.zinc]\nior = 2\n[materials.amber]\nior = 3\n"
@@ -218,8 +320,8 @@ mod tests {
                  emission = {{ checker = {{ even = 1, size = -2 }} }}\n"
             )),
             [
-                "expected a colour ([r, g, b], a number or { checker = { ... } }) for \
-                 `diffuse`, found a string",
+                "expected a colour ([r, g, b], a number, { checker = { ... } } or \
+                 { image = \"...\" }) for `diffuse`, found a string",
                 "expected 3 numbers for `specular`, found 2",
                 "`shininess` must not be negative, got -1",
                 "`ior` must be greater than 0, got 0",
@@ -227,7 +329,7 @@ mod tests {
                 "unknown key `glow` in material `bad`; expected one of: ambient, diffuse, \
                  specular, reflection, transmission, emission, shininess, ior, fresnel",
                 "missing required key `checker` in `ambient`",
-                "unknown key `chequer` in `ambient`; expected one of: checker",
+                "unknown key `chequer` in `ambient`; expected one of: checker, image",
                 "missing required key `odd` in checker",
                 "`size` must be greater than 0, got -2",
             ]

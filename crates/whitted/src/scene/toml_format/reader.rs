@@ -7,12 +7,14 @@
 //! other are all run before their results are combined with `?`.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use toml_span::Span;
 use toml_span::value::{Key, Table, Value};
 
 use crate::math::{Color, Vec3, unit};
 use crate::scene::{Diagnostic, SceneError};
+use crate::texture::{ImageCache, ImageData};
 
 /// A value was wrong and its error has been recorded. Only [`Reader::error`]
 /// makes one, so a failed walk always has at least one diagnostic.
@@ -38,6 +40,8 @@ pub(super) struct Reader<'s> {
     source: &'s str,
     path: &'s Path,
     diagnostics: Vec<Diagnostic>,
+    /// Images decoded so far, shared by every material naming them.
+    images: ImageCache,
 }
 
 /// A TOML table being read, with what to call it in messages.
@@ -102,7 +106,17 @@ impl<'s> Reader<'s> {
             source,
             path,
             diagnostics: Vec::new(),
+            images: ImageCache::default(),
         }
+    }
+
+    /// The image file named `name` (relative to the scene file), decoded
+    /// once; an error at `span` naming the file when it cannot be read.
+    pub(super) fn image(&mut self, name: &str, span: Span) -> Parsed<Arc<ImageData>> {
+        let file = self.path.parent().unwrap_or(Path::new("")).join(name);
+        self.images
+            .load(&file)
+            .map_err(|error| self.error(span, error.to_string()))
     }
 
     /// Records an error at `span`.

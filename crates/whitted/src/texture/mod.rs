@@ -1,10 +1,20 @@
-//! Colour sources for material slots: a constant colour or a procedural
-//! checkerboard over the surface's (u, v) coordinates.
+//! Colour sources for material slots: a constant colour, a procedural
+//! checkerboard or an image, over the surface's (u, v) coordinates.
 //!
-//! Scene syntax: a colour slot takes `[r, g, b]`, a single number (grey), or
+//! Scene syntax: a colour slot takes `[r, g, b]`, a single number (grey),
 //! `{ checker = { even = [r, g, b], odd = [r, g, b], size = s } }` where `s`
-//! is the side of one square in (u, v) units.
+//! is the side of one square in (u, v) units, or
+//! `{ image = "wood.png", wrap = "repeat", scale = [su, sv], offset = [ou, ov] }`.
 
+mod checker;
+mod decode;
+mod image;
+
+pub use self::checker::Checker;
+#[cfg(test)]
+pub(crate) use self::decode::tests::png_bytes;
+pub use self::decode::{ImageCache, ImageLoadError, decode_image};
+pub use self::image::{ImageData, ImageTexture, Wrap};
 use crate::math::{Color, DVec2};
 
 /// What a material slot's colour is at a surface point.
@@ -14,6 +24,8 @@ pub enum Texture {
     Constant(Color),
     /// Alternating squares in (u, v).
     Checker(Checker),
+    /// A PNG or JPEG image, filtered bilinearly.
+    Image(ImageTexture),
 }
 
 impl Default for Texture {
@@ -28,33 +40,14 @@ impl From<Color> for Texture {
     }
 }
 
-/// A checkerboard in texture space.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Checker {
-    /// Colour of the square containing (0, 0).
-    pub even: Color,
-    /// Colour of its neighbours.
-    pub odd: Color,
-    /// Side of one square, in (u, v) units (positive).
-    pub size: f64,
-}
-
 impl Texture {
     /// The colour at texture coordinates `uv`.
     #[inline]
     pub fn at(&self, uv: DVec2) -> Color {
         match self {
             Texture::Constant(c) => *c,
-            Texture::Checker(checker) => {
-                let cell = (uv / checker.size).floor();
-                // Cells are summed as floats: exact for any cell index a
-                // render can reach (|index| < 2^52).
-                if (cell.x + cell.y).rem_euclid(2.0) == 0.0 {
-                    checker.even
-                } else {
-                    checker.odd
-                }
-            }
+            Texture::Checker(checker) => checker.at(uv),
+            Texture::Image(image) => image.at(uv),
         }
     }
 
@@ -63,6 +56,7 @@ impl Texture {
         match self {
             Texture::Constant(c) => *c == Color::ZERO,
             Texture::Checker(c) => c.even == Color::ZERO && c.odd == Color::ZERO,
+            Texture::Image(image) => image.max_component() == 0.0,
         }
     }
 
@@ -71,6 +65,7 @@ impl Texture {
         match self {
             Texture::Constant(c) => c.max_element(),
             Texture::Checker(c) => c.even.max_element().max(c.odd.max_element()),
+            Texture::Image(image) => image.max_component(),
         }
     }
 }

@@ -1,0 +1,261 @@
+//! Reading PNG and JPEG files into linear RGB texels, each file once.
+//!
+//! PNG is decoded by the `png` crate, JPEG by `zune-jpeg`. Both formats are
+//! taken as sRGB-encoded (the PNG default and what JPEG cameras and editors
+//! write): every 8- or 16-bit sample goes through the sRGB transfer curve to
+//! linear light. Alpha is ignored.
+
+use std::collections::HashMap;
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use super::image::ImageData;
+
+/// Why an image file gave no texture.
+#[derive(Debug, thiserror::Error)]
+pub enum ImageLoadError {
+    /// The file could not be read.
+    #[error("cannot read the image `{}`: {source}", path.display())]
+    Io {
+        /// The file as named.
+        path: PathBuf,
+        /// What the system said.
+        source: std::io::Error,
+    },
+    /// The file is not a PNG or JPEG image we can decode.
+    #[error("cannot decode the image `{}`: {reason}", path.display())]
+    Decode {
+        /// The file as named.
+        path: PathBuf,
+        /// What the decoder said.
+        reason: String,
+    },
+}
+
+/// Decoded images by canonical path, so that every material naming a file
+/// shares one copy of its texels.
+#[derive(Debug, Default)]
+pub struct ImageCache {
+    images: HashMap<PathBuf, Arc<ImageData>>,
+}
+
+impl ImageCache {
+    /// The texels of the file at `path`, decoded on first use.
+    pub fn load(&mut self, path: &Path) -> Result<Arc<ImageData>, ImageLoadError> {
+        let io = |source| ImageLoadError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let canonical = path.canonicalize().map_err(io)?;
+        if let Some(image) = self.images.get(&canonical) {
+            return Ok(Arc::clone(image));
+        }
+        let bytes = std::fs::read(&canonical).map_err(io)?;
+        let image = Arc::new(
+            decode_image(&bytes).map_err(|reason| ImageLoadError::Decode {
+                path: path.to_path_buf(),
+                reason,
+            })?,
+        );
+        self.images.insert(canonical, Arc::clone(&image));
+        Ok(image)
+    }
+
+    /// How many distinct files were decoded.
+    pub fn len(&self) -> usize {
+        self.images.len()
+    }
+
+    /// True when no file was decoded.
+    pub fn is_empty(&self) -> bool {
+        self.images.is_empty()
+    }
+}
+
+/// Decodes a PNG or JPEG file's bytes, told apart by their signature.
+pub fn decode_image(bytes: &[u8]) -> Result<ImageData, String> {
+    if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
+        decode_png(bytes)
+    } else if bytes.starts_with(&[0xff, 0xd8]) {
+        decode_jpeg(bytes)
+    } else {
+        Err("not a PNG or JPEG file".to_string())
+    }
+}
+
+fn decode_png(bytes: &[u8]) -> Result<ImageData, String> {
+    let mut decoder = png::Decoder::new(Cursor::new(bytes));
+    decoder.set_transformations(png::Transformations::EXPAND);
+    let mut reader = decoder.read_info().map_err(|e| e.to_string())?;
+    let size = reader
+        .output_buffer_size()
+        .ok_or("the image is too large")?;
+    let mut buffer = vec![0; size];
+    let info = reader.next_frame(&mut buffer).map_err(|e| e.to_string())?;
+    let channels = match info.color_type {
+        png::ColorType::Grayscale => 1,
+        png::ColorType::GrayscaleAlpha => 2,
+        png::ColorType::Rgb => 3,
+        png::ColorType::Rgba => 4,
+        png::ColorType::Indexed => return Err("unexpanded palette".to_string()),
+    };
+    let (width, height) = (info.width as usize, info.height as usize);
+    let wide = info.bit_depth == png::BitDepth::Sixteen;
+    let sample_bytes = if wide { 2 } else { 1 };
+    let table = srgb_table();
+    let sample = |at: &[u8]| -> f32 {
+        if wide {
+            srgb_to_linear(f32::from(u16::from_be_bytes([at[0], at[1]])) / 65535.0)
+        } else {
+            table[usize::from(at[0])]
+        }
+    };
+    let mut texels = Vec::with_capacity(width * height);
+    for row in buffer.chunks(info.line_size).take(height) {
+        for pixel in row.chunks_exact(channels * sample_bytes).take(width) {
+            let value = |channel: usize| sample(&pixel[channel * sample_bytes..]);
+            texels.push(if channels < 3 {
+                [value(0); 3]
+            } else {
+                [value(0), value(1), value(2)]
+            });
+        }
+    }
+    ImageData::new(width, height, texels).ok_or_else(|| "the image data is truncated".to_string())
+}
+
+fn decode_jpeg(bytes: &[u8]) -> Result<ImageData, String> {
+    use zune_jpeg::zune_core::bytestream::ZCursor;
+    use zune_jpeg::zune_core::colorspace::ColorSpace;
+    use zune_jpeg::zune_core::options::DecoderOptions;
+    let options = DecoderOptions::default().jpeg_set_out_colorspace(ColorSpace::RGB);
+    let mut decoder = zune_jpeg::JpegDecoder::new_with_options(ZCursor::new(bytes), options);
+    let pixels = decoder.decode().map_err(|e| e.to_string())?;
+    let (width, height) = decoder.dimensions().ok_or("no image size")?;
+    let table = srgb_table();
+    let texels = pixels
+        .chunks_exact(3)
+        .map(|p| [0, 1, 2].map(|c| table[usize::from(p[c])]))
+        .collect();
+    ImageData::new(width, height, texels).ok_or_else(|| "the image data is truncated".to_string())
+}
+
+/// The sRGB transfer curve, from an encoded value in [0, 1] to linear light.
+pub(crate) fn srgb_to_linear(encoded: f32) -> f32 {
+    if encoded <= 0.04045 {
+        encoded / 12.92
+    } else {
+        ((encoded + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// [`srgb_to_linear`] of every 8-bit value.
+fn srgb_table() -> [f32; 256] {
+    std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0))
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// An 8-bit RGB PNG of `width × height` texels, row by row from the top.
+    pub(crate) fn png_bytes(width: u32, height: u32, rgb: &[u8]) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut encoder = png::Encoder::new(&mut out, width, height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().unwrap();
+        writer.write_image_data(rgb).unwrap();
+        writer.finish().unwrap();
+        out
+    }
+
+    #[test]
+    fn eight_bit_samples_are_srgb_decoded() {
+        let image = decode_image(&png_bytes(2, 1, &[0, 128, 255, 188, 188, 188])).unwrap();
+        let t = |x| {
+            super::super::ImageTexture::new(Arc::new(image.clone()))
+                .at(crate::math::DVec2::new((f64::from(x) + 0.5) / 2.0, 0.5))
+        };
+        // sRGB 128 is 0.2158605 linear; 188 is 0.5028865.
+        let left = t(0);
+        assert_eq!(left.x, 0.0);
+        assert!((left.y - 0.215_860_5).abs() < 1e-6, "{left}");
+        assert!((left.z - 1.0).abs() < 1e-6);
+        assert!(
+            (t(1) - crate::math::Color::splat(0.502_886_5))
+                .abs()
+                .max_element()
+                < 1e-6
+        );
+    }
+
+    #[test]
+    fn jpeg_is_decoded_and_srgb_linearised() {
+        // 16 x 8: the left half sRGB (200, 100, 50), the right half 128 grey.
+        let bytes = include_bytes!("../../tests/textures/two_blocks.jpg");
+        let image = decode_image(bytes).unwrap();
+        assert_eq!((image.width(), image.height()), (16, 8));
+        let t = super::super::ImageTexture::new(Arc::new(image));
+        let left = t.at(crate::math::DVec2::new(0.25, 0.5));
+        let right = t.at(crate::math::DVec2::new(0.75, 0.5));
+        // JPEG is lossy: allow about one 8-bit step.
+        let expected = [200, 100, 50].map(|c| f64::from(srgb_to_linear(c as f32 / 255.0)));
+        assert!(
+            (left - crate::math::Color::from(expected))
+                .abs()
+                .max_element()
+                < 0.01,
+            "{left}"
+        );
+        assert!(
+            (right - crate::math::Color::splat(0.215_860_5))
+                .abs()
+                .max_element()
+                < 0.01
+        );
+    }
+
+    #[test]
+    fn sixteen_bit_grey_png_gives_grey_texels() {
+        let mut out = Vec::new();
+        let mut encoder = png::Encoder::new(&mut out, 1, 1);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Sixteen);
+        let mut writer = encoder.write_header().unwrap();
+        writer.write_image_data(&65535u16.to_be_bytes()).unwrap();
+        writer.finish().unwrap();
+        let image = decode_image(&out).unwrap();
+        let t = super::super::ImageTexture::new(Arc::new(image));
+        assert_eq!(
+            t.at(crate::math::DVec2::splat(0.5)),
+            crate::math::Color::ONE
+        );
+    }
+
+    #[test]
+    fn a_file_named_twice_is_decoded_once() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("a.png"), png_bytes(1, 1, &[10, 20, 30])).unwrap();
+        let mut cache = ImageCache::default();
+        let first = cache.load(&dir.path().join("a.png")).unwrap();
+        let second = cache.load(&dir.path().join(".").join("a.png")).unwrap();
+        assert!(Arc::ptr_eq(&first, &second));
+        assert_eq!(cache.len(), 1);
+    }
+
+    #[test]
+    fn missing_and_foreign_files_say_why() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut cache = ImageCache::default();
+        let missing = cache.load(&dir.path().join("none.png")).unwrap_err();
+        assert!(matches!(missing, ImageLoadError::Io { .. }));
+        std::fs::write(dir.path().join("text.png"), "hello").unwrap();
+        let text = cache.load(&dir.path().join("text.png")).unwrap_err();
+        assert!(
+            text.to_string()
+                .ends_with("text.png`: not a PNG or JPEG file")
+        );
+    }
+}

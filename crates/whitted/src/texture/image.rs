@@ -1,0 +1,246 @@
+//! Image textures: linear RGB texels shared between materials, sampled
+//! with bilinear filtering.
+//!
+//! Texture coordinates follow the OBJ convention: `u` runs left to right and
+//! `v` bottom to top, so `v = 0` is the bottom row of the image and `v = 1`
+//! its top. Texel `(x, y)` (row `y` counted from the top) has its centre at
+//! `u = (x + 0.5) / width`, `v = 1 - (y + 0.5) / height`.
+
+use std::fmt;
+use std::sync::Arc;
+
+use crate::math::{Color, DVec2};
+
+/// Decoded texels in linear RGB, row 0 at the top of the image.
+#[derive(Clone, PartialEq)]
+pub struct ImageData {
+    width: usize,
+    height: usize,
+    texels: Vec<[f32; 3]>,
+    max_component: f64,
+}
+
+impl fmt::Debug for ImageData {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "ImageData({}x{})", self.width, self.height)
+    }
+}
+
+impl ImageData {
+    /// An image of `width × height` linear RGB texels, row by row from the
+    /// top; `None` when a side is zero or the count does not match.
+    pub fn new(width: usize, height: usize, texels: Vec<[f32; 3]>) -> Option<Self> {
+        if width == 0 || height == 0 || width.checked_mul(height) != Some(texels.len()) {
+            return None;
+        }
+        let max_component = texels
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, &c| m.max(f64::from(c)));
+        Some(Self {
+            width,
+            height,
+            texels,
+            max_component,
+        })
+    }
+
+    /// Width in texels.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Height in texels.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// The texel in column `x`, row `y` from the top (both in range).
+    fn texel(&self, x: usize, y: usize) -> Color {
+        let [r, g, b] = self.texels[y * self.width + x];
+        Color::new(f64::from(r), f64::from(g), f64::from(b))
+    }
+}
+
+/// What lies outside `[0, 1]` in (u, v).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Wrap {
+    /// The image tiles the plane.
+    #[default]
+    Repeat,
+    /// The edge texels extend outwards.
+    Clamp,
+    /// The image tiles the plane, every other copy mirrored.
+    Mirror,
+}
+
+impl Wrap {
+    /// The texel index in `0..n` for any integer index `i`.
+    fn index(self, i: i64, n: usize) -> usize {
+        let n = n as i64;
+        let wrapped = match self {
+            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::Clamp => i.clamp(0, n - 1),
+            Wrap::Mirror => {
+                let m = i.rem_euclid(2 * n);
+                if m < n { m } else { 2 * n - 1 - m }
+            }
+        };
+        wrapped as usize
+    }
+}
+
+/// An image placed on a surface: `(u, v)` maps to image coordinates
+/// `(u, v) · scale + offset`.
+#[derive(Clone, Debug)]
+pub struct ImageTexture {
+    /// The shared texels.
+    pub data: Arc<ImageData>,
+    /// What lies outside the image.
+    pub wrap: Wrap,
+    /// Multiplies (u, v) (MTL `-s`).
+    pub scale: DVec2,
+    /// Added to (u, v) after scaling (MTL `-o`).
+    pub offset: DVec2,
+}
+
+impl PartialEq for ImageTexture {
+    /// The same placement of the same shared image (or of equal texels).
+    fn eq(&self, other: &Self) -> bool {
+        (Arc::ptr_eq(&self.data, &other.data) || self.data == other.data)
+            && self.wrap == other.wrap
+            && self.scale == other.scale
+            && self.offset == other.offset
+    }
+}
+
+impl ImageTexture {
+    /// The whole image once over the unit square, repeated outside it.
+    pub fn new(data: Arc<ImageData>) -> Self {
+        Self {
+            data,
+            wrap: Wrap::Repeat,
+            scale: DVec2::ONE,
+            offset: DVec2::ZERO,
+        }
+    }
+
+    /// The bilinearly filtered colour at texture coordinates `uv`.
+    pub fn at(&self, uv: DVec2) -> Color {
+        let st = uv * self.scale + self.offset;
+        let data = &self.data;
+        let x = st.x * data.width as f64 - 0.5;
+        let y = (1.0 - st.y) * data.height as f64 - 0.5;
+        if !(x.is_finite() && y.is_finite()) {
+            return Color::ZERO;
+        }
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        // Saturating float-to-int casts: coordinates beyond ±2^63 texels
+        // land on the edge, which no render reaches.
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let xs = [x0, x0.saturating_add(1)].map(|i| self.wrap.index(i, data.width));
+        let ys = [y0, y0.saturating_add(1)].map(|i| self.wrap.index(i, data.height));
+        let top = data.texel(xs[0], ys[0]) * (1.0 - fx) + data.texel(xs[1], ys[0]) * fx;
+        let bottom = data.texel(xs[0], ys[1]) * (1.0 - fx) + data.texel(xs[1], ys[1]) * fx;
+        top * (1.0 - fy) + bottom * fy
+    }
+
+    /// The largest component of any texel.
+    pub fn max_component(&self) -> f64 {
+        self.data.max_component
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Row 0 (top): red, green; row 1 (bottom): blue, white.
+    fn two_by_two(wrap: Wrap) -> ImageTexture {
+        let texels = vec![
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [1.0, 1.0, 1.0],
+        ];
+        let data = ImageData::new(2, 2, texels).unwrap();
+        ImageTexture {
+            wrap,
+            ..ImageTexture::new(Arc::new(data))
+        }
+    }
+
+    fn close(a: Color, b: Color) -> bool {
+        (a - b).abs().max_element() < 1e-12
+    }
+
+    #[test]
+    fn texel_centres_give_the_texels_with_v_zero_at_the_bottom() {
+        let t = two_by_two(Wrap::Repeat);
+        assert!(close(t.at(DVec2::new(0.25, 0.75)), Color::X));
+        assert!(close(t.at(DVec2::new(0.75, 0.75)), Color::Y));
+        assert!(close(t.at(DVec2::new(0.25, 0.25)), Color::Z));
+        assert!(close(t.at(DVec2::new(0.75, 0.25)), Color::ONE));
+    }
+
+    #[test]
+    fn halfway_between_texels_gives_their_mean() {
+        let t = two_by_two(Wrap::Clamp);
+        assert!(close(
+            t.at(DVec2::new(0.5, 0.75)),
+            Color::new(0.5, 0.5, 0.0)
+        ));
+        assert!(close(
+            t.at(DVec2::new(0.25, 0.5)),
+            Color::new(0.5, 0.0, 0.5)
+        ));
+        assert!(close(t.at(DVec2::new(0.5, 0.5)), Color::new(0.5, 0.5, 0.5)));
+    }
+
+    #[test]
+    fn repeat_tiles_and_blends_across_the_edge() {
+        let t = two_by_two(Wrap::Repeat);
+        assert!(close(t.at(DVec2::new(1.25, -0.75)), Color::Z));
+        // At u = 0 the left and right columns of the top row meet.
+        assert!(close(
+            t.at(DVec2::new(0.0, 0.75)),
+            Color::new(0.5, 0.5, 0.0)
+        ));
+    }
+
+    #[test]
+    fn clamp_extends_the_edge_texels() {
+        let t = two_by_two(Wrap::Clamp);
+        assert!(close(t.at(DVec2::new(0.0, 0.75)), Color::X));
+        assert!(close(t.at(DVec2::new(-3.0, 0.75)), Color::X));
+        assert!(close(t.at(DVec2::new(7.0, -2.0)), Color::ONE));
+    }
+
+    #[test]
+    fn mirror_reflects_every_other_copy() {
+        let t = two_by_two(Wrap::Mirror);
+        // Just right of u = 1 is the mirrored copy: green first.
+        assert!(close(t.at(DVec2::new(1.25, 0.75)), Color::Y));
+        assert!(close(t.at(DVec2::new(1.75, 0.75)), Color::X));
+        assert!(close(t.at(DVec2::new(2.25, 0.75)), Color::X));
+        assert!(close(t.at(DVec2::new(1.0, 0.75)), Color::Y));
+    }
+
+    #[test]
+    fn scale_and_offset_move_the_image() {
+        let t = ImageTexture {
+            scale: DVec2::splat(2.0),
+            offset: DVec2::new(0.5, 0.0),
+            ..two_by_two(Wrap::Repeat)
+        };
+        // (0.125, 0.375) · 2 + (0.5, 0) = (0.75, 0.75): green.
+        assert!(close(t.at(DVec2::new(0.125, 0.375)), Color::Y));
+    }
+
+    #[test]
+    fn mismatched_sizes_are_refused() {
+        assert!(ImageData::new(2, 2, vec![[0.0; 3]; 3]).is_none());
+        assert!(ImageData::new(0, 0, Vec::new()).is_none());
+    }
+}
