@@ -469,6 +469,10 @@ impl Bins {
 
     /// Puts every primitive in its bin along each axis, in one pass (one
     /// pass per axis made the whole build run 12% more instructions).
+    /// Binning nodes of 16k primitives or more in parallel chunks of 8k,
+    /// merging the chunks' bins (exactly, so still deterministic), was not
+    /// faster: bunny 37.0 against 35.7 ms (best of 10, back to back, two
+    /// shared cores), the dragon within noise.
     fn fill(&mut self, builder: &Builder, prims: &[u32], planes: &[Plane; 3]) {
         let bins = planes[0].bins;
         for axis in 0..3 {
