@@ -87,10 +87,19 @@ pub struct Geometry<'a> {
 }
 
 /// A world-space ray with what the triangle test needs of it, computed once
-/// per query.
+/// per query when the scene has mesh triangles (a scene of analytic shapes
+/// does not pay for it).
 struct Query<'r> {
     ray: &'r Ray,
-    shear: RayShear,
+    shear: Option<RayShear>,
+}
+
+impl Query<'_> {
+    /// The ray's shear for the triangle test.
+    #[inline]
+    fn shear(&self) -> RayShear {
+        self.shear.unwrap_or_else(|| RayShear::new(self.ray))
+    }
 }
 
 impl<'a> Geometry<'a> {
@@ -157,6 +166,15 @@ impl<'a> Geometry<'a> {
         id.map(|id| &self.transforms[id.0 as usize])
     }
 
+    /// A query for `ray`, with the shear precomputed if triangles may need it.
+    #[inline]
+    fn query<'r>(&self, ray: &'r Ray) -> Query<'r> {
+        Query {
+            ray,
+            shear: (!self.instances.is_empty()).then(|| RayShear::new(ray)),
+        }
+    }
+
     /// Primitive `index` hit by the query's ray, closer than `t_max`.
     #[inline]
     fn intersect_primitive(&self, index: u32, query: &Query, t_max: f64) -> Option<ShapeHit> {
@@ -178,7 +196,7 @@ impl<'a> Geometry<'a> {
                         let local = t.ray_to_object(&ray);
                         mesh.intersect(triangle, &local, &RayShear::new(&local))
                     }
-                    None => mesh.intersect(triangle, &ray, &query.shear),
+                    None => mesh.intersect(triangle, &ray, &query.shear()),
                 }
             }
         }
@@ -192,7 +210,7 @@ impl<'a> Geometry<'a> {
             Some([p0, p1, p2]) => {
                 let mut ray = *query.ray;
                 ray.t_max = t_max;
-                watertight(*p0, *p1, *p2, &ray, &query.shear)
+                watertight(*p0, *p1, *p2, &ray, &query.shear())
             }
             None => self.intersect_primitive(index, query, t_max),
         }
@@ -242,10 +260,7 @@ impl<'a> Geometry<'a> {
 
     /// The closest hit, adding the traversal work to `counters`.
     pub fn intersect_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> Option<Hit> {
-        let query = Query {
-            ray,
-            shear: RayShear::new(ray),
-        };
+        let query = self.query(ray);
         let mut best: Option<Hit> = None;
         let mut t_max = ray.t_max;
         for &i in &self.unbounded {
@@ -278,10 +293,7 @@ impl<'a> Geometry<'a> {
 
     /// Any hit, adding the traversal work to `counters`.
     pub fn occluded_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> bool {
-        let query = Query {
-            ray,
-            shear: RayShear::new(ray),
-        };
+        let query = self.query(ray);
         self.unbounded.iter().any(|&i| self.occluded_by(i, &query))
             || self.accel.occluded(ray, counters, |slot| {
                 let i = self.bounded[slot as usize];
