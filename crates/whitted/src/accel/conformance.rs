@@ -55,6 +55,19 @@ fn random_triangle(rng: &mut Rng, around: Vec3, size: f64) -> TestPrimitive {
     }
 }
 
+/// `n` seeded random boxes: centres uniform in the cube of half-side
+/// `spread` around the origin, half-extents between 5% and 100% of `size`
+/// per axis. Shared by the structures' own tests.
+pub(crate) fn random_boxes(rng: &mut Rng, n: usize, spread: f64, size: f64) -> Vec<Aabb> {
+    (0..n)
+        .map(|_| {
+            let c = rng.point_in(Vec3::splat(-spread), Vec3::splat(spread));
+            let half = size * rng.point_in(Vec3::splat(0.05), Vec3::ONE);
+            Aabb::new(c - half, c + half)
+        })
+        .collect()
+}
+
 /// The named test scenes.
 fn scenes() -> Vec<(&'static str, Vec<TestPrimitive>)> {
     let mut rng = Rng::new(2024);

@@ -106,19 +106,9 @@ mod tests {
     use super::*;
     use crate::accel::AccelKind;
     use crate::accel::conformance::assert_conforms;
+    use crate::accel::conformance::random_boxes;
     use crate::math::Vec3;
     use crate::random::Rng;
-
-    fn random_boxes(seed: u64, n: usize) -> Vec<Aabb> {
-        let mut rng = Rng::new(seed);
-        (0..n)
-            .map(|_| {
-                let c = rng.point_in(Vec3::splat(-100.0), Vec3::splat(100.0));
-                let half = rng.point_in(Vec3::ZERO, Vec3::splat(2.0));
-                Aabb::new(c - half, c + half)
-            })
-            .collect()
-    }
 
     fn assert_valid(name: &str, boxes: &[Aabb], params: &BvhBuildParams) -> Bvh {
         let bvh = Bvh::build_with(boxes, params);
@@ -137,7 +127,11 @@ mod tests {
     fn builds_are_valid_for_random_inputs_of_many_sizes() {
         for n in [0, 1, 2, 3, 7, 8, 9, 100, 1000, 20_000] {
             for params in [BvhBuildParams::default(), BvhBuildParams::fastest_build()] {
-                let bvh = assert_valid(&format!("{n} boxes"), &random_boxes(n as u64, n), &params);
+                let bvh = assert_valid(
+                    &format!("{n} boxes"),
+                    &random_boxes(&mut Rng::new(n as u64), n, 100.0, 2.0),
+                    &params,
+                );
                 assert_eq!(bvh.stats().references, n);
             }
         }
@@ -207,7 +201,7 @@ mod tests {
 
     #[test]
     fn same_tree_whatever_the_thread_count() {
-        let boxes = random_boxes(11, 20_000);
+        let boxes = random_boxes(&mut Rng::new(11), 20_000, 100.0, 2.0);
         let reference = Bvh::build(&boxes);
         assert_eq!(Bvh::build(&boxes), reference);
         for threads in [1, 2] {
@@ -240,7 +234,7 @@ mod tests {
                 boxes.push(Aabb::new(c, c + Vec3::splat(0.05)));
             }
         }
-        boxes.extend(random_boxes(18, 200));
+        boxes.extend(random_boxes(&mut Rng::new(18), 200, 100.0, 2.0));
         let sah = Bvh::build(&boxes).stats().sah_cost;
         let median = Bvh::build_with(&boxes, &BvhBuildParams::fastest_build())
             .stats()

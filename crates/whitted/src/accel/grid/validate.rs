@@ -100,24 +100,13 @@ impl Grid {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::accel::conformance::random_boxes;
     use crate::math::Vec3;
     use crate::random::Rng;
 
-    fn random_boxes(n: usize, seed: u64) -> Vec<Aabb> {
-        let mut rng = Rng::new(seed);
-        (0..n)
-            .map(|_| {
-                let a = rng.point_in(Vec3::splat(-5.0), Vec3::splat(5.0));
-                let largest = rng.range(0.0, 2.0);
-                let size = rng.point_in(Vec3::ZERO, Vec3::splat(largest));
-                Aabb::new(a, a + size)
-            })
-            .collect()
-    }
-
     fn degenerate_inputs() -> Vec<(&'static str, Vec<Aabb>)> {
         let unit = Aabb::new(Vec3::ZERO, Vec3::ONE);
-        let mut huge = random_boxes(300, 4);
+        let mut huge = random_boxes(&mut Rng::new(4), 300, 5.0, 1.0);
         huge.push(Aabb::new(Vec3::splat(-1000.0), Vec3::splat(1000.0)));
         let flat_mesh = (0..400)
             .map(|i| {
@@ -126,7 +115,7 @@ mod tests {
             })
             .collect();
         vec![
-            ("random", random_boxes(2000, 1)),
+            ("random", random_boxes(&mut Rng::new(1), 2000, 5.0, 1.0)),
             ("identical", vec![unit; 500]),
             ("one huge among small", huge),
             ("flat mesh", flat_mesh),
@@ -155,7 +144,7 @@ mod tests {
 
     #[test]
     fn validate_finds_a_missing_reference() {
-        let boxes = random_boxes(500, 2);
+        let boxes = random_boxes(&mut Rng::new(2), 500, 5.0, 1.0);
         let mut grid = Grid::build(&boxes);
         let first = grid
             .cell_start
@@ -172,7 +161,7 @@ mod tests {
 
     #[test]
     fn validate_finds_broken_offsets_and_stray_indices() {
-        let boxes = random_boxes(500, 3);
+        let boxes = random_boxes(&mut Rng::new(3), 500, 5.0, 1.0);
         let grid = Grid::build(&boxes);
 
         let mut backwards = grid.clone();

@@ -232,29 +232,15 @@ fn clip(b: &Aabb, cell: &Aabb) -> Aabb {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::accel::conformance::random_boxes;
     use crate::math::Vec3;
     use crate::random::Rng;
-
-    fn random_boxes(n: usize, seed: u64) -> Vec<Aabb> {
-        let mut rng = Rng::new(seed);
-        (0..n)
-            .map(|_| {
-                let c = rng.point_in(Vec3::splat(-100.0), Vec3::splat(100.0));
-                let half = Vec3::new(
-                    rng.range(0.1, 2.0),
-                    rng.range(0.1, 2.0),
-                    rng.range(0.1, 2.0),
-                );
-                Aabb::new(c - half, c + half)
-            })
-            .collect()
-    }
 
     #[test]
     fn work_grows_like_n_log_n_and_events_are_sorted_about_once() {
         let params = KdTreeBuildParams::default();
-        let (_, small) = build(&random_boxes(2_000, 1), &params);
-        let (tree, large) = build(&random_boxes(8_000, 1), &params);
+        let (_, small) = build(&random_boxes(&mut Rng::new(1), 2_000, 100.0, 2.0), &params);
+        let (tree, large) = build(&random_boxes(&mut Rng::new(1), 8_000, 100.0, 2.0), &params);
         // N log N predicts a ratio of about 4.6 for 4x the boxes; N² gives 16.
         let ratio = large.events_swept as f64 / small.events_swept as f64;
         assert!(ratio > 3.0 && ratio < 6.0, "swept events grew {ratio}x");
@@ -263,7 +249,10 @@ mod tests {
         let initial = 6 * 8_000;
         assert!(large.events_sorted < initial + initial / 2, "{large:?}");
         assert!(large.events_swept > 10 * large.events_sorted, "{large:?}");
-        assert!(tree.validate(&random_boxes(8_000, 1)).is_ok());
+        assert!(
+            tree.validate(&random_boxes(&mut Rng::new(1), 8_000, 100.0, 2.0))
+                .is_ok()
+        );
     }
 
     #[test]

@@ -8,7 +8,7 @@
 use super::build::default_max_depth;
 use super::node::NodeKind;
 use super::{KdTree, KdTreeBuildParams};
-use crate::accel::conformance::assert_conforms;
+use crate::accel::conformance::{assert_conforms, random_boxes};
 use crate::accel::{AccelKind, Accelerator, TraversalCounters};
 use crate::math::{Aabb, Ray, Vec3};
 use crate::random::Rng;
@@ -50,16 +50,6 @@ fn assert_matches_brute_force(boxes: &[Aabb], rays: &[Ray], what: &str) -> KdTre
     }
     assert!(hits > 0 || boxes.is_empty(), "{what}: no ray hits anything");
     tree
-}
-
-fn random_boxes(rng: &mut Rng, n: usize, spread: f64, size: f64) -> Vec<Aabb> {
-    (0..n)
-        .map(|_| {
-            let c = rng.point_in(Vec3::splat(-spread), Vec3::splat(spread));
-            let half = size * rng.point_in(Vec3::splat(0.05), Vec3::ONE);
-            Aabb::new(c - half, c + half)
-        })
-        .collect()
 }
 
 fn random_rays(rng: &mut Rng, n: usize, spread: f64) -> Vec<Ray> {
