@@ -23,6 +23,7 @@ mod axis_box;
 mod cone;
 mod cylinder;
 mod disk;
+mod outline;
 mod parallelogram;
 mod plane;
 mod polygon;

@@ -21,6 +21,7 @@
 //! reprojected as the plane through `v0` with the Newell normal (see
 //! [`super::plane`]).
 
+use super::outline::Outline;
 use super::plane::{onto_plane, plane_hit};
 use super::{LocalSurface, ShapeError, ShapeHit, finite};
 use crate::math::{Aabb, DVec2, Ray, Vec3, gamma, unit};
@@ -48,9 +49,9 @@ pub struct Polygon {
     vertices: Box<[Vec3]>,
     normal: Vec3,
     tangent: Vec3,
-    /// The two axes kept for the 2D inside test (the normal's dominant axis
-    /// is dropped).
-    axes: [u8; 2],
+    /// The vertices on two coordinate axes (the normal's dominant axis is
+    /// dropped), for the inside test.
+    outline: Box<Outline>,
 }
 
 impl Polygon {
@@ -111,11 +112,12 @@ impl Polygon {
             .ok_or(degenerate("it has no area (its vertices are collinear)"))?;
 
         let dropped = normal.abs().max_position();
+        let axes = [(dropped + 1) % 3, (dropped + 2) % 3];
         Ok(Self {
+            outline: Box::new(Outline::new(&vertices, axes)),
             vertices: vertices.into_boxed_slice(),
             normal,
             tangent,
-            axes: [(dropped as u8 + 1) % 3, (dropped as u8 + 2) % 3],
         })
     }
 
@@ -134,41 +136,10 @@ impl Polygon {
         self.vertices[0]
     }
 
-    /// True when `p`, a point of the plane, is inside by the even-odd rule.
-    ///
-    /// Counts the edges crossed by a ray from `p` along the first kept axis.
-    /// Each edge is half-open in the second axis (one end strictly above the
-    /// point, the other at or below), so a vertex level with the point is
-    /// counted exactly once; the side test is computed from the edge's lower
-    /// end whatever the vertex order, so a point on an edge shared by two
-    /// polygons of the same plane is inside exactly one of them.
-    fn contains(&self, p: Vec3) -> bool {
-        let [ax, ay] = self.axes.map(usize::from);
-        let (px, py) = (p[ax], p[ay]);
-        let mut inside = false;
-        let mut previous = self.vertices[self.vertices.len() - 1];
-        for &vertex in self.vertices.iter() {
-            if (vertex[ay] > py) != (previous[ay] > py) {
-                let (low, high) = if vertex[ay] > previous[ay] {
-                    (previous, vertex)
-                } else {
-                    (vertex, previous)
-                };
-                let side =
-                    (high[ax] - low[ax]) * (py - low[ay]) - (high[ay] - low[ay]) * (px - low[ax]);
-                if side > 0.0 {
-                    inside = !inside;
-                }
-            }
-            previous = vertex;
-        }
-        inside
-    }
-
     /// The closest hit in the ray's interval (there is at most one).
     pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
         let t = plane_hit(self.anchor(), self.normal, ray)?;
-        self.contains(ray.at(t)).then(|| ShapeHit::at(t))
+        self.outline.contains(ray.at(t)).then(|| ShapeHit::at(t))
     }
 
     /// True when the ray meets the polygon in its interval.
@@ -195,7 +166,7 @@ impl Polygon {
     /// along the dropped axis onto the plane through `v0` (they may sit off
     /// it by the planarity tolerance), padded by the rounding of that move.
     pub fn bounds(&self) -> Aabb {
-        let [ax, ay] = self.axes.map(usize::from);
+        let [ax, ay] = self.outline.axes();
         let dropped = 3 - ax - ay;
         let v0 = self.anchor();
         let n = self.normal;
