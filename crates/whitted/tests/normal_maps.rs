@@ -95,7 +95,7 @@ fn a_height_ramp_on_a_parallelogram_tilts_the_normal_45_degrees_downhill() {
     ] {
         let mut scene = lit_square(to_light);
         let m = scene.add_material(matte(bump.clone()));
-        scene.add_primitive(Shape::Parallelogram(square.clone()), m, Transform::IDENTITY);
+        scene.add_primitive(Shape::Parallelogram(square), m, Transform::IDENTITY);
         let value = centre(&scene);
         assert!((value - expected).abs() < 1e-5, "{to_light}: {value}");
     }
