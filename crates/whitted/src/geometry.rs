@@ -45,8 +45,10 @@ pub struct Surface {
     pub shading_normal: Vec3,
     /// Texture coordinates.
     pub uv: DVec2,
-    /// Tangent along u (not normalised).
+    /// Derivative of the point along u (a tangent; not normalised).
     pub dpdu: Vec3,
+    /// Derivative of the point along v (a tangent; not normalised).
+    pub dpdv: Vec3,
     /// The surface's material.
     pub material: MaterialId,
 }
@@ -335,6 +337,7 @@ impl<'a> Geometry<'a> {
                     shading_normal: t.normal_to_world(shading_normal).normalize(),
                     uv: local.uv,
                     dpdu: t.vector_to_world(local.dpdu),
+                    dpdv: t.vector_to_world(local.dpdv),
                     material,
                 }
             }
@@ -351,6 +354,7 @@ impl Surface {
             shading_normal,
             uv: s.uv,
             dpdu: s.dpdu,
+            dpdv: s.dpdv,
             material,
         }
     }
@@ -429,6 +433,57 @@ mod tests {
             }
         }
         assert!(hits > 50);
+    }
+
+    #[test]
+    fn tangents_stay_derivatives_of_uv_and_perpendicular_to_the_normal_under_a_transform() {
+        use crate::shape::{AxisBox, Cylinder};
+        let transform = Transform::translate(Vec3::new(0.5, -1.0, 2.0))
+            .unwrap()
+            .then_after(&Transform::rotate(Vec3::new(1.0, 2.0, 0.5), 40.0).unwrap())
+            .then_after(&Transform::scale(Vec3::new(3.0, 0.5, -1.5)).unwrap());
+        let shapes = [
+            Shape::Sphere(Sphere::new(Vec3::ZERO, 1.0).unwrap()),
+            Shape::Cylinder(Cylinder::new(1.0, 2.0, true).unwrap()),
+            Shape::AxisBox(AxisBox::new(Vec3::splat(-1.0), Vec3::ONE).unwrap()),
+        ];
+        let mut rng = crate::random::Rng::new(8);
+        for shape in shapes {
+            let scene = scene_with(shape, transform);
+            let geometry = Geometry::new(&scene);
+            let mut checked = 0;
+            for _ in 0..300 {
+                let target =
+                    transform.point_to_world(rng.point_in(Vec3::splat(-0.9), Vec3::splat(0.9)));
+                let origin = target + 20.0 * rng.unit_vector();
+                let ray = Ray::new(origin, target - origin);
+                let Some(hit) = geometry.intersect(&ray) else {
+                    continue;
+                };
+                let s = geometry.surface(&ray, &hit);
+                for (tangent, along) in [(s.dpdu, DVec2::X), (s.dpdv, DVec2::Y)] {
+                    assert!(tangent.dot(s.normal).abs() < 1e-12 * tangent.length());
+                    if tangent.length() < 1e-3 {
+                        continue;
+                    }
+                    let h = 1e-6;
+                    let back_origin = s.point + h * tangent + 0.01 * s.normal;
+                    let back = Ray::new(back_origin, -s.normal);
+                    let Some(moved) = geometry.intersect(&back) else {
+                        continue;
+                    };
+                    let change = geometry.surface(&back, &moved).uv - s.uv;
+                    if moved.shape_hit.part != hit.shape_hit.part
+                        || change.abs().max_element() > 0.5
+                    {
+                        continue;
+                    }
+                    assert!((change / h - along).abs().max_element() < 1e-3, "{change}");
+                    checked += 1;
+                }
+            }
+            assert!(checked > 200, "{checked}");
+        }
     }
 
     #[test]

@@ -44,6 +44,7 @@
 
 pub mod accel;
 pub mod bench;
+pub mod bump;
 pub mod camera;
 pub mod geometry;
 pub mod heat_map;
@@ -57,5 +58,6 @@ pub mod render;
 pub mod sampling;
 pub mod scene;
 pub mod shape;
+pub mod tangent_frame;
 pub mod texture;
 pub mod trace;

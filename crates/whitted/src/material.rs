@@ -12,6 +12,7 @@
 //! ray gets `kr + kt F`. Without it, total internal reflection alone moves the
 //! refracted weight `kt` onto the reflected ray.
 
+use crate::bump::Bump;
 use crate::texture::Texture;
 
 /// Index of a material in [`crate::scene::Scene::materials`].
@@ -41,6 +42,8 @@ pub struct Material {
     /// Split the transmission `kt` by Schlick's Fresnel term `F`: `kt (1 - F)`
     /// to the refracted ray, `kr + kt F` to the reflected one.
     pub fresnel: bool,
+    /// A bump or normal map tilting the shading normal `N`, if any.
+    pub bump: Option<Bump>,
 }
 
 impl Default for Material {
@@ -57,6 +60,7 @@ impl Default for Material {
             emission: Texture::default(),
             ior: 1.0,
             fresnel: false,
+            bump: None,
         }
     }
 }

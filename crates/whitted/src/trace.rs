@@ -6,6 +6,8 @@
 //! See [`crate::material`] for the formula and the Fresnel option.
 //!
 //! - Shading is two-sided: the normal is turned to face the incoming ray.
+//!   A material's bump or normal map tilts it (see [`crate::bump`]); a
+//!   light behind the geometric surface then lights nothing.
 //! - Shadow rays pass through transmissive surfaces, each crossing scaling
 //!   the light by that surface's `kt`; an opaque surface blocks it.
 //! - Refraction follows Snell's law with the index of the medium the ray is
@@ -14,6 +16,7 @@
 //! - Recursion stops at `max_depth`, and earlier when a branch's weight on
 //!   the pixel falls below `min_weight` (adaptive depth control).
 
+use crate::bump::shading_normal;
 use crate::geometry::{Geometry, Hit, Surface};
 use crate::light::Light;
 use crate::material::{Material, MaterialId};
@@ -244,12 +247,11 @@ impl<'a> Tracer<'a> {
         let view = -incident;
         let entering = incident.dot(s.normal) < 0.0;
         let facing = if entering { s.normal } else { -s.normal };
-        // The shading normal (interpolated on meshes) on the viewer's side.
-        let n = if s.shading_normal.dot(facing) < 0.0 {
-            -s.shading_normal
-        } else {
-            s.shading_normal
-        };
+        // The shading normal (interpolated on meshes, tilted by a bump or
+        // normal map) on the viewer's side.
+        let n = shading_normal(m.bump.as_ref(), s, facing, view);
+        // A tilted normal may see a light that is behind the surface itself.
+        let bumped = m.bump.is_some();
 
         let mut color = m.emission.at(s.uv) + m.ambient.at(s.uv) * self.scene.ambient;
 
@@ -261,7 +263,7 @@ impl<'a> Tracer<'a> {
                     continue;
                 };
                 let n_dot_l = n.dot(sample.to_light);
-                if n_dot_l <= 0.0 {
+                if n_dot_l <= 0.0 || (bumped && facing.dot(sample.to_light) <= 0.0) {
                     continue;
                 }
                 let shadow = self.transmittance(s, light, sample.to_light, sample.distance, counts);

@@ -59,6 +59,13 @@ pub struct TriangleMesh {
 /// A mesh triangle's surface: the geometric surface and the shading normal
 /// interpolated from the vertex normals (the geometric normal when the mesh
 /// has none).
+///
+/// The tangents `dpdu`, `dpdv` follow the texture coordinates: solved per
+/// triangle from the differences of its corners' positions and (u, v). A
+/// mesh without texture coordinates uses the barycentric ones, so the
+/// tangents are the edges `p1 - p0` and `p2 - p0`; a triangle whose texture
+/// coordinates span no area gets an arbitrary orthonormal pair around its
+/// geometric normal (`dpdu × dpdv = normal`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MeshSurface {
     /// Point, error bound, geometric normal, texture coordinates, tangent.
@@ -180,9 +187,9 @@ impl TriangleMesh {
         let (b1, b2) = (hit.u, hit.v);
         let b0 = 1.0 - b1 - b2;
         let (w0, w1, w2) = (b0 * p0, b1 * p1, b2 * p2);
-        let edge = p1 - p0;
-        let normal = edge
-            .cross(p2 - p0)
+        let (edge1, edge2) = (p1 - p0, p2 - p0);
+        let normal = edge1
+            .cross(edge2)
             .try_normalize()
             .unwrap_or_else(|| -ray.dir.normalize());
         let shading_normal = if self.normals.is_empty() {
@@ -193,11 +200,13 @@ impl TriangleMesh {
                 .try_normalize()
                 .unwrap_or(normal)
         };
-        let uv = if self.uvs.is_empty() {
-            DVec2::new(b1, b2)
+        let (uv, (dpdu, dpdv)) = if self.uvs.is_empty() {
+            (DVec2::new(b1, b2), (edge1, edge2))
         } else {
             let [t0, t1, t2] = indices.map(|v| self.uvs[v]);
-            b0 * t0 + b1 * t1 + b2 * t2
+            let tangents = uv_tangents([p0, p1, p2], [t0, t1, t2])
+                .unwrap_or_else(|| normal.any_orthonormal_pair());
+            (b0 * t0 + b1 * t1 + b2 * t2, tangents)
         };
         MeshSurface {
             local: LocalSurface {
@@ -205,11 +214,30 @@ impl TriangleMesh {
                 point_error: gamma(7) * (w0.abs() + w1.abs() + w2.abs()),
                 normal,
                 uv,
-                dpdu: edge,
+                dpdu,
+                dpdv,
             },
             shading_normal,
         }
     }
+}
+
+/// The derivatives `dpdu`, `dpdv` of the points of a triangle with corners
+/// `p` and texture coordinates `uv` (the affine map from (u, v) to the
+/// triangle's plane), or `None` when the texture coordinates span no area
+/// relative to their size (collinear or repeated).
+///
+/// From `p_i - p_0 = (u_i - u_0) dpdu + (v_i - v_0) dpdv` for `i = 1, 2`.
+fn uv_tangents(p: [Vec3; 3], uv: [DVec2; 3]) -> Option<(Vec3, Vec3)> {
+    let (d1, d2) = (uv[1] - uv[0], uv[2] - uv[0]);
+    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+    let det = d1.perp_dot(d2);
+    if det.abs() <= 1e-12 * d1.length() * d2.length() {
+        return None;
+    }
+    let dpdu = (d2.y * e1 - d1.y * e2) / det;
+    let dpdv = (d1.x * e2 - d2.x * e1) / det;
+    (dpdu.is_finite() && dpdv.is_finite()).then_some((dpdu, dpdv))
 }
 
 #[cfg(test)]
@@ -266,6 +294,86 @@ mod tests {
         assert_eq!(s.local.normal, Vec3::Z);
         let expected = (0.25 * Vec3::Z + 0.75 * tilted).normalize();
         assert!((s.shading_normal - expected).length() < 1e-12);
+    }
+
+    #[test]
+    fn tangents_follow_the_texture_coordinates() {
+        // u runs along +y and v along -x, at half speed.
+        let mesh = quad()
+            .with_uvs(vec![
+                DVec2::ZERO,
+                DVec2::new(0.0, -2.0),
+                DVec2::new(2.0, -2.0),
+                DVec2::new(2.0, 0.0),
+            ])
+            .unwrap();
+        let ray = Ray::new(Vec3::new(0.75, 0.25, 1.0), -Vec3::Z);
+        for triangle in [0, 1] {
+            let Some(hit) = mesh.intersect(triangle, &ray, &RayShear::new(&ray)) else {
+                continue;
+            };
+            let s = mesh.surface(triangle, &ray, &hit).local;
+            assert!(
+                (s.dpdu - Vec3::new(0.0, 0.5, 0.0)).length() < 1e-15,
+                "{}",
+                s.dpdu
+            );
+            assert!(
+                (s.dpdv - Vec3::new(-0.5, 0.0, 0.0)).length() < 1e-15,
+                "{}",
+                s.dpdv
+            );
+        }
+        let bare = quad().surface(
+            0,
+            &ray,
+            &quad().intersect(0, &ray, &RayShear::new(&ray)).unwrap(),
+        );
+        assert_eq!(
+            (bare.local.dpdu, bare.local.dpdv),
+            (Vec3::X, Vec3::new(1.0, 1.0, 0.0))
+        );
+    }
+
+    #[test]
+    fn solved_tangents_map_uv_differences_onto_the_edges() {
+        let mut rng = crate::random::Rng::new(21);
+        let mut solved = 0;
+        for _ in 0..1000 {
+            let p = [0; 3].map(|_| rng.point_in(Vec3::splat(-10.0), Vec3::splat(10.0)));
+            let uv = [0; 3].map(|_| DVec2::new(rng.range(-3.0, 3.0), rng.range(-3.0, 3.0)));
+            let Some((dpdu, dpdv)) = uv_tangents(p, uv) else {
+                continue;
+            };
+            solved += 1;
+            for i in [1, 2] {
+                let d = uv[i] - uv[0];
+                let rebuilt = d.x * dpdu + d.y * dpdv;
+                let scale = p[i].length() + p[0].length();
+                assert!((rebuilt - (p[i] - p[0])).length() < 1e-9 * scale);
+            }
+        }
+        assert!(solved > 990);
+    }
+
+    #[test]
+    fn degenerate_texture_coordinates_fall_back_to_a_frame_around_the_normal() {
+        let p = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        for uv in [
+            [DVec2::ZERO; 3],
+            [DVec2::ZERO, DVec2::new(1.0, 1.0), DVec2::new(2.0, 2.0)],
+        ] {
+            assert_eq!(uv_tangents(p, uv), None);
+        }
+        let mesh = TriangleMesh::new(p.to_vec(), vec![[0, 1, 2]])
+            .unwrap()
+            .with_uvs(vec![DVec2::ONE; 3])
+            .unwrap();
+        let ray = Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z);
+        let hit = mesh.intersect(0, &ray, &RayShear::new(&ray)).unwrap();
+        let s = mesh.surface(0, &ray, &hit).local;
+        assert!((s.dpdu.cross(s.dpdv) - Vec3::Z).length() < 1e-15);
+        assert!((s.dpdu.length() - 1.0).abs() < 1e-15);
     }
 
     #[test]

@@ -7,8 +7,8 @@
 //! 3 at +y, 4 at -z, 5 at +z, each with that outward normal. On the face
 //! across axis `i`, `(u, v)` are the coordinates along the next two axes in
 //! cyclic order (y, z on the x faces; z, x on the y faces; x, y on the z
-//! faces), each scaled to [0, 1] over the face; `dpdu` is the face's edge
-//! along the u axis.
+//! faces), each scaled to [0, 1] over the face; `dpdu` and `dpdv` are the
+//! face's edges along the u and v axes.
 
 use super::{LocalSurface, ShapeError, ShapeHit, finite};
 use crate::math::{Aabb, DVec2, Ray, Vec3, gamma};
@@ -112,14 +112,16 @@ impl AxisBox {
         let (u_axis, v_axis) = ((axis + 1) % 3, (axis + 2) % 3);
         let extent = self.max - self.min;
         let along = (point - self.min) / extent;
-        let mut dpdu = Vec3::ZERO;
+        let (mut dpdu, mut dpdv) = (Vec3::ZERO, Vec3::ZERO);
         dpdu[u_axis] = extent[u_axis];
+        dpdv[v_axis] = extent[v_axis];
         LocalSurface {
             point,
             point_error: gamma(5) * point.abs(),
             normal,
             uv: DVec2::new(along[u_axis], along[v_axis]),
             dpdu,
+            dpdv,
         }
     }
 
@@ -135,7 +137,7 @@ mod tests {
     use crate::random::Rng;
     use crate::shape::testing::{
         assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
-        assert_outward_rays_escape, assert_surface_is_sane, rays_toward,
+        assert_outward_rays_escape, assert_surface_is_sane, assert_tangents_follow_uv, rays_toward,
     };
     use crate::shape::{Shape, ShapeError};
 
@@ -367,6 +369,17 @@ mod tests {
             assert_surface_is_sane(&shape, 109);
             assert_convex_exits_cleanly(&shape, 113);
             assert_no_nan_for_awkward_rays(&shape);
+        }
+    }
+
+    #[test]
+    fn tangents_are_the_derivatives_of_the_parametric_form() {
+        for (min, max) in [
+            (Vec3::splat(-1.0), Vec3::ONE),
+            (Vec3::new(0.2, 0.5, -3.0), Vec3::new(0.3, 4.0, 1.0)),
+        ] {
+            let shape = Shape::AxisBox(AxisBox::new(min, max).unwrap());
+            assert_tangents_follow_uv(&shape, 29);
         }
     }
 }

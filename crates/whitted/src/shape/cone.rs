@@ -15,7 +15,9 @@
 //! side: `u = φ / 2π` with `φ = atan2(y, x)` in [0, 2π), `v = z / height`;
 //! on the caps, as on a disk: the same `u`, `v = 1 - r / radius` (0 on the
 //! rim, 1 at the centre). `dpdu = 2π (-y, x, 0)` everywhere (zero at the
-//! apex).
+//! apex); `dpdv` is `(Δr cos φ, Δr sin φ, height)` with `Δr = r1 - r0` on
+//! the side, up the slant, and points inwards on the caps (see
+//! [`super::disk`]).
 
 use std::f64::consts::TAU;
 
@@ -195,6 +197,11 @@ impl Cone {
             ),
             uv: DVec2::new(azimuth(cos, sin) / TAU, z / self.height),
             dpdu: Vec3::new(-TAU * point.y, TAU * point.x, 0.0),
+            dpdv: Vec3::new(
+                (self.radius1 - self.radius0) * cos,
+                (self.radius1 - self.radius0) * sin,
+                self.height,
+            ),
         }
     }
 
@@ -213,7 +220,7 @@ mod tests {
     use crate::random::Rng;
     use crate::shape::testing::{
         assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
-        assert_outward_rays_escape, assert_surface_is_sane, rays_toward,
+        assert_outward_rays_escape, assert_surface_is_sane, assert_tangents_follow_uv, rays_toward,
     };
     use crate::shape::{Cylinder, Shape, ShapeError};
 
@@ -512,6 +519,17 @@ mod tests {
                 assert_convex_exits_cleanly(&shape, 97);
                 assert_no_nan_for_awkward_rays(&shape);
             }
+        }
+    }
+
+    #[test]
+    fn tangents_are_the_derivatives_of_the_parametric_form() {
+        let ray = Ray::new(Vec3::new(-5.0, 0.0, 0.5), Vec3::X);
+        let s = pointed(true).surface(&ray, &pointed(true).intersect(&ray).unwrap());
+        assert!(close(s.dpdv, Vec3::new(1.0, 0.0, 1.0)), "{}", s.dpdv);
+        for (radius0, radius1, height) in [(1.0, 0.0, 1.0), (0.5, 1.5, 2.0), (2.0, 1.0, 0.3)] {
+            let cone = Cone::new(radius0, radius1, height, true).unwrap();
+            assert_tangents_follow_uv(&Shape::Cone(cone), 23);
         }
     }
 }

@@ -10,7 +10,9 @@
 //! -z), 2 the top cap (z = height, facing +z). Texture coordinates on the
 //! side: `u = φ / 2π` with `φ = atan2(y, x)` in [0, 2π), `v = z / height`;
 //! on the caps, as on a disk: the same `u`, `v = 1 - r / radius` (0 on the
-//! rim, 1 at the centre). `dpdu = 2π (-y, x, 0)` everywhere.
+//! rim, 1 at the centre). `dpdu = 2π (-y, x, 0)` everywhere; `dpdv` is
+//! `(0, 0, height)` on the side and points inwards on the caps (see
+//! [`super::disk`]).
 
 use std::f64::consts::TAU;
 
@@ -138,6 +140,7 @@ impl Cylinder {
             normal,
             uv: DVec2::new(azimuth(point.x, point.y) / TAU, point.z / self.height),
             dpdu: Vec3::new(-TAU * point.y, TAU * point.x, 0.0),
+            dpdv: Vec3::new(0.0, 0.0, self.height),
         }
     }
 
@@ -156,7 +159,7 @@ mod tests {
     use crate::random::Rng;
     use crate::shape::testing::{
         assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
-        assert_outward_rays_escape, assert_surface_is_sane, rays_toward,
+        assert_outward_rays_escape, assert_surface_is_sane, assert_tangents_follow_uv, rays_toward,
     };
     use crate::shape::{Shape, ShapeError};
 
@@ -367,6 +370,17 @@ mod tests {
                 assert_convex_exits_cleanly(&shape, 55);
                 assert_no_nan_for_awkward_rays(&shape);
             }
+        }
+    }
+
+    #[test]
+    fn tangents_are_the_derivatives_of_the_parametric_form() {
+        let ray = Ray::new(Vec3::new(-5.0, 0.0, 1.0), Vec3::X);
+        let s = capped().surface(&ray, &capped().intersect(&ray).unwrap());
+        assert!((s.dpdu - Vec3::new(0.0, -TAU, 0.0)).length() < 1e-15);
+        assert_eq!(s.dpdv, Vec3::new(0.0, 0.0, 2.0));
+        for shape in [capped(), open(), Cylinder::new(3.0, 0.5, true).unwrap()] {
+            assert_tangents_follow_uv(&Shape::Cylinder(shape), 19);
         }
     }
 }

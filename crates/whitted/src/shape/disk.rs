@@ -7,7 +7,8 @@
 //!
 //! Texture coordinates are polar: `u = φ / 2π` with `φ = atan2(y, x)` in
 //! [0, 2π), and `v = (radius - r) / (radius - inner_radius)`, 0 on the rim
-//! rising to 1 at the centre (or at the inner rim); `dpdu = 2π (-y, x, 0)`.
+//! rising to 1 at the centre (or at the inner rim); `dpdu = 2π (-y, x, 0)`
+//! and `dpdv = -(radius - inner_radius) (cos φ, sin φ, 0)`, pointing inwards.
 //!
 //! [`cap_hit`] and [`cap_surface`] are the whole geometry of a disk at some
 //! height; the cylinder and the cone use them for their caps.
@@ -108,15 +109,18 @@ pub(super) fn cap_surface(
 ) -> LocalSurface {
     let point = Vec3::new(p.x, p.y, height);
     let r = p.x.hypot(p.y);
+    let phi = azimuth(p.x, p.y);
+    let (sin_phi, cos_phi) = phi.sin_cos();
     LocalSurface {
         point,
         point_error: gamma(5) * point.abs(),
         normal: Vec3::new(0.0, 0.0, normal_z),
         uv: DVec2::new(
-            azimuth(p.x, p.y) / TAU,
+            phi / TAU,
             ((radius - r) / (radius - inner_radius)).clamp(0.0, 1.0),
         ),
         dpdu: Vec3::new(-TAU * p.y, TAU * p.x, 0.0),
+        dpdv: -(radius - inner_radius) * Vec3::new(cos_phi, sin_phi, 0.0),
     }
 }
 
@@ -131,7 +135,7 @@ mod tests {
     use super::*;
     use crate::shape::testing::{
         assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
-        assert_surface_is_sane,
+        assert_surface_is_sane, assert_tangents_follow_uv,
     };
     use crate::shape::{Shape, ShapeError};
 
@@ -265,6 +269,17 @@ mod tests {
             assert_surface_is_sane(&shape, 43);
             assert_convex_exits_cleanly(&shape, 45);
             assert_no_nan_for_awkward_rays(&shape);
+        }
+    }
+
+    #[test]
+    fn tangents_are_the_derivatives_of_the_parametric_form() {
+        let ray = down_at(0.0, 0.5);
+        let s = unit().surface(&ray, &unit().intersect(&ray).unwrap());
+        assert!((s.dpdu - Vec3::new(-TAU * 0.5, 0.0, 0.0)).length() < 1e-15);
+        assert!((s.dpdv - Vec3::new(0.0, -1.0, 0.0)).length() < 1e-15);
+        for disk in [unit(), annulus(), Disk::new(1e3, 2e2).unwrap()] {
+            assert_tangents_follow_uv(&Shape::Disk(disk), 17);
         }
     }
 }

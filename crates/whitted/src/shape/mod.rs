@@ -7,8 +7,9 @@
 //! - [`Shape::occluded`]: is there any hit at all (for shadow rays);
 //! - [`Shape::surface`]: for the final hit only, the point with its
 //!   floating-point error bound, the unit geometric normal, the texture
-//!   coordinates (u, v) from the shape's parametric form and the tangent
-//!   `dpdu`;
+//!   coordinates (u, v) from the shape's parametric form and the tangents
+//!   `dpdu` and `dpdv` (the derivatives of the point along u and v, both
+//!   perpendicular to the normal), which orient bump and normal maps;
 //! - [`Shape::bounds`]: the object-space bounding box.
 //!
 //! Normals point "outward": away from the inside of closed shapes, and along
@@ -84,6 +85,9 @@ pub struct LocalSurface {
     /// Derivative of the point along u (a tangent; not normalised, may be
     /// zero at a pole).
     pub dpdu: Vec3,
+    /// Derivative of the point along v (a tangent; not normalised, may be
+    /// zero where the parametrisation pinches, like the centre of a disk).
+    pub dpdv: Vec3,
 }
 
 /// Why a shape could not be built.

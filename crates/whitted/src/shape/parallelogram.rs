@@ -6,7 +6,8 @@
 //!
 //! Texture coordinates are the parameters `(u, v)` themselves: (0, 0) at
 //! `origin`, (1, 0) at `origin + edge_u`, (0, 1) at `origin + edge_v`. The
-//! normal is `normalize(edge_u × edge_v)` and `dpdu = edge_u`.
+//! normal is `normalize(edge_u × edge_v)`, `dpdu = edge_u` and
+//! `dpdv = edge_v`.
 //!
 //! The parallelogram is hit and reprojected as the plane through `origin`
 //! with that normal (see [`super::plane`]), then `(u, v)` decide whether the
@@ -100,6 +101,7 @@ impl Parallelogram {
             normal,
             uv: DVec2::new(hit.u, hit.v),
             dpdu: self.edge_u,
+            dpdv: self.edge_v,
         }
     }
 
@@ -119,7 +121,7 @@ mod tests {
     use super::*;
     use crate::shape::testing::{
         assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
-        assert_surface_is_sane,
+        assert_surface_is_sane, assert_tangents_follow_uv,
     };
     use crate::shape::{Shape, ShapeError};
 
@@ -279,5 +281,15 @@ mod tests {
             assert_convex_exits_cleanly(&shape, 31);
             assert_no_nan_for_awkward_rays(&shape);
         }
+    }
+
+    #[test]
+    fn tangents_are_the_derivatives_of_the_parametric_form() {
+        let (edge_u, edge_v) = (Vec3::new(2.0, 0.0, 0.5), Vec3::new(1.0, 1.0, 1.0));
+        let shape = Parallelogram::new(Vec3::ONE, edge_u, edge_v).unwrap();
+        let ray = Ray::new(Vec3::new(2.0, 1.5, 5.0), -Vec3::Z);
+        let s = shape.surface(&ray, &shape.intersect(&ray).unwrap());
+        assert_eq!((s.dpdu, s.dpdv), (edge_u, edge_v));
+        assert_tangents_follow_uv(&Shape::Parallelogram(shape), 11);
     }
 }

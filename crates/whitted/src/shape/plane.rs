@@ -5,7 +5,8 @@
 //!
 //! Texture coordinates are unbounded and in world units: `(u, v)` are the
 //! coordinates of `p - point` along the fixed tangent frame
-//! `normal.any_orthonormal_pair()`.
+//! `normal.any_orthonormal_pair()`, so `dpdu` and `dpdv` are that frame's
+//! two unit vectors (`dpdu × dpdv = normal`).
 //!
 //! The two helpers [`plane_hit`] and [`onto_plane`] are the whole geometry of
 //! a plane; the bounded flat shapes (parallelogram, polygon) use them too, so
@@ -63,6 +64,7 @@ impl Plane {
             normal: self.normal,
             uv: DVec2::new(offset.dot(tangent), offset.dot(bitangent)),
             dpdu: tangent,
+            dpdv: bitangent,
         }
     }
 
@@ -109,7 +111,7 @@ mod tests {
     use super::*;
     use crate::shape::testing::{
         assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
-        assert_surface_is_sane,
+        assert_surface_is_sane, assert_tangents_follow_uv,
     };
     use crate::shape::{Shape, ShapeError};
 
@@ -240,6 +242,18 @@ mod tests {
             assert_surface_is_sane(&shape, 5);
             assert_convex_exits_cleanly(&shape, 7);
             assert_no_nan_for_awkward_rays(&shape);
+        }
+    }
+
+    #[test]
+    fn tangents_are_the_derivatives_of_the_parametric_form() {
+        for normal in [Vec3::Z, -Vec3::Y, Vec3::new(1.0, -2.0, 0.5)] {
+            let plane = Plane::new(Vec3::new(0.5, 1.0, -2.0), normal).unwrap();
+            let origin = plane.point() + 3.0 * plane.normal() + Vec3::new(0.3, 0.2, 0.1);
+            let ray = Ray::new(origin, -plane.normal());
+            let s = plane.surface(&ray, &plane.intersect(&ray).unwrap());
+            assert!((s.dpdu.cross(s.dpdv) - plane.normal()).length() < 1e-15);
+            assert_tangents_follow_uv(&Shape::Plane(plane), 5);
         }
     }
 }

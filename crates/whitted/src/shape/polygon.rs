@@ -13,7 +13,8 @@
 //! Texture coordinates are planar and in world units: `(u, v)` are the
 //! coordinates of `p - v0` along the unit direction of the first edge that is
 //! not vanishingly short (its part in the plane) and along
-//! `normal × that direction`; `dpdu` is that unit direction.
+//! `normal × that direction`; `dpdu` is that unit direction and `dpdv` the
+//! second one.
 //!
 //! The vertices may stray from the plane by 1e-4 of the polygon's size plus
 //! 3e-5 of its largest coordinate: enough for coordinates printed with six
@@ -159,6 +160,7 @@ impl Polygon {
             normal: self.normal,
             uv: DVec2::new(offset.dot(self.tangent), offset.dot(bitangent)),
             dpdu: self.tangent,
+            dpdv: bitangent,
         }
     }
 
@@ -193,7 +195,7 @@ mod tests {
     use crate::random::Rng;
     use crate::shape::testing::{
         assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
-        assert_surface_is_sane,
+        assert_surface_is_sane, assert_tangents_follow_uv,
     };
     use crate::shape::{Shape, ShapeError};
 
@@ -473,6 +475,16 @@ mod tests {
             assert_surface_is_sane(&shape, 37);
             assert_convex_exits_cleanly(&shape, 39);
             assert_no_nan_for_awkward_rays(&shape);
+        }
+    }
+
+    #[test]
+    fn tangents_are_the_derivatives_of_the_parametric_form() {
+        let ray = down_at(0.5, 1.5);
+        let s = ell().surface(&ray, &ell().intersect(&ray).unwrap());
+        assert_eq!((s.dpdu, s.dpdv), (Vec3::X, Vec3::Y));
+        for polygon in [ell(), gear(Vec3::new(1e3, -1e3, 3e2), 2.0)] {
+            assert_tangents_follow_uv(&Shape::Polygon(polygon), 13);
         }
     }
 }

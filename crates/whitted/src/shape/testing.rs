@@ -2,7 +2,7 @@
 //! aimed at the shape, and the invariants each hit must keep.
 
 use super::Shape;
-use crate::math::{Aabb, Ray, Vec3, offset_ray_origin};
+use crate::math::{Aabb, DVec2, Ray, Vec3, offset_ray_origin};
 use crate::random::Rng;
 
 /// The region random rays aim at: the shape's bounds, or a box around the
@@ -148,6 +148,15 @@ pub(crate) fn assert_surface_is_sane(shape: &Shape, seed: u64) {
             s.normal
         );
         assert!(s.uv.is_finite() && s.dpdu.is_finite() && s.point_error.is_finite());
+        assert!(s.dpdv.is_finite(), "{}: dpdv {:?}", shape.kind(), s.dpdv);
+        for tangent in [s.dpdu, s.dpdv] {
+            assert!(
+                tangent.dot(s.normal).abs() <= 1e-9 * tangent.length(),
+                "{}: tangent {tangent:?} not perpendicular to the normal {:?}",
+                shape.kind(),
+                s.normal
+            );
+        }
         let distance = (s.point - ray.at(hit.t)).length();
         assert!(
             distance <= 1e-9 * size.max(ray.origin.length()),
@@ -203,6 +212,7 @@ pub(crate) fn assert_no_nan_for_awkward_rays(shape: &Shape) {
                         && s.point_error.is_finite()
                         && s.uv.is_finite()
                         && s.dpdu.is_finite()
+                        && s.dpdv.is_finite()
                         && (s.normal.length() - 1.0).abs() < 1e-9,
                     "{}: {s:?} for {ray:?}",
                     shape.kind()
@@ -210,4 +220,54 @@ pub(crate) fn assert_no_nan_for_awkward_rays(shape: &Shape) {
             }
         }
     }
+}
+
+/// `dpdu` and `dpdv` are the derivatives of the parametric form: moving a
+/// hit point by `h dpdu` (or `h dpdv`) for a small `h` and casting a ray
+/// back at the surface there changes (u, v) by `(h, 0)` (or `(0, h)`), to
+/// within 1e-3 of `h`. Steps that leave the part hit, cross the seam of u
+/// or start where a tangent (nearly) vanishes are skipped; returns how many
+/// steps were checked.
+pub(crate) fn assert_tangents_follow_uv(shape: &Shape, seed: u64) -> usize {
+    let size = region(shape).extent().length();
+    let mut checked = 0;
+    for ray in random_rays(shape, seed, 500) {
+        let Some(hit) = shape.intersect(&ray) else {
+            continue;
+        };
+        let s = shape.surface(&ray, &hit);
+        for (tangent, along) in [(s.dpdu, DVec2::X), (s.dpdv, DVec2::Y)] {
+            if tangent.length() < 1e-4 * size {
+                continue;
+            }
+            let h = 1e-6 * s.uv.abs().max_element().max(1.0);
+            let target = s.point + h * tangent;
+            let back = Ray::new(target + 0.01 * size * s.normal, -s.normal);
+            let Some(moved) = shape.intersect(&back) else {
+                continue;
+            };
+            if moved.part != hit.part {
+                continue;
+            }
+            let change = shape.surface(&back, &moved).uv - s.uv;
+            if change.abs().max_element() > 0.5 {
+                continue;
+            }
+            let step = change / h;
+            assert!(
+                (step - along).abs().max_element() < 1e-3,
+                "{}: moving along {tangent:?} from {:?} (uv {:?}) changed uv by {step:?} per unit",
+                shape.kind(),
+                s.point,
+                s.uv
+            );
+            checked += 1;
+        }
+    }
+    assert!(
+        checked > 200,
+        "{}: too few tangent steps checked ({checked})",
+        shape.kind()
+    );
+    checked
 }

@@ -7,7 +7,7 @@
 //! normal is `normalize((p1 - p0) × (p2 - p0))`. Texture coordinates are the
 //! barycentric coordinates `(u, v) = (b1, b2)` of the point
 //! `b0 p0 + b1 p1 + b2 p2`, so `p0` is at (0, 0), `p1` at (1, 0) and `p2` at
-//! (0, 1); `dpdu = p1 - p0`.
+//! (0, 1); `dpdu = p1 - p0` and `dpdv = p2 - p0`.
 //!
 //! Intersection is the watertight test of Woop, Benthin and Wald ("Watertight
 //! Ray/Triangle Intersection", JCGT 2013) with the conservative bound on `t`
@@ -74,15 +74,16 @@ impl Triangle {
         let (b1, b2) = (hit.u, hit.v);
         let b0 = 1.0 - b1 - b2;
         let (w0, w1, w2) = (b0 * self.p0, b1 * self.p1, b2 * self.p2);
-        let edge = self.p1 - self.p0;
+        let (edge1, edge2) = (self.p1 - self.p0, self.p2 - self.p0);
         LocalSurface {
             point: w0 + w1 + w2,
             point_error: gamma(7) * (w0.abs() + w1.abs() + w2.abs()),
             // Cannot fail: the constructor refused triangles whose cross
             // product does not normalise.
-            normal: edge.cross(self.p2 - self.p0).normalize(),
+            normal: edge1.cross(edge2).normalize(),
             uv: DVec2::new(b1, b2),
-            dpdu: edge,
+            dpdu: edge1,
+            dpdv: edge2,
         }
     }
 
@@ -192,7 +193,7 @@ mod tests {
     use crate::random::Rng;
     use crate::shape::testing::{
         assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
-        assert_surface_is_sane,
+        assert_surface_is_sane, assert_tangents_follow_uv,
     };
     use crate::shape::{Shape, ShapeError};
 
@@ -394,5 +395,19 @@ mod tests {
             assert_convex_exits_cleanly(&shape, 17);
             assert_no_nan_for_awkward_rays(&shape);
         }
+    }
+
+    #[test]
+    fn tangents_are_the_derivatives_of_the_parametric_form() {
+        let (p0, p1, p2) = (
+            Vec3::new(0.3, -1.2, 0.4),
+            Vec3::new(2.1, 0.7, -0.8),
+            Vec3::new(-0.6, 0.9, 1.5),
+        );
+        let triangle = Triangle::new(p0, p1, p2).unwrap();
+        let ray = Ray::new(Vec3::new(0.5, 0.2, 3.0), Vec3::new(0.0, 0.0, -1.0));
+        let s = triangle.surface(&ray, &triangle.intersect(&ray).unwrap());
+        assert_eq!((s.dpdu, s.dpdv), (p1 - p0, p2 - p0));
+        assert_tangents_follow_uv(&Shape::Triangle(triangle), 7);
     }
 }

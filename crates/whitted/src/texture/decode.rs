@@ -1,9 +1,12 @@
 //! Reading PNG and JPEG files into linear RGB texels, each file once.
 //!
-//! PNG is decoded by the `png` crate, JPEG by `zune-jpeg`. Both formats are
+//! PNG is decoded by the `png` crate, JPEG by `zune-jpeg`. How samples
+//! become texels is the [`Decoding`] the file is read with: colours are
 //! taken as sRGB-encoded (the PNG default and what JPEG cameras and editors
-//! write): every 8- or 16-bit sample goes through the sRGB transfer curve to
-//! linear light. Alpha is ignored.
+//! write), every 8- or 16-bit sample going through the sRGB transfer curve
+//! to linear light; data (normal and height maps) is read as stored, scaled
+//! to [0, 1]; opacity is the alpha channel. A file read two ways is decoded
+//! once per way.
 
 use std::collections::HashMap;
 use std::io::Cursor;
@@ -33,36 +36,57 @@ pub enum ImageLoadError {
     },
 }
 
-/// Decoded images by canonical path, so that every material naming a file
-/// shares one copy of its texels.
+/// How an image's samples become texels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Decoding {
+    /// A colour: sRGB-encoded samples converted to linear RGB; alpha is
+    /// ignored.
+    #[default]
+    Color,
+    /// Data, such as a normal or height map: the samples as stored, scaled
+    /// to [0, 1], with no transfer curve; alpha is ignored.
+    Data,
+    /// Opacity: the alpha channel, as stored, in all three components; an
+    /// image without alpha is read as [`Decoding::Data`].
+    Opacity,
+}
+
+/// Decoded images by canonical path and decoding, so that every material
+/// naming a file shares one copy of its texels.
 #[derive(Debug, Default)]
 pub struct ImageCache {
-    images: HashMap<PathBuf, Arc<ImageData>>,
+    images: HashMap<(PathBuf, Decoding), Arc<ImageData>>,
 }
 
 impl ImageCache {
-    /// The texels of the file at `path`, decoded on first use.
-    pub fn load(&mut self, path: &Path) -> Result<Arc<ImageData>, ImageLoadError> {
+    /// The texels of the file at `path` read as `decoding`, decoded on
+    /// first use.
+    pub fn load(
+        &mut self,
+        path: &Path,
+        decoding: Decoding,
+    ) -> Result<Arc<ImageData>, ImageLoadError> {
         let io = |source| ImageLoadError::Io {
             path: path.to_path_buf(),
             source,
         };
-        let canonical = path.canonicalize().map_err(io)?;
-        if let Some(image) = self.images.get(&canonical) {
+        let key = (path.canonicalize().map_err(io)?, decoding);
+        if let Some(image) = self.images.get(&key) {
             return Ok(Arc::clone(image));
         }
-        let bytes = std::fs::read(&canonical).map_err(io)?;
-        let image = Arc::new(
-            decode_image(&bytes).map_err(|reason| ImageLoadError::Decode {
-                path: path.to_path_buf(),
-                reason,
-            })?,
-        );
-        self.images.insert(canonical, Arc::clone(&image));
+        let bytes = std::fs::read(&key.0).map_err(io)?;
+        let image =
+            Arc::new(
+                decode_image(&bytes, decoding).map_err(|reason| ImageLoadError::Decode {
+                    path: path.to_path_buf(),
+                    reason,
+                })?,
+            );
+        self.images.insert(key, Arc::clone(&image));
         Ok(image)
     }
 
-    /// How many distinct files were decoded.
+    /// How many distinct files (and decodings of one file) were decoded.
     pub fn len(&self) -> usize {
         self.images.len()
     }
@@ -74,17 +98,30 @@ impl ImageCache {
 }
 
 /// Decodes a PNG or JPEG file's bytes, told apart by their signature.
-pub fn decode_image(bytes: &[u8]) -> Result<ImageData, String> {
+pub fn decode_image(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
     if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
-        decode_png(bytes)
+        decode_png(bytes, decoding)
     } else if bytes.starts_with(&[0xff, 0xd8]) {
-        decode_jpeg(bytes)
+        decode_jpeg(bytes, decoding)
     } else {
         Err("not a PNG or JPEG file".to_string())
     }
 }
 
-fn decode_png(bytes: &[u8]) -> Result<ImageData, String> {
+/// The texel value of a sample `encoded` in [0, 1].
+fn texel_value(encoded: f32, decoding: Decoding) -> f32 {
+    match decoding {
+        Decoding::Color => srgb_to_linear(encoded),
+        Decoding::Data | Decoding::Opacity => encoded,
+    }
+}
+
+/// [`texel_value`] of every 8-bit sample.
+fn eight_bit_table(decoding: Decoding) -> [f32; 256] {
+    std::array::from_fn(|i| texel_value(i as f32 / 255.0, decoding))
+}
+
+fn decode_png(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
     let mut decoder = png::Decoder::new(Cursor::new(bytes));
     decoder.set_transformations(png::Transformations::EXPAND);
     let mut reader = decoder.read_info().map_err(|e| e.to_string())?;
@@ -103,29 +140,33 @@ fn decode_png(bytes: &[u8]) -> Result<ImageData, String> {
     let (width, height) = (info.width as usize, info.height as usize);
     let wide = info.bit_depth == png::BitDepth::Sixteen;
     let sample_bytes = if wide { 2 } else { 1 };
-    let table = srgb_table();
+    let table = eight_bit_table(decoding);
     let sample = |at: &[u8]| -> f32 {
         if wide {
-            srgb_to_linear(f32::from(u16::from_be_bytes([at[0], at[1]])) / 65535.0)
+            texel_value(
+                f32::from(u16::from_be_bytes([at[0], at[1]])) / 65535.0,
+                decoding,
+            )
         } else {
             table[usize::from(at[0])]
         }
     };
+    let alpha = (decoding == Decoding::Opacity && channels % 2 == 0).then_some(channels - 1);
     let mut texels = Vec::with_capacity(width * height);
     for row in buffer.chunks(info.line_size).take(height) {
         for pixel in row.chunks_exact(channels * sample_bytes).take(width) {
             let value = |channel: usize| sample(&pixel[channel * sample_bytes..]);
-            texels.push(if channels < 3 {
-                [value(0); 3]
-            } else {
-                [value(0), value(1), value(2)]
+            texels.push(match alpha {
+                Some(channel) => [value(channel); 3],
+                None if channels < 3 => [value(0); 3],
+                None => [value(0), value(1), value(2)],
             });
         }
     }
     ImageData::new(width, height, texels).ok_or_else(|| "the image data is truncated".to_string())
 }
 
-fn decode_jpeg(bytes: &[u8]) -> Result<ImageData, String> {
+fn decode_jpeg(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
     use zune_jpeg::zune_core::bytestream::ZCursor;
     use zune_jpeg::zune_core::colorspace::ColorSpace;
     use zune_jpeg::zune_core::options::DecoderOptions;
@@ -133,7 +174,7 @@ fn decode_jpeg(bytes: &[u8]) -> Result<ImageData, String> {
     let mut decoder = zune_jpeg::JpegDecoder::new_with_options(ZCursor::new(bytes), options);
     let pixels = decoder.decode().map_err(|e| e.to_string())?;
     let (width, height) = decoder.dimensions().ok_or("no image size")?;
-    let table = srgb_table();
+    let table = eight_bit_table(decoding);
     let texels = pixels
         .chunks_exact(3)
         .map(|p| [0, 1, 2].map(|c| table[usize::from(p[c])]))
@@ -150,30 +191,38 @@ pub(crate) fn srgb_to_linear(encoded: f32) -> f32 {
     }
 }
 
-/// [`srgb_to_linear`] of every 8-bit value.
-fn srgb_table() -> [f32; 256] {
-    std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0))
-}
-
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
 
     /// An 8-bit RGB PNG of `width × height` texels, row by row from the top.
     pub(crate) fn png_bytes(width: u32, height: u32, rgb: &[u8]) -> Vec<u8> {
+        encode_png(width, height, png::ColorType::Rgb, rgb)
+    }
+
+    /// An 8-bit RGBA PNG of `width × height` texels, row by row from the top.
+    pub(crate) fn rgba_png_bytes(width: u32, height: u32, rgba: &[u8]) -> Vec<u8> {
+        encode_png(width, height, png::ColorType::Rgba, rgba)
+    }
+
+    fn encode_png(width: u32, height: u32, color: png::ColorType, samples: &[u8]) -> Vec<u8> {
         let mut out = Vec::new();
         let mut encoder = png::Encoder::new(&mut out, width, height);
-        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_color(color);
         encoder.set_depth(png::BitDepth::Eight);
         let mut writer = encoder.write_header().unwrap();
-        writer.write_image_data(rgb).unwrap();
+        writer.write_image_data(samples).unwrap();
         writer.finish().unwrap();
         out
     }
 
     #[test]
     fn eight_bit_samples_are_srgb_decoded() {
-        let image = decode_image(&png_bytes(2, 1, &[0, 128, 255, 188, 188, 188])).unwrap();
+        let image = decode_image(
+            &png_bytes(2, 1, &[0, 128, 255, 188, 188, 188]),
+            Decoding::Color,
+        )
+        .unwrap();
         let t = |x| {
             super::super::ImageTexture::new(Arc::new(image.clone()))
                 .at(crate::math::DVec2::new((f64::from(x) + 0.5) / 2.0, 0.5))
@@ -195,7 +244,7 @@ pub(crate) mod tests {
     fn jpeg_is_decoded_and_srgb_linearised() {
         // 16 x 8: the left half sRGB (200, 100, 50), the right half 128 grey.
         let bytes = include_bytes!("../../tests/textures/two_blocks.jpg");
-        let image = decode_image(bytes).unwrap();
+        let image = decode_image(bytes, Decoding::Color).unwrap();
         assert_eq!((image.width(), image.height()), (16, 8));
         let t = super::super::ImageTexture::new(Arc::new(image));
         let left = t.at(crate::math::DVec2::new(0.25, 0.5));
@@ -226,7 +275,7 @@ pub(crate) mod tests {
         let mut writer = encoder.write_header().unwrap();
         writer.write_image_data(&65535u16.to_be_bytes()).unwrap();
         writer.finish().unwrap();
-        let image = decode_image(&out).unwrap();
+        let image = decode_image(&out, Decoding::Color).unwrap();
         let t = super::super::ImageTexture::new(Arc::new(image));
         assert_eq!(
             t.at(crate::math::DVec2::splat(0.5)),
@@ -235,12 +284,63 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn data_is_read_as_stored_and_opacity_from_alpha_or_else_as_data() {
+        let texel = |bytes: &[u8], decoding| {
+            let image = decode_image(bytes, decoding).unwrap();
+            super::super::ImageTexture::new(Arc::new(image)).at(crate::math::DVec2::splat(0.5))
+        };
+        let rgb = png_bytes(1, 1, &[0, 51, 255]);
+        let expected = crate::math::Color::new(0.0, 0.2, 1.0);
+        assert!((texel(&rgb, Decoding::Data) - expected).length() < 1e-7);
+        assert!((texel(&rgb, Decoding::Opacity) - expected).length() < 1e-7);
+        let rgba = rgba_png_bytes(1, 1, &[255, 255, 255, 102]);
+        let alpha = texel(&rgba, Decoding::Opacity);
+        assert!(
+            (alpha - crate::math::Color::splat(0.4)).length() < 1e-7,
+            "{alpha}"
+        );
+        assert_eq!(texel(&rgba, Decoding::Color), crate::math::Color::ONE);
+        let jpeg = include_bytes!("../../tests/textures/two_blocks.jpg");
+        let grey = decode_image(jpeg, Decoding::Data).unwrap();
+        let right =
+            super::super::ImageTexture::new(Arc::new(grey)).at(crate::math::DVec2::new(0.75, 0.5));
+        assert!(
+            (right - crate::math::Color::splat(128.0 / 255.0))
+                .abs()
+                .max_element()
+                < 0.01
+        );
+    }
+
+    #[test]
+    fn a_file_read_as_colour_and_as_data_is_decoded_once_each_way() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("a.png"), png_bytes(1, 1, &[128, 128, 255])).unwrap();
+        let mut cache = ImageCache::default();
+        let color = cache
+            .load(&dir.path().join("a.png"), Decoding::Color)
+            .unwrap();
+        let data = cache
+            .load(&dir.path().join("a.png"), Decoding::Data)
+            .unwrap();
+        let again = cache
+            .load(&dir.path().join("a.png"), Decoding::Data)
+            .unwrap();
+        assert!(!Arc::ptr_eq(&color, &data) && Arc::ptr_eq(&data, &again));
+        assert_eq!(cache.len(), 2);
+    }
+
+    #[test]
     fn a_file_named_twice_is_decoded_once() {
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(dir.path().join("a.png"), png_bytes(1, 1, &[10, 20, 30])).unwrap();
         let mut cache = ImageCache::default();
-        let first = cache.load(&dir.path().join("a.png")).unwrap();
-        let second = cache.load(&dir.path().join(".").join("a.png")).unwrap();
+        let first = cache
+            .load(&dir.path().join("a.png"), Decoding::Color)
+            .unwrap();
+        let second = cache
+            .load(&dir.path().join(".").join("a.png"), Decoding::Color)
+            .unwrap();
         assert!(Arc::ptr_eq(&first, &second));
         assert_eq!(cache.len(), 1);
     }
@@ -249,10 +349,14 @@ pub(crate) mod tests {
     fn missing_and_foreign_files_say_why() {
         let dir = tempfile::tempdir().unwrap();
         let mut cache = ImageCache::default();
-        let missing = cache.load(&dir.path().join("none.png")).unwrap_err();
+        let missing = cache
+            .load(&dir.path().join("none.png"), Decoding::Color)
+            .unwrap_err();
         assert!(matches!(missing, ImageLoadError::Io { .. }));
         std::fs::write(dir.path().join("text.png"), "hello").unwrap();
-        let text = cache.load(&dir.path().join("text.png")).unwrap_err();
+        let text = cache
+            .load(&dir.path().join("text.png"), Decoding::Data)
+            .unwrap_err();
         assert!(
             text.to_string()
                 .ends_with("text.png`: not a PNG or JPEG file")

@@ -18,6 +18,7 @@ pub struct ImageData {
     height: usize,
     texels: Vec<[f32; 3]>,
     max_component: f64,
+    mean: Color,
 }
 
 impl fmt::Debug for ImageData {
@@ -37,12 +38,22 @@ impl ImageData {
             .iter()
             .flatten()
             .fold(0.0f64, |m, &c| m.max(f64::from(c)));
+        let sum = texels.iter().fold(Color::ZERO, |sum, &[r, g, b]| {
+            sum + Color::new(f64::from(r), f64::from(g), f64::from(b))
+        });
+        let mean = sum / texels.len() as f64;
         Some(Self {
             width,
             height,
             texels,
             max_component,
+            mean,
         })
+    }
+
+    /// The mean of all texels.
+    pub fn mean(&self) -> Color {
+        self.mean
     }
 
     /// Width in texels.

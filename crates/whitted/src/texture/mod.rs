@@ -5,17 +5,26 @@
 //! `{ checker = { even = [r, g, b], odd = [r, g, b], size = s } }` where `s`
 //! is the side of one square in (u, v) units, or
 //! `{ image = "wood.png", wrap = "repeat", scale = [su, sv], offset = [ou, ov] }`.
+//! MTL dissolve maps (`map_d`) become a [`DissolveMap`] transmission.
 
 mod checker;
 mod decode;
+mod dissolve;
 mod image;
 
 pub use self::checker::Checker;
 #[cfg(test)]
-pub(crate) use self::decode::tests::png_bytes;
-pub use self::decode::{ImageCache, ImageLoadError, decode_image};
+pub(crate) use self::decode::tests::{png_bytes, rgba_png_bytes};
+pub use self::decode::{Decoding, ImageCache, ImageLoadError, decode_image};
+pub use self::dissolve::DissolveMap;
 pub use self::image::{ImageData, ImageTexture, Wrap};
 use crate::math::{Color, DVec2};
+
+/// The luminance of a linear RGB colour (Rec. 709 weights, which sum to 1:
+/// a grey's luminance is its level).
+pub fn luminance(c: Color) -> f64 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
 
 /// What a material slot's colour is at a surface point.
 #[derive(Clone, Debug, PartialEq)]
@@ -26,6 +35,8 @@ pub enum Texture {
     Checker(Checker),
     /// A PNG or JPEG image, filtered bilinearly.
     Image(ImageTexture),
+    /// What an MTL dissolve map (`map_d`) lets through.
+    Dissolve(DissolveMap),
 }
 
 impl Default for Texture {
@@ -48,24 +59,30 @@ impl Texture {
             Texture::Constant(c) => *c,
             Texture::Checker(checker) => checker.at(uv),
             Texture::Image(image) => image.at(uv),
+            Texture::Dissolve(map) => map.at(uv),
         }
     }
 
-    /// True when the colour is zero everywhere (the slot can be skipped).
+    /// True when the colour is zero everywhere (the slot can be skipped);
+    /// may say false for a dissolve map that happens to be opaque
+    /// everywhere.
     pub fn is_black(&self) -> bool {
         match self {
             Texture::Constant(c) => *c == Color::ZERO,
             Texture::Checker(c) => c.even == Color::ZERO && c.odd == Color::ZERO,
             Texture::Image(image) => image.max_component() == 0.0,
+            Texture::Dissolve(map) => map.filter == Color::ZERO,
         }
     }
 
-    /// The largest component anywhere (bounds the slot's weight).
+    /// The largest component anywhere, or a bound on it (bounds the slot's
+    /// weight).
     pub fn max_component(&self) -> f64 {
         match self {
             Texture::Constant(c) => c.max_element(),
             Texture::Checker(c) => c.even.max_element().max(c.odd.max_element()),
             Texture::Image(image) => image.max_component(),
+            Texture::Dissolve(map) => map.filter.max_element(),
         }
     }
 }

@@ -61,6 +61,7 @@ impl Fill {
             emission: Color::ZERO.into(),
             ior: if self.t > 0.0 { self.ior } else { 1.0 },
             fresnel: false,
+            bump: None,
         }
     }
 }

@@ -1,9 +1,12 @@
-//! Texture maps of MTL materials: `map_Ka`, `map_Kd` and `map_Ks`, with
-//! their `-s`, `-o` and `-clamp` options, are applied; other options are
-//! read and ignored.
+//! Texture maps of MTL materials: `map_Ka`, `map_Kd`, `map_Ks`, the
+//! dissolve map `map_d`, bump maps (`bump`, `map_bump`, in any
+//! capitalisation) and normal maps (`norm`, `map_Kn`, `map_norm`), with
+//! their `-s`, `-o`, `-clamp`, `-bm` and `-imfchan` options, are applied;
+//! other options are read and ignored.
 //!
 //! ```text
 //! map_Kd -s 2 2 -o 0.5 0 -clamp on textures\wood grain.png
+//! map_Bump -bm 0.02 -imfchan l plaster.png
 //! ```
 //!
 //! The file name is the rest of the line after the options (spaces
@@ -17,7 +20,7 @@ use super::text::Line;
 use crate::math::DVec2;
 use crate::texture::Wrap;
 
-/// The colour slot a map applies to.
+/// What a map applies to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum MapSlot {
     /// `map_Ka`.
@@ -26,6 +29,12 @@ pub(super) enum MapSlot {
     Diffuse,
     /// `map_Ks`.
     Specular,
+    /// `map_d`.
+    Dissolve,
+    /// `bump`, `map_bump` (any capitalisation).
+    Bump,
+    /// `norm`, `map_Kn`, `map_norm` (any capitalisation).
+    Normal,
 }
 
 impl MapSlot {
@@ -35,21 +44,41 @@ impl MapSlot {
             "map_Ka" => Some(MapSlot::Ambient),
             "map_Kd" => Some(MapSlot::Diffuse),
             "map_Ks" => Some(MapSlot::Specular),
-            _ => None,
+            "map_d" => Some(MapSlot::Dissolve),
+            _ => match keyword.to_ascii_lowercase().as_str() {
+                "bump" | "map_bump" => Some(MapSlot::Bump),
+                "norm" | "map_kn" | "map_norm" => Some(MapSlot::Normal),
+                _ => None,
+            },
         }
     }
 
-    /// The MTL name of the colour the map replaces.
-    pub(super) fn color_name(self) -> &'static str {
+    /// What the material keeps when the map's file cannot be read.
+    pub(super) fn fallback(self) -> &'static str {
         match self {
-            MapSlot::Ambient => "Ka",
-            MapSlot::Diffuse => "Kd",
-            MapSlot::Specular => "Ks",
+            MapSlot::Ambient => "`Ka` keeps its constant colour",
+            MapSlot::Diffuse => "`Kd` keeps its constant colour",
+            MapSlot::Specular => "`Ks` keeps its constant colour",
+            MapSlot::Dissolve => "`d` keeps its constant value",
+            MapSlot::Bump | MapSlot::Normal => "the surface is shaded without it",
         }
     }
 }
 
-/// One `map_K?` statement.
+/// Which channel of the image a scalar map (`map_d`, a bump map) reads
+/// (`-imfchan`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Channel {
+    /// Not given: a dissolve map reads alpha when the image has it, a bump
+    /// map the luminance.
+    Default,
+    /// `-imfchan l` (and `r`, `g`, `b`, `z`, read as luminance).
+    Luminance,
+    /// `-imfchan m`: the matte (alpha) channel.
+    Matte,
+}
+
+/// One map statement.
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct MapStatement {
     /// Which slot it fills.
@@ -64,6 +93,10 @@ pub(super) struct MapStatement {
     pub(super) scale: DVec2,
     /// `-o u v`.
     pub(super) offset: DVec2,
+    /// `-bm m`: the bump multiplier (strength of a bump or normal map).
+    pub(super) bump_multiplier: f64,
+    /// `-imfchan c`.
+    pub(super) channel: Channel,
 }
 
 /// Options and how many words follow each (at most; `-s`, `-o` and `-t`
@@ -79,8 +112,9 @@ fn arguments(option: &str) -> Option<usize> {
     }
 }
 
-/// Reads a `map_Ka`, `map_Kd` or `map_Ks` line of an MTL file in folder
-/// `folder`; `None` for other lines or a map without a file name.
+/// Reads a map line of an MTL file in folder `folder` (one whose keyword
+/// [`MapSlot::of`] knows); `None` for other lines or a map without a file
+/// name.
 pub(super) fn read_map(line: Line<'_>, folder: &Path) -> Option<MapStatement> {
     let mut words = line.words().peekable();
     let slot = MapSlot::of(words.next()?.0)?;
@@ -91,6 +125,8 @@ pub(super) fn read_map(line: Line<'_>, folder: &Path) -> Option<MapStatement> {
         wrap: Wrap::Repeat,
         scale: DVec2::ONE,
         offset: DVec2::ZERO,
+        bump_multiplier: 1.0,
+        channel: Channel::Default,
     };
     while let Some((option, _)) = words.next_if(|(word, _)| arguments(word).is_some()) {
         let count = arguments(option).unwrap_or(0);
@@ -109,6 +145,9 @@ pub(super) fn read_map(line: Line<'_>, folder: &Path) -> Option<MapStatement> {
             ("-o", &[u, v, ..], _) => statement.offset = DVec2::new(u, v),
             ("-clamp", _, Some(&"on")) => statement.wrap = Wrap::Clamp,
             ("-clamp", _, Some(&"off")) => statement.wrap = Wrap::Repeat,
+            ("-bm", &[m], _) => statement.bump_multiplier = m,
+            ("-imfchan", _, Some(&"m")) => statement.channel = Channel::Matte,
+            ("-imfchan", _, Some(_)) => statement.channel = Channel::Luminance,
             _ => {}
         }
     }
@@ -138,7 +177,34 @@ mod tests {
             (DVec2::new(2.0, 3.0), DVec2::new(0.5, 0.0))
         );
         assert_eq!(m.wrap, Wrap::Clamp);
+        assert_eq!(m.bump_multiplier, 0.2);
         assert_eq!(m.span, 41..64);
+    }
+
+    #[test]
+    fn bump_normal_and_dissolve_maps_are_recognised_in_exporters_spellings() {
+        for (line, slot) in [
+            ("bump h.png", MapSlot::Bump),
+            ("map_bump h.png", MapSlot::Bump),
+            ("map_Bump h.png", MapSlot::Bump),
+            ("BUMP h.png", MapSlot::Bump),
+            ("norm n.png", MapSlot::Normal),
+            ("map_Kn n.png", MapSlot::Normal),
+            ("map_d a.png", MapSlot::Dissolve),
+        ] {
+            assert_eq!(map(line).map(|m| m.slot), Some(slot), "{line}");
+        }
+        let m = map("map_Bump -bm 0.05 -imfchan m -clamp on h.png").unwrap();
+        assert_eq!(
+            (m.bump_multiplier, m.channel, m.wrap),
+            (0.05, Channel::Matte, Wrap::Clamp)
+        );
+        assert_eq!(
+            map("map_d -imfchan l a.png").unwrap().channel,
+            Channel::Luminance
+        );
+        assert_eq!(map("map_d a.png").unwrap().channel, Channel::Default);
+        assert!(map("disp d.png").is_none() && map("map_Ns n.png").is_none());
     }
 
     #[test]
@@ -148,7 +214,6 @@ mod tests {
             (m.slot, m.wrap, m.scale),
             (MapSlot::Specular, Wrap::Repeat, DVec2::ONE)
         );
-        assert!(map("map_d alpha.png").is_none());
         assert!(map("map_Kd -clamp on").is_none());
     }
 }

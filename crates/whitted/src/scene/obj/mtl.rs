@@ -7,12 +7,13 @@ use std::collections::HashMap;
 use std::ops::Range;
 use std::path::Path;
 
-use super::maps::{MapSlot, MapStatement, read_map};
+use super::maps::{Channel, MapSlot, MapStatement, read_map};
 use super::text::lines;
+use crate::bump::Bump;
 use crate::material::Material;
 use crate::math::Color;
 use crate::scene::Diagnostic;
-use crate::texture::{ImageCache, ImageTexture, Texture};
+use crate::texture::{Decoding, DissolveMap, ImageCache, ImageData, ImageTexture, Texture};
 
 /// The materials of one library by name, or its errors; with its warnings.
 pub(super) struct Library {
@@ -62,7 +63,7 @@ fn is_error(d: &Diagnostic) -> bool {
 }
 
 /// Every malformed number, with its place; a warning for the texture maps
-/// we do not apply (all but `map_Ka`, `map_Kd` and `map_Ks`).
+/// we do not apply (all but those [`MapSlot::of`] knows).
 fn check(source: &str, path: &Path) -> Vec<Diagnostic> {
     let mut diagnostics = Vec::new();
     let mut maps: Option<(Range<usize>, usize)> = None;
@@ -117,8 +118,9 @@ fn check(source: &str, path: &Path) -> Vec<Diagnostic> {
     }
     if let Some((at, count)) = maps {
         let message = format!(
-            "{count} texture map{} in this library not applied: only `map_Ka`, `map_Kd` \
-             and `map_Ks` are; bump, normal, dissolve and other maps are ignored",
+            "{count} texture map{} in this library not applied: only `map_Ka`, `map_Kd`, \
+             `map_Ks`, `map_d`, bump (`bump`, `map_Bump`) and normal (`norm`) maps are; \
+             displacement, decal, reflection and other maps are ignored",
             if count == 1 { "" } else { "s" }
         );
         diagnostics.push(Diagnostic::warning(path, source, at, message));
@@ -169,10 +171,32 @@ struct Maps {
     ambient: Option<Texture>,
     diffuse: Option<Texture>,
     specular: Option<Texture>,
+    dissolve: Option<ImageTexture>,
+    bump: Option<Bump>,
 }
 
-/// Decodes each map; a file that cannot be read is a warning and its slot
-/// keeps its constant colour.
+/// How a map's file is decoded: colours as sRGB; a dissolve map as opacity
+/// (alpha when the image has it) unless `-imfchan` says luminance; bump and
+/// normal maps as data, a bump map's alpha with `-imfchan m`.
+fn decoding(statement: &MapStatement) -> Decoding {
+    match (statement.slot, statement.channel) {
+        (MapSlot::Ambient | MapSlot::Diffuse | MapSlot::Specular, _) => Decoding::Color,
+        (MapSlot::Dissolve, Channel::Default) | (_, Channel::Matte) => Decoding::Opacity,
+        _ => Decoding::Data,
+    }
+}
+
+/// True when an image read as data looks like a tangent-space normal map:
+/// its mean texel is close to (0.5, 0.5, 1), a straight-up normal, and
+/// bluer than it is red (no grey height map is). Exporters (Blender's among
+/// them) write normal maps as `map_Bump`.
+fn looks_like_normal_map(data: &ImageData) -> bool {
+    let mean = data.mean();
+    (mean.x - 0.5).abs() < 0.1 && (mean.y - 0.5).abs() < 0.1 && mean.z > 0.75
+}
+
+/// Decodes each map; a file that cannot be read is a warning and the
+/// material does without the map.
 fn load_maps(
     statements: &[MapStatement],
     images: &mut ImageCache,
@@ -182,13 +206,10 @@ fn load_maps(
 ) -> Maps {
     let mut maps = Maps::default();
     for statement in statements {
-        let data = match images.load(&statement.file) {
+        let data = match images.load(&statement.file, decoding(statement)) {
             Ok(data) => data,
             Err(error) => {
-                let message = format!(
-                    "{error}; `{}` keeps its constant colour",
-                    statement.slot.color_name()
-                );
+                let message = format!("{error}; {}", statement.slot.fallback());
                 diagnostics.push(Diagnostic::warning(
                     path,
                     source,
@@ -198,18 +219,32 @@ fn load_maps(
                 continue;
             }
         };
-        let texture = Texture::Image(ImageTexture {
+        let image = ImageTexture {
             data,
             wrap: statement.wrap,
             scale: statement.scale,
             offset: statement.offset,
-        });
-        let slot = match statement.slot {
-            MapSlot::Ambient => &mut maps.ambient,
-            MapSlot::Diffuse => &mut maps.diffuse,
-            MapSlot::Specular => &mut maps.specular,
         };
-        *slot = Some(texture);
+        let strength = statement.bump_multiplier;
+        match statement.slot {
+            MapSlot::Ambient => maps.ambient = Some(Texture::Image(image)),
+            MapSlot::Diffuse => maps.diffuse = Some(Texture::Image(image)),
+            MapSlot::Specular => maps.specular = Some(Texture::Image(image)),
+            MapSlot::Dissolve => maps.dissolve = Some(image),
+            MapSlot::Bump if !looks_like_normal_map(&image.data) => {
+                maps.bump = Some(Bump::Height {
+                    texture: Texture::Image(image),
+                    strength,
+                });
+            }
+            MapSlot::Bump | MapSlot::Normal => {
+                maps.bump = Some(Bump::Normal {
+                    texture: Texture::Image(image),
+                    strength,
+                    flip_green: false,
+                });
+            }
+        }
     }
     maps
 }
@@ -219,7 +254,9 @@ fn color(c: Option<[f64; 3]>, default: Color) -> Color {
 }
 
 /// Our material for an MTL material, by its illumination model (see
-/// `docs/obj.md`); a map replaces the constant colour of its slot.
+/// `docs/obj.md`); a colour map replaces the constant colour of its slot, a
+/// dissolve map scales `d` per texel, a bump or normal map tilts the
+/// shading normal.
 fn whitted_material(m: &tobj::Material, extra: &Extra, maps: &Maps) -> Material {
     let kd = color(m.diffuse, Color::splat(0.8));
     let ke = color(m.emissive, Color::ZERO);
@@ -238,16 +275,29 @@ fn whitted_material(m: &tobj::Material, extra: &Extra, maps: &Maps) -> Material 
         .unwrap_or(1.0)
         .clamp(0.0, 1.0);
     let illum = m.illumination_model.unwrap_or(2);
+    // What a dissolve lets through, tinted by `filter`: per texel with a
+    // dissolve map.
+    let through = |filter: Color| -> Texture {
+        match &maps.dissolve {
+            Some(opacity) => Texture::Dissolve(DissolveMap {
+                opacity: opacity.clone(),
+                dissolve,
+                filter,
+            }),
+            None => (filter * (1.0 - dissolve)).into(),
+        }
+    };
     let mut material = Material {
         ambient: ka,
         diffuse: kd_map.clone(),
         specular: Color::ZERO.into(),
         shininess: m.shininess.unwrap_or(32.0).max(1.0),
         reflection: Color::ZERO.into(),
-        transmission: Color::splat(1.0 - dissolve).into(),
+        transmission: through(Color::ONE),
         emission: ke.into(),
         ior: 1.0,
         fresnel: false,
+        bump: maps.bump.clone(),
     };
     if illum == 0 {
         material.ambient = Color::ZERO.into();
@@ -264,16 +314,15 @@ fn whitted_material(m: &tobj::Material, extra: &Extra, maps: &Maps) -> Material 
         material.reflection = ks;
     }
     if illum == 4 {
-        let filter = extra.transmission_filter.unwrap_or(Color::ONE);
-        material.transmission = (filter * (1.0 - dissolve)).into();
+        material.transmission = through(extra.transmission_filter.unwrap_or(Color::ONE));
     }
     if matches!(illum, 6 | 7) {
-        let fallback = if dissolve < 1.0 {
-            Color::splat(1.0 - dissolve)
-        } else {
-            Color::ONE
+        material.transmission = match (extra.transmission_filter, &maps.dissolve) {
+            (Some(filter), _) => filter.into(),
+            (None, Some(_)) => through(Color::ONE),
+            (None, None) if dissolve < 1.0 => Color::splat(1.0 - dissolve).into(),
+            (None, None) => Color::ONE.into(),
         };
-        material.transmission = extra.transmission_filter.unwrap_or(fallback).into();
         material.ior = m.optical_density.filter(|n| *n > 0.0).unwrap_or(1.0);
         material.fresnel = illum == 7;
     }
@@ -345,8 +394,96 @@ mod tests {
     }
 
     #[test]
+    fn dissolve_bump_and_normal_maps_are_applied_with_their_options() {
+        let dir = tempfile::tempdir().unwrap();
+        let write = |name: &str, bytes: Vec<u8>| std::fs::write(dir.path().join(name), bytes);
+        // Left texel clear (alpha 0), right texel opaque.
+        write(
+            "leaf.png",
+            crate::texture::rgba_png_bytes(2, 1, &[0, 255, 0, 0, 0, 255, 0, 255]),
+        )
+        .unwrap();
+        write(
+            "height.png",
+            crate::texture::png_bytes(2, 1, &[0, 0, 0, 255, 255, 255]),
+        )
+        .unwrap();
+        write(
+            "normal.png",
+            crate::texture::png_bytes(1, 1, &[128, 128, 255]),
+        )
+        .unwrap();
+        let source = "newmtl leaf\nKd 0 1 0\nmap_d -s 2 1 leaf.png\nbump -bm 0.05 height.png\n\
+                      newmtl tiles\nmap_Bump -bm 0.5 normal.png\n\
+                      newmtl wall\nnorm -clamp on normal.png\n\
+                      newmtl glass\nillum 4\nTf 1 0.5 0.5\nd 0.5\nmap_d -imfchan l height.png\n";
+        let lib = read_library(
+            source,
+            &dir.path().join("m.mtl"),
+            &mut ImageCache::default(),
+        );
+        assert!(lib.diagnostics.is_empty(), "{:?}", lib.diagnostics);
+        let m = &lib.materials;
+        let Texture::Dissolve(leaf) = &m["leaf"].transmission else {
+            panic!("{:?}", m["leaf"].transmission);
+        };
+        assert_eq!((leaf.dissolve, leaf.filter), (1.0, Color::ONE));
+        assert_eq!(leaf.opacity.scale, crate::math::DVec2::new(2.0, 1.0));
+        let at = |u| m["leaf"].transmission.at(crate::math::DVec2::new(u, 0.5));
+        assert_eq!((at(0.125), at(0.375)), (Color::ONE, Color::ZERO));
+        assert!(matches!(
+            m["leaf"].bump,
+            Some(Bump::Height { strength: 0.05, .. })
+        ));
+        let Some(Bump::Normal { strength: 0.5, .. }) = m["tiles"].bump else {
+            panic!("a bluish map_Bump is a normal map: {:?}", m["tiles"].bump);
+        };
+        let Some(Bump::Normal {
+            texture: Texture::Image(wall),
+            strength: 1.0,
+            flip_green: false,
+        }) = &m["wall"].bump
+        else {
+            panic!("{:?}", m["wall"].bump);
+        };
+        assert_eq!(wall.wrap, crate::texture::Wrap::Clamp);
+        let glass = &m["glass"].transmission;
+        let (clear, opaque) = (
+            glass.at(crate::math::DVec2::new(0.25, 0.5)),
+            glass.at(crate::math::DVec2::new(0.75, 0.5)),
+        );
+        assert_eq!(clear, Color::new(1.0, 0.5, 0.5));
+        assert!(
+            (opaque - Color::new(0.5, 0.25, 0.25)).length() < 1e-12,
+            "{opaque}"
+        );
+    }
+
+    #[test]
+    fn missing_dissolve_and_bump_files_are_warnings_and_the_material_does_without() {
+        let lib = read("newmtl a\nd 0.75\nmap_d none.png\nmap_Bump -bm 2 flat.png\n");
+        let text: Vec<String> = lib.diagnostics.iter().map(ToString::to_string).collect();
+        assert_eq!(text.len(), 2, "{text:?}");
+        assert!(
+            text[0].starts_with("m.mtl:3:7: warning: cannot read the image `none.png`")
+                && text[0].contains("; `d` keeps its constant value"),
+            "{}",
+            text[0]
+        );
+        assert!(
+            text[1].starts_with("m.mtl:4:16: warning: cannot read the image `flat.png`")
+                && text[1].contains("; the surface is shaded without it"),
+            "{}",
+            text[1]
+        );
+        let a = &lib.materials["a"];
+        assert_eq!(a.transmission, Texture::Constant(Color::splat(0.25)));
+        assert_eq!(a.bump, None);
+    }
+
+    #[test]
     fn bad_numbers_are_located_and_texture_maps_warned_about() {
-        let lib = read("newmtl a\nKd 1 x 0\nmap_d wood.png\nNs\n");
+        let lib = read("newmtl a\nKd 1 x 0\ndisp wood.png\nNs\n");
         let text: Vec<String> = lib.diagnostics.iter().map(ToString::to_string).collect();
         assert!(
             text[0].starts_with("m.mtl:2:6: error: expected a number after `Kd`, found `x`"),

@@ -7,6 +7,12 @@
 //! [materials.wood]                # paths are relative to the scene file
 //! diffuse = { image = "textures/wood.png", wrap = "mirror", scale = [2, 2] }
 //!
+//! [materials.stone]               # a tangent-space normal map (OpenGL: green is up)
+//! normal_map = { image = "textures/stone_normal.png", strength = 1, flip_green = false }
+//!
+//! [materials.plaster]             # or a height field, strength in scene units
+//! bump_map = { image = "textures/plaster_height.png", scale = [4, 4], strength = 0.01 }
+//!
 //! [materials.glass]
 //! diffuse = 0.05                  # colour slots: [r, g, b], a grey, a checker or an image
 //! specular = 0.8
@@ -20,14 +26,17 @@
 //! other colour slots default to black, `shininess` to 32, `ior` to 1 and
 //! `fresnel` to false. A checker's `size` defaults to 1; an image's `wrap` to
 //! `"repeat"` (or `"clamp"`, `"mirror"`), `scale` to `[1, 1]` and `offset` to
-//! `[0, 0]`.
+//! `[0, 0]`. A material takes a normal map or a bump map, not both; both
+//! read their image as data (no sRGB curve) and place it like a colour
+//! slot's; `strength` defaults to 1 and `flip_green` to false.
 
 use toml_span::value::Value;
 
 use super::reader::{Fields, Parsed, Reader, all};
+use crate::bump::Bump;
 use crate::material::Material;
 use crate::math::{Color, DVec2};
-use crate::texture::{Checker, ImageTexture, Texture, Wrap};
+use crate::texture::{Checker, Decoding, ImageTexture, Texture, Wrap};
 
 /// The keys of a material.
 const KEYS: &[&str] = &[
@@ -40,6 +49,8 @@ const KEYS: &[&str] = &[
     "shininess",
     "ior",
     "fresnel",
+    "normal_map",
+    "bump_map",
 ];
 
 /// The materials of a scene, in the order they appear in the file.
@@ -92,6 +103,15 @@ fn read_material(r: &mut Reader<'_>, value: &Value<'_>, name: &str) -> Parsed<Ma
     let shininess = r.or_default(&f, "shininess", 32.0, Reader::non_negative);
     let ior = r.or_default(&f, "ior", 1.0, Reader::positive);
     let fresnel = r.or_default(&f, "fresnel", false, Reader::boolean);
+    let normal_map = r.optional(&f, "normal_map", normal_map);
+    let bump_map = r.optional(&f, "bump_map", bump_map);
+    let bump = match (f.get("normal_map"), f.get("bump_map")) {
+        (Some(_), Some(second)) => Err(r.error(
+            second.span,
+            "a material takes `normal_map` or `bump_map`, not both",
+        )),
+        _ => Ok(normal_map?.or(bump_map?)),
+    };
     keys?;
     let diffuse = diffuse?;
     Ok(Material {
@@ -104,6 +124,7 @@ fn read_material(r: &mut Reader<'_>, value: &Value<'_>, name: &str) -> Parsed<Ma
         emission: emission?,
         ior: ior?,
         fresnel: fresnel?,
+        bump: bump?,
     })
 }
 
@@ -130,12 +151,27 @@ fn texture(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Texture> 
     checker
 }
 
+/// The keys placing an image.
+const IMAGE_KEYS: [&str; 4] = ["image", "wrap", "scale", "offset"];
+
 /// `{ image = "file", wrap = "repeat", scale = [su, sv], offset = [ou, ov] }`.
 fn image(r: &mut Reader<'_>, f: &Fields<'_, '_>) -> Parsed<Texture> {
-    let keys = r.check_keys(f, &["image", "wrap", "scale", "offset"]);
+    let keys = r.check_keys(f, &IMAGE_KEYS);
+    let image = placed_image(r, f, Decoding::Color);
+    keys?;
+    Ok(Texture::Image(image?))
+}
+
+/// The image of `f` decoded as `decoding`, placed by its `wrap`, `scale`
+/// and `offset` (its keys are checked by the caller).
+fn placed_image(
+    r: &mut Reader<'_>,
+    f: &Fields<'_, '_>,
+    decoding: Decoding,
+) -> Parsed<ImageTexture> {
     let data = r.require(f, "image", |r, value, key| {
         let (name, span) = r.string(value, key)?;
-        r.image(name, span)
+        r.image(name, span, decoding)
     });
     let wrap = r.or_default(f, "wrap", Wrap::Repeat, wrap);
     let scale = r.or_default(f, "scale", [1.0, 1.0], |r, v, k| {
@@ -144,13 +180,40 @@ fn image(r: &mut Reader<'_>, f: &Fields<'_, '_>) -> Parsed<Texture> {
     let offset = r.or_default(f, "offset", [0.0, 0.0], |r, v, k| {
         r.numbers::<2>(v, k, Reader::number)
     });
-    keys?;
-    Ok(Texture::Image(ImageTexture {
+    Ok(ImageTexture {
         data: data?,
         wrap: wrap?,
         scale: DVec2::from_array(scale?),
         offset: DVec2::from_array(offset?),
-    }))
+    })
+}
+
+/// `{ image = "file", wrap, scale, offset, strength = 1, flip_green = false }`.
+fn normal_map(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Bump> {
+    let f = r.table(value, key, format!("`{key}`"))?;
+    let keys = r.check_keys(&f, &[&IMAGE_KEYS[..], &["strength", "flip_green"]].concat());
+    let image = placed_image(r, &f, Decoding::Data);
+    let strength = r.or_default(&f, "strength", 1.0, Reader::number);
+    let flip_green = r.or_default(&f, "flip_green", false, Reader::boolean);
+    keys?;
+    Ok(Bump::Normal {
+        texture: Texture::Image(image?),
+        strength: strength?,
+        flip_green: flip_green?,
+    })
+}
+
+/// `{ image = "file", wrap, scale, offset, strength = 1 }`.
+fn bump_map(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Bump> {
+    let f = r.table(value, key, format!("`{key}`"))?;
+    let keys = r.check_keys(&f, &[&IMAGE_KEYS[..], &["strength"]].concat());
+    let image = placed_image(r, &f, Decoding::Data);
+    let strength = r.or_default(&f, "strength", 1.0, Reader::number);
+    keys?;
+    Ok(Bump::Height {
+        texture: Texture::Image(image?),
+        strength: strength?,
+    })
 }
 
 /// `"repeat"`, `"clamp"` or `"mirror"`.
@@ -218,6 +281,7 @@ mod tests {
                 emission: Texture::Constant(Color::new(1.0, 2.0, 3.0)),
                 ior: 1.33,
                 fresnel: true,
+                bump: None,
             }]
         );
     }
@@ -302,6 +366,66 @@ mod tests {
     }
 
     #[test]
+    fn normal_and_bump_maps_are_read_as_data_with_their_options() {
+        let dir = tempfile::tempdir().unwrap();
+        let png = crate::texture::png_bytes(1, 1, &[128, 128, 255]);
+        std::fs::write(dir.path().join("n.png"), png).unwrap();
+        let source = format!(
+            "{CAMERA}[materials.a]\nnormal_map = {{ image = 'n.png', strength = 0.5, \
+             flip_green = true, wrap = 'clamp' }}\n\
+             [materials.b]\nbump_map = {{ image = 'n.png', scale = [2, 3], strength = 0.01 }}\n\
+             [materials.c]\ndiffuse = {{ image = 'n.png' }}\n"
+        );
+        let s = super::super::parse_scene(&source, &dir.path().join("s.toml")).unwrap();
+        let Some(Bump::Normal {
+            texture: Texture::Image(normals),
+            strength: 0.5,
+            flip_green: true,
+        }) = &s.materials[0].bump
+        else {
+            panic!("{:?}", s.materials[0].bump);
+        };
+        assert_eq!(normals.wrap, Wrap::Clamp);
+        // Data: 128 is 128/255, not the sRGB-decoded 0.2158.
+        let texel = normals.at(DVec2::splat(0.5));
+        assert!((texel.x - 128.0 / 255.0).abs() < 1e-6, "{texel}");
+        let Some(Bump::Height {
+            texture: Texture::Image(heights),
+            strength,
+        }) = &s.materials[1].bump
+        else {
+            panic!("{:?}", s.materials[1].bump);
+        };
+        assert_eq!((heights.scale, *strength), (DVec2::new(2.0, 3.0), 0.01));
+        assert!(Arc::ptr_eq(&normals.data, &heights.data));
+        let Texture::Image(color) = &s.materials[2].diffuse else {
+            panic!();
+        };
+        assert!(!Arc::ptr_eq(&color.data, &normals.data));
+    }
+
+    #[test]
+    fn map_errors_are_located_and_both_maps_at_once_refused() {
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[materials.a]\nnormal_map = 'n.png'\n\
+                 [materials.b]\nbump_map = {{ strength = 'high', flip_green = true }}\n\
+                 [materials.c]\nnormal_map = {{ image = 1 }}\nbump_map = {{ image = 2 }}\n"
+            )),
+            [
+                "expected a table for `normal_map`, found a string",
+                "missing required key `image` in `bump_map`",
+                "expected a number for `strength`, found a string",
+                "unknown key `flip_green` in `bump_map`; expected one of: image, wrap, scale, \
+                 offset, strength",
+                "expected a string for `image`, found an integer",
+                "a material takes `normal_map` or `bump_map`, not both",
+                "expected a string for `image`, found an integer",
+            ]
+        );
+    }
+
+    #[test]
     fn materials_keep_the_order_of_the_file() {
         let s = scene(&format!(
             "{CAMERA}[materials.zinc]\nior = 2\n[materials.amber]\nior = 3\n"
@@ -327,7 +451,8 @@ mod tests {
                 "`ior` must be greater than 0, got 0",
                 "expected `true` or `false` for `fresnel`, found an integer",
                 "unknown key `glow` in material `bad`; expected one of: ambient, diffuse, \
-                 specular, reflection, transmission, emission, shininess, ior, fresnel",
+                 specular, reflection, transmission, emission, shininess, ior, fresnel, \
+                 normal_map, bump_map",
                 "missing required key `checker` in `ambient`",
                 "unknown key `chequer` in `ambient`; expected one of: checker, image",
                 "missing required key `odd` in checker",

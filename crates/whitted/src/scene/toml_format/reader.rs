@@ -14,7 +14,7 @@ use toml_span::value::{Key, Table, Value};
 
 use crate::math::{Color, Vec3, unit};
 use crate::scene::{Diagnostic, SceneError};
-use crate::texture::{ImageCache, ImageData};
+use crate::texture::{Decoding, ImageCache, ImageData};
 
 /// A value was wrong and its error has been recorded. Only [`Reader::error`]
 /// makes one, so a failed walk always has at least one diagnostic.
@@ -111,11 +111,17 @@ impl<'s> Reader<'s> {
     }
 
     /// The image file named `name` (relative to the scene file), decoded
-    /// once; an error at `span` naming the file when it cannot be read.
-    pub(super) fn image(&mut self, name: &str, span: Span) -> Parsed<Arc<ImageData>> {
+    /// once as `decoding`; an error at `span` naming the file when it cannot
+    /// be read.
+    pub(super) fn image(
+        &mut self,
+        name: &str,
+        span: Span,
+        decoding: Decoding,
+    ) -> Parsed<Arc<ImageData>> {
         let file = self.path.parent().unwrap_or(Path::new("")).join(name);
         self.images
-            .load(&file)
+            .load(&file, decoding)
             .map_err(|error| self.error(span, error.to_string()))
     }
 
