@@ -128,19 +128,21 @@ impl Sphere {
             phi += TAU;
         }
         let theta = (local.z / self.radius).clamp(-1.0, 1.0).acos();
-        let (sin_phi, cos_phi) = phi.sin_cos();
+        // cos φ and sin φ from the point itself (φ = 0 at the poles, as
+        // atan2(0, 0) gives).
+        let rho = local.x.hypot(local.y);
+        let (sin_phi, cos_phi) = if rho > 0.0 {
+            (local.y / rho, local.x / rho)
+        } else {
+            (0.0, 1.0)
+        };
         LocalSurface {
             point,
             point_error,
             normal,
             uv: DVec2::new(phi / TAU, 1.0 - theta / PI),
             dpdu: Vec3::new(-TAU * local.y, TAU * local.x, 0.0),
-            dpdv: PI
-                * Vec3::new(
-                    -local.z * cos_phi,
-                    -local.z * sin_phi,
-                    local.x.hypot(local.y),
-                ),
+            dpdv: PI * Vec3::new(-local.z * cos_phi, -local.z * sin_phi, rho),
         }
     }
 
