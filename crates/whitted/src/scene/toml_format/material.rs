@@ -157,7 +157,8 @@ const IMAGE_KEYS: [&str; 4] = ["image", "wrap", "scale", "offset"];
 /// `{ image = "file", wrap = "repeat", scale = [su, sv], offset = [ou, ov] }`.
 fn image(r: &mut Reader<'_>, f: &Fields<'_, '_>) -> Parsed<Texture> {
     let keys = r.check_keys(f, &IMAGE_KEYS);
-    let image = placed_image(r, f, Decoding::Color);
+    let decoding = r.color_image_decoding();
+    let image = placed_image(r, f, decoding);
     keys?;
     Ok(Texture::Image(image?))
 }
@@ -340,6 +341,23 @@ mod tests {
             (Wrap::Mirror, DVec2::new(2.0, 3.0), DVec2::new(0.5, -1.0))
         );
         assert_eq!(a.at(DVec2::splat(0.5)), Color::ONE);
+    }
+
+    #[test]
+    fn a_display_scene_reads_colour_images_as_stored() {
+        let dir = tempfile::tempdir().unwrap();
+        let png = crate::texture::png_bytes(1, 1, &[128, 128, 128]);
+        std::fs::write(dir.path().join("grey.png"), png).unwrap();
+        let texel = |colours: &str| {
+            let source = format!(
+                "{CAMERA}[render]\ncolours = '{colours}'\n\
+                 [materials.a]\ndiffuse = {{ image = 'grey.png' }}\n"
+            );
+            let s = super::super::parse_scene(&source, &dir.path().join("s.toml")).unwrap();
+            s.materials[0].diffuse.at(DVec2::splat(0.5)).x
+        };
+        assert!((texel("display") - 128.0 / 255.0).abs() < 1e-6);
+        assert!((texel("linear") - 0.2158605).abs() < 1e-6);
     }
 
     #[test]
