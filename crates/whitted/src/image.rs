@@ -1,5 +1,7 @@
-//! The film (a grid of float pixels) and its writers: PNG (8-bit sRGB), EXR
-//! and PFM (linear float).
+//! The film (a grid of float pixels) and its writers: PNG (8-bit, encoded
+//! as the film's [`ColorSpace`] says), EXR and PFM (32-bit float, the values
+//! as computed: linear light for a linear scene, display values for a
+//! display-referred one).
 //!
 //! Files are written whole or not at all: the bytes go to a temporary file
 //! in the destination folder, which is renamed over the destination only
@@ -8,24 +10,28 @@
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
+use crate::color_space::ColorSpace;
+
 /// A `width` × `height` grid of pixels with `channels` float values each,
-/// row 0 at the top.
+/// row 0 at the top, and what its values mean.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     width: u32,
     height: u32,
     channels: usize,
+    color_space: ColorSpace,
     data: Vec<f32>,
 }
 
 /// The image file formats whitted writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ImageFormat {
-    /// 8-bit sRGB PNG (values clamped to [0, 1]).
+    /// 8-bit PNG (values clamped to [0, 1]): linear values through the
+    /// sRGB curve, display values as they are.
     Png,
-    /// OpenEXR, 32-bit linear float.
+    /// OpenEXR, 32-bit float, the values as they are.
     Exr,
-    /// Portable float map, 32-bit linear float.
+    /// Portable float map, 32-bit float, the values as they are.
     Pfm,
 }
 
@@ -75,14 +81,28 @@ impl ImageFormat {
 }
 
 impl Film {
-    /// A black film.
+    /// A black film of linear values.
     pub fn new(width: u32, height: u32, channels: usize) -> Self {
         Self {
             width,
             height,
             channels,
+            color_space: ColorSpace::Linear,
             data: vec![0.0; width as usize * height as usize * channels],
         }
+    }
+
+    /// The same film, its values taken to be in `color_space`.
+    pub fn with_color_space(self, color_space: ColorSpace) -> Self {
+        Self {
+            color_space,
+            ..self
+        }
+    }
+
+    /// What the values mean, which decides how a PNG encodes them.
+    pub fn color_space(&self) -> ColorSpace {
+        self.color_space
     }
 
     /// Width in pixels.
@@ -151,7 +171,11 @@ impl Film {
         });
         encoder.set_depth(png::BitDepth::Eight);
         encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-        let bytes: Vec<u8> = self.data.iter().map(|&v| encode_srgb8(v)).collect();
+        let bytes: Vec<u8> = self
+            .data
+            .iter()
+            .map(|&v| self.color_space.encode8(v))
+            .collect();
         let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
         writer
             .write_image_data(&bytes)
@@ -209,21 +233,6 @@ impl Film {
             .to_buffered(BufWriter::new(out))
             .map_err(std::io::Error::other)
     }
-}
-
-/// A linear value as an 8-bit sRGB code (clamped; NaN becomes 0).
-pub fn encode_srgb8(linear: f32) -> u8 {
-    let v = if linear.is_nan() {
-        0.0
-    } else {
-        linear.clamp(0.0, 1.0)
-    };
-    let encoded = if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    };
-    (encoded * 255.0 + 0.5) as u8
 }
 
 /// An encoded image waiting in a temporary file beside its destination.
@@ -317,17 +326,6 @@ mod tests {
     }
 
     #[test]
-    fn srgb_encoding_matches_known_codes() {
-        assert_eq!(encode_srgb8(0.0), 0);
-        assert_eq!(encode_srgb8(1.0), 255);
-        assert_eq!(encode_srgb8(2.0), 255);
-        assert_eq!(encode_srgb8(-1.0), 0);
-        assert_eq!(encode_srgb8(f32::NAN), 0);
-        assert_eq!(encode_srgb8(0.5), 188);
-        assert_eq!(encode_srgb8(0.2159), 128);
-    }
-
-    #[test]
     fn pfm_is_written_bottom_row_first_with_a_little_endian_scale() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("g.pfm");
@@ -363,6 +361,36 @@ mod tests {
         let image = exr::prelude::read_first_flat_layer_from_file(&exr_path).unwrap();
         assert_eq!(image.layer_data.size, exr::prelude::Vec2(3, 2));
         assert_eq!(image.layer_data.channel_data.list.len(), 3);
+    }
+
+    /// The 8-bit codes of a PNG file.
+    fn png_codes(path: &Path) -> Vec<u8> {
+        let decoder =
+            png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+        let mut reader = decoder.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        buf.truncate(info.buffer_size());
+        buf
+    }
+
+    #[test]
+    fn a_display_film_writes_its_values_without_the_curve_and_its_floats_unchanged() {
+        let dir = tempfile::tempdir().unwrap();
+        let film = gradient().with_color_space(ColorSpace::Display);
+        assert_eq!(film.color_space(), ColorSpace::Display);
+        let png_path = dir.path().join("g.png");
+        film.write(&png_path).unwrap();
+        // Pixel (1, 0) is (0.5, 0, 0.25); linear it would be (188, 0, 137).
+        assert_eq!(&png_codes(&png_path)[3..6], &[128, 0, 64]);
+        let pfm_path = dir.path().join("g.pfm");
+        film.write(&pfm_path).unwrap();
+        let linear_path = dir.path().join("linear.pfm");
+        gradient().write(&linear_path).unwrap();
+        assert_eq!(
+            std::fs::read(&pfm_path).unwrap(),
+            std::fs::read(&linear_path).unwrap()
+        );
     }
 
     #[test]

@@ -46,6 +46,7 @@ pub mod accel;
 pub mod bench;
 pub mod bump;
 pub mod camera;
+pub mod color_space;
 pub mod geometry;
 pub mod heat_map;
 pub mod image;

@@ -3,16 +3,24 @@
 //! The colour leaving a surface point towards the viewer is
 //!
 //! ```text
-//! I = ke + ka·Ia + Σ_lights f_att · S · I_light · (kd (N·L) + ks (R·V)^n)
-//!       + kr · I(reflected) + kt · I(refracted)
+//! I = α (ke + ka·Ia + Σ_lights f_att · S · I_light · (kd (N·L) + ks (R·V)^n))
+//!       + α kr · I(reflected) + (α kt + 1 - α) · I(refracted)
 //! ```
 //!
+//! The opacity `α` dissolves the surface: its own light and mirror
+//! reflection are weighted by `α`, and what is behind shows through by
+//! `1 - α`, on the refracted ray (straight on, with `ior` 1). An opaque
+//! surface (`α` = 1, the default) is the plain Whitted model; a clear one
+//! (`α` = 0) is invisible. A shadow ray crossing the surface keeps
+//! `α kt + 1 - α` of the light.
+//!
 //! With `fresnel = true`, the transmission `kt` is split by Schlick's
-//! approximation `F`: the refracted ray gets `kt (1 - F)` and the reflected
-//! ray gets `kr + kt F`. Without it, total internal reflection alone moves the
-//! refracted weight `kt` onto the reflected ray.
+//! approximation `F`: the refracted ray gets `α kt (1 - F) + 1 - α` and the
+//! reflected ray gets `α (kr + kt F)`. Without it, total internal reflection
+//! alone moves the refracted weight onto the reflected ray.
 
 use crate::bump::Bump;
+use crate::math::{Color, DVec2};
 use crate::texture::Texture;
 
 /// Index of a material in [`crate::scene::Scene::materials`].
@@ -44,12 +52,15 @@ pub struct Material {
     pub fresnel: bool,
     /// A bump or normal map tilting the shading normal `N`, if any.
     pub bump: Option<Bump>,
+    /// `α`: how much of the surface is there, per component in [0, 1]; the
+    /// rest is dissolved and shows what is behind it.
+    pub opacity: Texture,
 }
 
 impl Default for Material {
     /// A matte mid-grey.
     fn default() -> Self {
-        let grey = Texture::Constant(crate::math::Color::splat(0.8));
+        let grey = Texture::Constant(Color::splat(0.8));
         Self {
             ambient: grey.clone(),
             diffuse: grey,
@@ -61,13 +72,52 @@ impl Default for Material {
             ior: 1.0,
             fresnel: false,
             bump: None,
+            opacity: Texture::Constant(Color::ONE),
         }
     }
 }
 
 impl Material {
-    /// True when shadow rays can pass through this surface.
+    /// True when shadow rays can pass through this surface: it transmits,
+    /// or it may be dissolved somewhere.
     pub fn is_transmissive(&self) -> bool {
-        !self.transmission.is_black()
+        !self.transmission.is_black() || !self.opacity.is_white()
+    }
+
+    /// How much light passes through the surface at `uv` (a shadow ray's
+    /// factor): `α kt + 1 - α`.
+    pub fn pass_through(&self, uv: DVec2) -> Color {
+        let alpha = self.opacity.at(uv);
+        alpha * self.transmission.at(uv) + (Color::ONE - alpha)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dissolving_lets_light_through_beside_the_surface_own_transmission() {
+        let glass = Material {
+            transmission: Color::splat(0.5).into(),
+            ..Material::default()
+        };
+        let uv = DVec2::ZERO;
+        assert_eq!(glass.pass_through(uv), Color::splat(0.5));
+        let half = Material {
+            opacity: Color::splat(0.5).into(),
+            ..glass
+        };
+        assert_eq!(half.pass_through(uv), Color::splat(0.75));
+        assert!(half.is_transmissive());
+        let opaque = Material::default();
+        assert_eq!(opaque.pass_through(uv), Color::ZERO);
+        assert!(!opaque.is_transmissive());
+        let clear = Material {
+            opacity: Color::ZERO.into(),
+            ..opaque
+        };
+        assert_eq!(clear.pass_through(uv), Color::ONE);
+        assert!(clear.is_transmissive());
     }
 }

@@ -96,7 +96,7 @@ pub struct Progress {
 /// A finished render.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderOutput {
-    /// The colour image (3 channels, linear).
+    /// The colour image (3 channels, in the scene's colour space).
     pub image: Film,
     /// The requested AOVs, in the order asked for.
     pub aovs: Vec<(Aov, Film)>,
@@ -205,7 +205,7 @@ pub fn render(
             .collect()
     });
 
-    let mut image = Film::new(width, height, 3);
+    let mut image = Film::new(width, height, 3).with_color_space(scene.color_space);
     let mut aovs: Vec<(Aov, Film)> = options
         .aovs
         .iter()

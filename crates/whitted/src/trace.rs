@@ -8,8 +8,9 @@
 //! - Shading is two-sided: the normal is turned to face the incoming ray.
 //!   A material's bump or normal map tilts it (see [`crate::bump`]); a
 //!   light behind the geometric surface then lights nothing.
-//! - Shadow rays pass through transmissive surfaces, each crossing scaling
-//!   the light by that surface's `kt`; an opaque surface blocks it.
+//! - Shadow rays pass through transmissive and dissolved surfaces, each
+//!   crossing scaling the light by what that surface lets through
+//!   (`α kt + 1 - α`); an opaque surface blocks it.
 //! - Refraction follows Snell's law with the index of the medium the ray is
 //!   in, tracked on a small stack of the media it has entered; total
 //!   internal reflection moves the refracted weight onto the reflected ray.
@@ -253,11 +254,14 @@ impl<'a> Tracer<'a> {
         // A tilted normal may see a light that is behind the surface itself.
         let bumped = m.bump.is_some();
 
-        let mut color = m.emission.at(s.uv) + m.ambient.at(s.uv) * self.scene.ambient;
+        // The opacity weighs the surface's own light and mirror; the
+        // dissolved rest joins the transmitted ray.
+        let alpha = m.opacity.at(s.uv);
+        let mut local = m.emission.at(s.uv) + m.ambient.at(s.uv) * self.scene.ambient;
 
         let diffuse = m.diffuse.at(s.uv);
         let specular = m.specular.at(s.uv);
-        if diffuse != Color::ZERO || specular != Color::ZERO {
+        if alpha != Color::ZERO && (diffuse != Color::ZERO || specular != Color::ZERO) {
             for light in &self.scene.lights {
                 let Some(sample) = light.sample(s.point) else {
                     continue;
@@ -275,16 +279,17 @@ impl<'a> Tracer<'a> {
                 if r_dot_v > 0.0 && specular != Color::ZERO {
                     direct += specular * r_dot_v.powf(m.shininess);
                 }
-                color += shadow * sample.intensity * direct;
+                local += shadow * sample.intensity * direct;
             }
         }
+        let mut color = alpha * local;
 
         if depth >= self.settings.max_depth {
             return color;
         }
         let kr = m.reflection.at(s.uv);
         let kt = m.transmission.at(s.uv);
-        if kr == Color::ZERO && kt == Color::ZERO {
+        if kr == Color::ZERO && kt == Color::ZERO && alpha == Color::ONE {
             return color;
         }
 
@@ -294,12 +299,14 @@ impl<'a> Tracer<'a> {
             after: inside_after,
         } = media.cross(s.material, m.ior, entering);
         let cos_i = view.dot(n).clamp(0.0, 1.0);
-        let (mut reflected_weight, mut transmitted_weight) = if m.fresnel && kt != Color::ZERO {
+        let (reflected, transmitted) = if m.fresnel && kt != Color::ZERO {
             let f = schlick_reflectance(cos_i, n_from, n_to);
             (kr + kt * f, kt * (1.0 - f))
         } else {
             (kr, kt)
         };
+        let mut reflected_weight = alpha * reflected;
+        let mut transmitted_weight = alpha * transmitted + (Color::ONE - alpha);
         let refracted = if transmitted_weight == Color::ZERO {
             None
         } else {
@@ -338,8 +345,9 @@ impl<'a> Tracer<'a> {
     }
 
     /// How much of `light` reaches `s` along `to_light` (unit) over
-    /// `distance`: 0 behind an opaque surface, the product of the `kt` of
-    /// every transmissive surface crossed otherwise.
+    /// `distance`: 0 behind an opaque surface, the product of what every
+    /// transmissive or dissolved surface crossed lets through otherwise
+    /// ([`Material::pass_through`]).
     fn transmittance(
         &self,
         s: &Surface,
@@ -373,7 +381,7 @@ impl<'a> Tracer<'a> {
             };
             let blocker = self.geometry.surface(&ray, &hit);
             let m = &self.scene.materials[blocker.material.0 as usize];
-            through *= m.transmission.at(blocker.uv);
+            through *= m.pass_through(blocker.uv);
             if through.max_element() <= 0.0 {
                 return Color::ZERO;
             }

@@ -11,7 +11,8 @@
 
 use std::path::{Path, PathBuf};
 
-use whitted::image::{Film, encode_srgb8};
+use whitted::color_space::encode_srgb8;
+use whitted::image::Film;
 use whitted::render::{RenderOptions, render};
 use whitted::scene::load_scene;
 

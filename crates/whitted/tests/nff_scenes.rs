@@ -89,3 +89,24 @@ fn the_spd_like_fixture_reads_every_entity() {
     let default = Color::splat(1.0 / 2f64.sqrt());
     assert_eq!(intensities, [default, Color::new(0.3, 0.3, 0.25)]);
 }
+
+#[test]
+fn an_nff_background_is_written_to_png_as_pov_ray_writes_it() {
+    let source = "b 0.078 0.361 0.753\nv\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 30\n\
+                  hither 1\nresolution 2 2\n";
+    let scene = whitted::scene::parse_nff(source, Path::new("sky.nff")).unwrap();
+    let film = whitted::render::render(&scene, &Default::default(), &|_| {})
+        .unwrap()
+        .image;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sky.png");
+    film.write(&path).unwrap();
+    let mut reader =
+        png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()))
+            .read_info()
+            .unwrap();
+    let mut codes = vec![0; reader.output_buffer_size().unwrap()];
+    reader.next_frame(&mut codes).unwrap();
+    // POV-Ray 3.7 writes the SPD's POV-Ray export of this background so.
+    assert_eq!(&codes[..3], &[20, 92, 192]);
+}

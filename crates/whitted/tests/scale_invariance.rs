@@ -3,7 +3,8 @@
 //! epsilon would speckle the small scene or leak at the large one.
 
 use whitted::camera::Camera;
-use whitted::image::{Film, encode_srgb8};
+use whitted::color_space::encode_srgb8;
+use whitted::image::Film;
 use whitted::light::{Attenuation, Light};
 use whitted::material::Material;
 use whitted::math::{Color, Transform, Vec3};

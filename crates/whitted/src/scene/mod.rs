@@ -20,6 +20,7 @@ use std::path::Path;
 
 use crate::accel::AccelKind;
 use crate::camera::Camera;
+use crate::color_space::ColorSpace;
 use crate::light::Light;
 use crate::material::{Material, MaterialId};
 use crate::math::{Color, Transform};
@@ -153,6 +154,9 @@ pub struct Scene {
     pub background: Color,
     /// Global ambient light `Ia`.
     pub ambient: Color,
+    /// What the colour values of the scene (and so of its picture) mean:
+    /// linear light, or display values (NFF).
+    pub color_space: ColorSpace,
     /// Materials, indexed by [`MaterialId`].
     pub materials: Vec<Material>,
     /// Light sources.
@@ -186,13 +190,14 @@ impl Scene {
     }
 
     /// An empty scene seen by `camera`, with default settings, a black
-    /// background and no ambient light.
+    /// background, no ambient light and linear colours.
     pub fn new(camera: Camera) -> Self {
         Self {
             camera,
             settings: RenderSettings::default(),
             background: Color::ZERO,
             ambient: Color::ZERO,
+            color_space: ColorSpace::Linear,
             materials: Vec::new(),
             lights: Vec::new(),
             transforms: Vec::new(),

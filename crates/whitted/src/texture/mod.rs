@@ -5,7 +5,8 @@
 //! `{ checker = { even = [r, g, b], odd = [r, g, b], size = s } }` where `s`
 //! is the side of one square in (u, v) units, or
 //! `{ image = "wood.png", wrap = "repeat", scale = [su, sv], offset = [ou, ov] }`.
-//! MTL dissolve maps (`map_d`) become a [`DissolveMap`] transmission.
+//! MTL dissolve maps (`map_d`) become a [`DissolveMap`]: an opacity, or the
+//! transmission of MTL glass.
 
 mod checker;
 mod decode;
@@ -35,7 +36,7 @@ pub enum Texture {
     Checker(Checker),
     /// A PNG or JPEG image, filtered bilinearly.
     Image(ImageTexture),
-    /// What an MTL dissolve map (`map_d`) lets through.
+    /// An MTL dissolve map (`map_d`): an opacity, or what it lets through.
     Dissolve(DissolveMap),
 }
 
@@ -64,14 +65,25 @@ impl Texture {
     }
 
     /// True when the colour is zero everywhere (the slot can be skipped);
-    /// may say false for a dissolve map that happens to be opaque
+    /// may say false for a dissolve map that happens to be clear
     /// everywhere.
     pub fn is_black(&self) -> bool {
         match self {
             Texture::Constant(c) => *c == Color::ZERO,
             Texture::Checker(c) => c.even == Color::ZERO && c.odd == Color::ZERO,
             Texture::Image(image) => image.max_component() == 0.0,
-            Texture::Dissolve(map) => map.filter == Color::ZERO,
+            Texture::Dissolve(map) => map.max_component() == 0.0,
+        }
+    }
+
+    /// True when the colour is one in every component everywhere (an
+    /// opacity that lets nothing through); may say false for an image or a
+    /// dissolve map that happens to be opaque everywhere.
+    pub fn is_white(&self) -> bool {
+        match self {
+            Texture::Constant(c) => *c == Color::ONE,
+            Texture::Checker(c) => c.even == Color::ONE && c.odd == Color::ONE,
+            Texture::Image(_) | Texture::Dissolve(_) => false,
         }
     }
 
@@ -82,7 +94,7 @@ impl Texture {
             Texture::Constant(c) => c.max_element(),
             Texture::Checker(c) => c.even.max_element().max(c.odd.max_element()),
             Texture::Image(image) => image.max_component(),
-            Texture::Dissolve(map) => map.filter.max_element(),
+            Texture::Dissolve(map) => map.max_component(),
         }
     }
 }
@@ -106,14 +118,16 @@ mod tests {
     }
 
     #[test]
-    fn black_detection_covers_both_squares() {
+    fn black_and_white_detection_covers_both_squares() {
         assert!(Texture::default().is_black());
+        assert!(Texture::Constant(Color::ONE).is_white());
+        assert!(!Texture::Constant(Color::new(1.0, 1.0, 0.5)).is_white());
         let t = Texture::Checker(Checker {
             even: Color::ZERO,
             odd: Color::X,
             size: 1.0,
         });
-        assert!(!t.is_black());
+        assert!(!t.is_black() && !t.is_white());
         assert_eq!(t.max_component(), 1.0);
     }
 }

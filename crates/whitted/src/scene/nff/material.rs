@@ -62,6 +62,7 @@ impl Fill {
             ior: if self.t > 0.0 { self.ior } else { 1.0 },
             fresnel: false,
             bump: None,
+            opacity: Color::ONE.into(),
         }
     }
 }

@@ -20,7 +20,9 @@
 //! # ...                         comment to the end of the line
 //! ```
 //!
-//! The file is read as a stream of tokens, so line breaks never matter. The
+//! The file is read as a stream of tokens, so line breaks never matter. Its
+//! colours are display values, shaded and written as they are (as the
+//! classic renderers and POV-Ray do). The
 //! scene gets the SPD's tracing rules: depth 5 counting the eye ray
 //! (`max_depth` 4) and no adaptive cut-off (`min_weight` 0); the command
 //! line overrides both. Every problem is reported with its place; after one,
@@ -43,6 +45,7 @@ use self::patches::{PatchSet, patches_to_meshes, read_patch};
 use self::reader::{Parsed, Reader};
 use self::shapes::{Placed, flat_shape, read_cone, read_polygon, read_sphere};
 use self::view::{View, read_view};
+use crate::color_space::ColorSpace;
 use crate::light::{Attenuation, Light};
 use crate::material::{Material, MaterialId};
 use crate::math::{Color, Transform, Vec3};
@@ -186,6 +189,7 @@ impl Document {
             min_weight: 0.0,
             ..RenderSettings::default()
         };
+        scene.color_space = ColorSpace::Display;
         scene.background = self.background.unwrap_or(Color::ZERO);
         scene.ambient = Color::splat(AMBIENT);
         scene.materials = self.materials;

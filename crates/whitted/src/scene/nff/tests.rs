@@ -40,6 +40,11 @@ fn the_view_sets_camera_size_and_the_spd_tracing_rules() {
 }
 
 #[test]
+fn nff_colours_are_display_values() {
+    assert_eq!(scene(VIEW).color_space, ColorSpace::Display);
+}
+
+#[test]
 fn lights_without_a_colour_share_one_over_root_n() {
     let s = scene(&format!(
         "b 0.1 0.2 0.3\n{VIEW}l 1 2 3\nl 4 5 6 0.5 0.25 1\nl 0 0 9\nl 1 1 1\n"

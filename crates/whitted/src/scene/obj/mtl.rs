@@ -257,6 +257,12 @@ fn color(c: Option<[f64; 3]>, default: Color) -> Color {
 /// `docs/obj.md`); a colour map replaces the constant colour of its slot, a
 /// dissolve map scales `d` per texel, a bump or normal map tilts the
 /// shading normal.
+///
+/// The dissolve `d` (or `1 - Tr`, times the dissolve map) is the opacity of
+/// every model but 4: the surface's own light and mirror fade with it and
+/// what is behind shows through. Model 4, the MTL's glass, keeps its
+/// highlights and reflection whatever the dissolve, so there `d` sets the
+/// transmission instead: `Tf (1 - d)`, straight through.
 fn whitted_material(m: &tobj::Material, extra: &Extra, maps: &Maps) -> Material {
     let kd = color(m.diffuse, Color::splat(0.8));
     let ke = color(m.emissive, Color::ZERO);
@@ -275,17 +281,14 @@ fn whitted_material(m: &tobj::Material, extra: &Extra, maps: &Maps) -> Material 
         .unwrap_or(1.0)
         .clamp(0.0, 1.0);
     let illum = m.illumination_model.unwrap_or(2);
-    // What a dissolve lets through, tinted by `filter`: per texel with a
-    // dissolve map.
-    let through = |filter: Color| -> Texture {
-        match &maps.dissolve {
-            Some(opacity) => Texture::Dissolve(DissolveMap {
-                opacity: opacity.clone(),
-                dissolve,
-                filter,
-            }),
-            None => (filter * (1.0 - dissolve)).into(),
-        }
+    // `d`, per texel with a dissolve map.
+    let opacity = match &maps.dissolve {
+        Some(opacity) => Texture::Dissolve(DissolveMap {
+            opacity: opacity.clone(),
+            dissolve,
+            filter: None,
+        }),
+        None => Color::splat(dissolve).into(),
     };
     let mut material = Material {
         ambient: ka,
@@ -293,11 +296,12 @@ fn whitted_material(m: &tobj::Material, extra: &Extra, maps: &Maps) -> Material 
         specular: Color::ZERO.into(),
         shininess: m.shininess.unwrap_or(32.0).max(1.0),
         reflection: Color::ZERO.into(),
-        transmission: through(Color::ONE),
+        transmission: Color::ZERO.into(),
         emission: ke.into(),
         ior: 1.0,
         fresnel: false,
         bump: maps.bump.clone(),
+        opacity,
     };
     if illum == 0 {
         material.ambient = Color::ZERO.into();
@@ -314,14 +318,26 @@ fn whitted_material(m: &tobj::Material, extra: &Extra, maps: &Maps) -> Material 
         material.reflection = ks;
     }
     if illum == 4 {
-        material.transmission = through(extra.transmission_filter.unwrap_or(Color::ONE));
+        let filter = extra.transmission_filter.unwrap_or(Color::ONE);
+        material.transmission = match &maps.dissolve {
+            Some(opacity) => Texture::Dissolve(DissolveMap {
+                opacity: opacity.clone(),
+                dissolve,
+                filter: Some(filter),
+            }),
+            None => (filter * (1.0 - dissolve)).into(),
+        };
+        material.opacity = Color::ONE.into();
     }
     if matches!(illum, 6 | 7) {
-        material.transmission = match (extra.transmission_filter, &maps.dissolve) {
-            (Some(filter), _) => filter.into(),
-            (None, Some(_)) => through(Color::ONE),
-            (None, None) if dissolve < 1.0 => Color::splat(1.0 - dissolve).into(),
-            (None, None) => Color::ONE.into(),
+        // Glass: its own transmission is `Tf`, or clear when neither `Tf`
+        // nor a dissolve says otherwise; a dissolve without `Tf` is all the
+        // light it lets through.
+        let dissolved = dissolve < 1.0 || maps.dissolve.is_some();
+        material.transmission = match extra.transmission_filter {
+            Some(filter) => filter.into(),
+            None if dissolved => Color::ZERO.into(),
+            None => Color::ONE.into(),
         };
         material.ior = m.optical_density.filter(|n| *n > 0.0).unwrap_or(1.0);
         material.fresnel = illum == 7;
@@ -332,6 +348,7 @@ fn whitted_material(m: &tobj::Material, extra: &Extra, maps: &Maps) -> Material 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::DVec2;
     use crate::texture::Texture;
 
     fn read(source: &str) -> Library {
@@ -363,10 +380,42 @@ mod tests {
             Texture::Constant(Color::new(0.9, 0.8, 0.7))
         );
         assert!(glass.fresnel && glass.ior == 1.5);
-        assert_eq!(
-            m["half"].transmission,
-            Texture::Constant(Color::splat(0.25))
+        assert_eq!(glass.opacity, Texture::Constant(Color::ONE));
+        // A dissolve is an opacity, not a transmission.
+        assert_eq!(m["half"].opacity, Texture::Constant(Color::splat(0.75)));
+        assert!(m["half"].transmission.is_black());
+    }
+
+    #[test]
+    fn glass_keeps_its_transmission_and_a_dissolve_fades_the_rest() {
+        let lib = read(
+            "newmtl clear\nKs 0.1 0.1 0.1\nNi 1.5\nillum 7\n\
+             newmtl blender glass\nd 0.2\nNi 1.45\nillum 6\n\
+             newmtl tinted\nTf 0.5 1 1\nd 0.5\nillum 6\n\
+             newmtl old glass\nTf 0.5 1 1\nd 0.5\nillum 4\n",
         );
+        assert!(lib.diagnostics.is_empty(), "{:?}", lib.diagnostics);
+        let m = &lib.materials;
+        let constant = |c: Color| Texture::Constant(c);
+        let clear = &m["clear"];
+        assert_eq!(
+            (&clear.transmission, &clear.opacity),
+            (&constant(Color::ONE), &constant(Color::ONE))
+        );
+        // Without `Tf`, the dissolve is all the glass lets through (as it
+        // was before dissolve faded the surface): 1 - 0.2.
+        let blender = &m["blender glass"];
+        assert_eq!(blender.opacity, constant(Color::splat(0.2)));
+        assert!(blender.transmission.is_black());
+        assert_eq!(blender.pass_through(DVec2::ZERO), Color::splat(0.8));
+        assert_eq!(blender.ior, 1.45);
+        let tinted = &m["tinted"];
+        assert_eq!(tinted.transmission, constant(Color::new(0.5, 1.0, 1.0)));
+        assert_eq!(tinted.pass_through(DVec2::ZERO), Color::new(0.75, 1.0, 1.0));
+        // Model 4 is not dissolved: `d` sets its transmission.
+        let old = &m["old glass"];
+        assert_eq!(old.opacity, constant(Color::ONE));
+        assert_eq!(old.transmission, constant(Color::new(0.25, 0.5, 0.5)));
     }
 
     #[test]
@@ -424,13 +473,14 @@ mod tests {
         );
         assert!(lib.diagnostics.is_empty(), "{:?}", lib.diagnostics);
         let m = &lib.materials;
-        let Texture::Dissolve(leaf) = &m["leaf"].transmission else {
-            panic!("{:?}", m["leaf"].transmission);
+        let Texture::Dissolve(leaf) = &m["leaf"].opacity else {
+            panic!("{:?}", m["leaf"].opacity);
         };
-        assert_eq!((leaf.dissolve, leaf.filter), (1.0, Color::ONE));
-        assert_eq!(leaf.opacity.scale, crate::math::DVec2::new(2.0, 1.0));
-        let at = |u| m["leaf"].transmission.at(crate::math::DVec2::new(u, 0.5));
-        assert_eq!((at(0.125), at(0.375)), (Color::ONE, Color::ZERO));
+        assert_eq!((leaf.dissolve, leaf.filter), (1.0, None));
+        assert_eq!(leaf.opacity.scale, DVec2::new(2.0, 1.0));
+        let at = |u| m["leaf"].opacity.at(DVec2::new(u, 0.5));
+        assert_eq!((at(0.125), at(0.375)), (Color::ZERO, Color::ONE));
+        assert!(m["leaf"].transmission.is_black());
         assert!(matches!(
             m["leaf"].bump,
             Some(Bump::Height { strength: 0.05, .. })
@@ -477,7 +527,7 @@ mod tests {
             text[1]
         );
         let a = &lib.materials["a"];
-        assert_eq!(a.transmission, Texture::Constant(Color::splat(0.25)));
+        assert_eq!(a.opacity, Texture::Constant(Color::splat(0.75)));
         assert_eq!(a.bump, None);
     }
 

@@ -13,6 +13,10 @@
 //! [materials.plaster]             # or a height field, strength in scene units
 //! bump_map = { image = "textures/plaster_height.png", scale = [4, 4], strength = 0.01 }
 //!
+//! [materials.leaves]             # a cut-out: clear where the image's alpha is 0
+//! diffuse = { image = "textures/leaves.png" }
+//! opacity = { image = "textures/leaves.png" }
+//!
 //! [materials.glass]
 //! diffuse = 0.05                  # colour slots: [r, g, b], a grey, a checker or an image
 //! specular = 0.8
@@ -28,7 +32,10 @@
 //! `"repeat"` (or `"clamp"`, `"mirror"`), `scale` to `[1, 1]` and `offset` to
 //! `[0, 0]`. A material takes a normal map or a bump map, not both; both
 //! read their image as data (no sRGB curve) and place it like a colour
-//! slot's; `strength` defaults to 1 and `flip_green` to false.
+//! slot's; `strength` defaults to 1 and `flip_green` to false. `opacity`
+//! (default 1) is a slot like the colour slots, each component at most 1;
+//! its image is read as opacity (the alpha channel when there is one, else
+//! the values as stored).
 
 use toml_span::value::Value;
 
@@ -51,6 +58,7 @@ const KEYS: &[&str] = &[
     "fresnel",
     "normal_map",
     "bump_map",
+    "opacity",
 ];
 
 /// The materials of a scene, in the order they appear in the file.
@@ -105,6 +113,7 @@ fn read_material(r: &mut Reader<'_>, value: &Value<'_>, name: &str) -> Parsed<Ma
     let fresnel = r.or_default(&f, "fresnel", false, Reader::boolean);
     let normal_map = r.optional(&f, "normal_map", normal_map);
     let bump_map = r.optional(&f, "bump_map", bump_map);
+    let opacity = r.or_default(&f, "opacity", Texture::Constant(Color::ONE), opacity);
     let bump = match (f.get("normal_map"), f.get("bump_map")) {
         (Some(_), Some(second)) => Err(r.error(
             second.span,
@@ -125,12 +134,39 @@ fn read_material(r: &mut Reader<'_>, value: &Value<'_>, name: &str) -> Parsed<Ma
         ior: ior?,
         fresnel: fresnel?,
         bump: bump?,
+        opacity: opacity?,
     })
 }
 
 /// A colour slot: a colour, `{ checker = { even, odd, size } }` or
 /// `{ image = "file", wrap, scale, offset }`.
 fn texture(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Texture> {
+    let decoding = r.color_image_decoding();
+    decoded_texture(r, value, key, decoding)
+}
+
+/// The opacity slot: like a colour slot, each component at most 1, an
+/// image read as opacity.
+fn opacity(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Texture> {
+    let texture = decoded_texture(r, value, key, Decoding::Opacity)?;
+    let largest = texture.max_component();
+    if largest > 1.0 {
+        let span = r.span_of(value);
+        return Err(r.error(
+            span,
+            format!("`{key}` must be at most 1 in every component, got {largest}"),
+        ));
+    }
+    Ok(texture)
+}
+
+/// A slot whose image is decoded as `decoding`.
+fn decoded_texture(
+    r: &mut Reader<'_>,
+    value: &Value<'_>,
+    key: &str,
+    decoding: Decoding,
+) -> Parsed<Texture> {
     if value.as_table().is_none() {
         if value.as_str().is_some() || value.as_bool().is_some() {
             return Err(r.wrong_type(
@@ -143,7 +179,7 @@ fn texture(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Texture> 
     }
     let f = r.table(value, key, format!("`{key}`"))?;
     if f.get("image").is_some() {
-        return image(r, &f);
+        return image(r, &f, decoding);
     }
     let keys = r.check_keys(&f, &["checker", "image"]);
     let checker = r.require(&f, "checker", checker);
@@ -154,10 +190,11 @@ fn texture(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Texture> 
 /// The keys placing an image.
 const IMAGE_KEYS: [&str; 4] = ["image", "wrap", "scale", "offset"];
 
-/// `{ image = "file", wrap = "repeat", scale = [su, sv], offset = [ou, ov] }`.
-fn image(r: &mut Reader<'_>, f: &Fields<'_, '_>) -> Parsed<Texture> {
+/// `{ image = "file", wrap = "repeat", scale = [su, sv], offset = [ou, ov] }`,
+/// decoded as `decoding`.
+fn image(r: &mut Reader<'_>, f: &Fields<'_, '_>, decoding: Decoding) -> Parsed<Texture> {
     let keys = r.check_keys(f, &IMAGE_KEYS);
-    let image = placed_image(r, f, Decoding::Color);
+    let image = placed_image(r, f, decoding);
     keys?;
     Ok(Texture::Image(image?))
 }
@@ -267,7 +304,7 @@ mod tests {
         let s = scene(&format!(
             "{CAMERA}[materials.all]\nambient = 0.1\ndiffuse = [0.2, 0.3, 0.4]\nspecular = 0.5\n\
              reflection = 0.6\ntransmission = 0.7\nemission = [1, 2, 3]\nshininess = 100\n\
-             ior = 1.33\nfresnel = true\n"
+             ior = 1.33\nfresnel = true\nopacity = 0.5\n"
         ));
         assert_eq!(
             s.materials,
@@ -282,6 +319,7 @@ mod tests {
                 ior: 1.33,
                 fresnel: true,
                 bump: None,
+                opacity: Texture::Constant(Color::splat(0.5)),
             }]
         );
     }
@@ -340,6 +378,23 @@ mod tests {
             (Wrap::Mirror, DVec2::new(2.0, 3.0), DVec2::new(0.5, -1.0))
         );
         assert_eq!(a.at(DVec2::splat(0.5)), Color::ONE);
+    }
+
+    #[test]
+    fn a_display_scene_reads_colour_images_as_stored() {
+        let dir = tempfile::tempdir().unwrap();
+        let png = crate::texture::png_bytes(1, 1, &[128, 128, 128]);
+        std::fs::write(dir.path().join("grey.png"), png).unwrap();
+        let texel = |colours: &str| {
+            let source = format!(
+                "{CAMERA}[render]\ncolours = '{colours}'\n\
+                 [materials.a]\ndiffuse = {{ image = 'grey.png' }}\n"
+            );
+            let s = super::super::parse_scene(&source, &dir.path().join("s.toml")).unwrap();
+            s.materials[0].diffuse.at(DVec2::splat(0.5)).x
+        };
+        assert!((texel("display") - 128.0 / 255.0).abs() < 1e-6);
+        assert!((texel("linear") - 0.2158605).abs() < 1e-6);
     }
 
     #[test]
@@ -441,7 +496,7 @@ mod tests {
                 "{CAMERA}[materials.bad]\ndiffuse = 'red'\nspecular = [1, 2]\nshininess = -1\n\
                  ior = 0\nfresnel = 1\nglow = 2\n\
                  [materials.worse]\nambient = {{ chequer = 1 }}\n\
-                 emission = {{ checker = {{ even = 1, size = -2 }} }}\n"
+                 emission = {{ checker = {{ even = 1, size = -2 }} }}\nopacity = [1, 2, 0.5]\n"
             )),
             [
                 "expected a colour ([r, g, b], a number, { checker = { ... } } or \
@@ -452,11 +507,12 @@ mod tests {
                 "expected `true` or `false` for `fresnel`, found an integer",
                 "unknown key `glow` in material `bad`; expected one of: ambient, diffuse, \
                  specular, reflection, transmission, emission, shininess, ior, fresnel, \
-                 normal_map, bump_map",
+                 normal_map, bump_map, opacity",
                 "missing required key `checker` in `ambient`",
                 "unknown key `chequer` in `ambient`; expected one of: checker, image",
                 "missing required key `odd` in checker",
                 "`size` must be greater than 0, got -2",
+                "`opacity` must be at most 1 in every component, got 2",
             ]
         );
         assert_eq!(

@@ -6,6 +6,7 @@
 //! width = 640
 //! height = 480
 //! background = [0.1, 0.2, 0.5]
+//! colours = "linear"              # or "display"
 //!
 //! [camera]                        # required
 //! eye = [0, 1, -5]
@@ -47,6 +48,7 @@ use toml_span::value::Value;
 
 use self::reader::{Parsed, Reader};
 use crate::camera::{Camera, CameraError};
+use crate::color_space::ColorSpace;
 use crate::material::{Material, MaterialId};
 use crate::math::{Color, Vec3};
 use crate::scene::{Diagnostic, RenderSettings, Scene, SceneError};
@@ -87,6 +89,9 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
         Some(value) => read_render(r, value),
         None => Ok(Render::default()),
     };
+    if let Ok(render) = &render {
+        r.set_color_space(render.color_space);
+    }
     let camera = match top.get("camera") {
         Some(value) => read_camera(r, value),
         None => Err(r.error(Span::new(0, 0), "missing required table `[camera]`")),
@@ -100,6 +105,7 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
     scene.settings = render.settings;
     scene.background = render.background;
     scene.ambient = render.ambient;
+    scene.color_space = render.color_space;
     scene.lights = lights?;
     for material in materials.list? {
         scene.add_material(material);
@@ -124,6 +130,7 @@ struct Render {
     settings: RenderSettings,
     background: Color,
     ambient: Color,
+    color_space: ColorSpace,
 }
 
 /// The keys of `[render]`.
@@ -136,6 +143,7 @@ const RENDER_KEYS: &[&str] = &[
     "background",
     "ambient",
     "accel",
+    "colours",
 ];
 
 fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
@@ -152,6 +160,7 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
     let background = r.or_default(&f, "background", Color::ZERO, Reader::color);
     let ambient = r.or_default(&f, "ambient", Color::ZERO, Reader::color);
     let accel = r.or_default(&f, "accel", d.accel, read_accel);
+    let color_space = r.or_default(&f, "colours", ColorSpace::Linear, read_color_space);
     keys?;
     Ok(Render {
         settings: RenderSettings {
@@ -164,6 +173,22 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
         },
         background: background?,
         ambient: ambient?,
+        color_space: color_space?,
+    })
+}
+
+/// What the scene's colour values mean.
+fn read_color_space(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<ColorSpace> {
+    let (name, span) = r.string(value, key)?;
+    ColorSpace::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = ColorSpace::ALL.iter().map(ColorSpace::name).collect();
+        r.error(
+            span,
+            format!(
+                "unknown colour convention `{name}` for `{key}`; expected one of: {}",
+                names.join(", ")
+            ),
+        )
     })
 }
 
@@ -237,6 +262,7 @@ pub(super) mod tests {
         let s = scene(CAMERA);
         assert_eq!(s.settings, RenderSettings::default());
         assert_eq!((s.background, s.ambient), (Color::ZERO, Color::ZERO));
+        assert_eq!(s.color_space, ColorSpace::Linear);
         assert_eq!(s.camera.up(), Vec3::Y);
         assert_eq!(s.camera.fov_degrees(), 45.0);
         assert!(s.materials.is_empty() && s.lights.is_empty() && s.primitives.is_empty());
@@ -246,7 +272,8 @@ pub(super) mod tests {
     fn render_settings_are_read() {
         let s = scene(&format!(
             "{CAMERA}[render]\nwidth = 32\nheight = 24\nsamples = 4\nmax_depth = 0\n\
-             min_weight = 0\nbackground = [0.1, 0.2, 0.3]\nambient = 0.5\naccel = 'linear'\n"
+             min_weight = 0\nbackground = [0.1, 0.2, 0.3]\nambient = 0.5\naccel = 'linear'\n\
+             colours = 'display'\n"
         ));
         assert_eq!(
             s.settings,
@@ -261,6 +288,7 @@ pub(super) mod tests {
         );
         assert_eq!(s.background, Color::new(0.1, 0.2, 0.3));
         assert_eq!(s.ambient, Color::splat(0.5));
+        assert_eq!(s.color_space, ColorSpace::Display);
     }
 
     #[test]
@@ -277,7 +305,8 @@ pub(super) mod tests {
         assert_eq!(
             errors(&format!(
                 "{CAMERA}[render]\nwidth = 0\nheight = 1.5\nsamples = '4'\nmax_depth = -1\n\
-                 min_weight = -0.5\nbackground = [1, 1]\nambient = -1\nsize = 3\naccel = 'octree'\n"
+                 min_weight = -0.5\nbackground = [1, 1]\nambient = -1\nsize = 3\naccel = 'octree'\n\
+                 colours = 'srgb'\n"
             )),
             [
                 "`width` must be at least 1, got 0",
@@ -288,8 +317,9 @@ pub(super) mod tests {
                 "expected 3 numbers for `background`, found 2",
                 "`ambient` must not be negative, got -1",
                 "unknown key `size` in [render]; expected one of: width, height, samples, \
-                 max_depth, min_weight, background, ambient, accel",
+                 max_depth, min_weight, background, ambient, accel, colours",
                 "unknown acceleration structure `octree`; expected one of: bvh, kdtree, grid, linear",
+                "unknown colour convention `srgb` for `colours`; expected one of: linear, display",
             ]
         );
     }

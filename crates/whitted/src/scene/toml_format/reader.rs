@@ -12,6 +12,7 @@ use std::sync::Arc;
 use toml_span::Span;
 use toml_span::value::{Key, Table, Value};
 
+use crate::color_space::ColorSpace;
 use crate::math::{Color, Vec3, unit};
 use crate::scene::{Diagnostic, SceneError};
 use crate::texture::{Decoding, ImageCache, ImageData};
@@ -42,6 +43,9 @@ pub(super) struct Reader<'s> {
     diagnostics: Vec<Diagnostic>,
     /// Images decoded so far, shared by every material naming them.
     images: ImageCache,
+    /// How colour images are decoded: through the sRGB curve for a linear
+    /// scene, as stored for a display-referred one.
+    color_images: Decoding,
 }
 
 /// A TOML table being read, with what to call it in messages.
@@ -107,7 +111,22 @@ impl<'s> Reader<'s> {
             path,
             diagnostics: Vec::new(),
             images: ImageCache::default(),
+            color_images: Decoding::Color,
         }
+    }
+
+    /// Takes the scene's colours to mean `color_space` from now on: colour
+    /// images are then decoded into the same space.
+    pub(super) fn set_color_space(&mut self, color_space: ColorSpace) {
+        self.color_images = match color_space {
+            ColorSpace::Linear => Decoding::Color,
+            ColorSpace::Display => Decoding::Data,
+        };
+    }
+
+    /// How a colour image is decoded.
+    pub(super) fn color_image_decoding(&self) -> Decoding {
+        self.color_images
     }
 
     /// The image file named `name` (relative to the scene file), decoded
