@@ -204,10 +204,17 @@ impl<'a> Mutator<'a> {
                 input.drain(start..end);
             }
             4 if !words.is_empty() => {
+                // Sometimes thousands of times: a file with an error in
+                // every word must still be read in linear time and space.
                 let (start, end) = pick(self, &words);
+                let copies = if self.chance(0.25) {
+                    1 + self.below(20_000)
+                } else {
+                    1
+                };
                 let mut word = input[start..end].to_vec();
                 word.push(b' ');
-                input.splice(start..start, word);
+                input.splice(start..start, word.repeat(copies));
             }
             5 if words.len() >= 2 => {
                 let a = pick(self, &words);

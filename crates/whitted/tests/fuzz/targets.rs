@@ -14,7 +14,9 @@ use whitted::geometry::Geometry;
 use whitted::math::{DVec2, Vec3};
 use whitted::mesh::obj_positions::parse_obj_positions;
 use whitted::render::{Aov, RenderOptions, render};
-use whitted::scene::{Scene, parse_nff, parse_obj, parse_scene};
+use whitted::scene::{
+    MAX_DIAGNOSTICS, MAX_SHOWN_CHARS, Scene, SceneError, parse_nff, parse_obj, parse_scene,
+};
 use whitted::texture::{ImageTexture, Wrap, decode_image};
 
 use super::corpus::{self, fixtures, read_all, repository};
@@ -94,26 +96,56 @@ fn exercise(mut scene: Scene, accel: AccelKind) {
     let _ = render(&scene, &options, &|_| {});
 }
 
+/// Renders the scene a reader accepted, or checks the size of its report:
+/// a bounded number of diagnostics, each of bounded size apart from the
+/// words of the input it quotes. (Before reports were bounded, 64 KB of
+/// `s s s ...` gave a 2 GB NFF message.)
+fn render_or_check_report(
+    parsed: Result<Scene, SceneError>,
+    parts: &[Vec<u8>],
+    accel: AccelKind,
+) -> bool {
+    match parsed {
+        Ok(scene) => {
+            exercise(scene, accel);
+            true
+        }
+        Err(error) => {
+            let input: usize = parts.iter().map(Vec::len).sum();
+            // Three readers' worth of errors (an OBJ and its libraries),
+            // each at most about 1.5 KB plus the input quoted, a few times.
+            let limit = 3 * (MAX_DIAGNOSTICS + 1) * (1024 + 4 * MAX_SHOWN_CHARS) + 4 * input;
+            let length = error.to_string().len();
+            assert!(
+                length <= limit,
+                "a report of {length} bytes for {input} bytes of input"
+            );
+            false
+        }
+    }
+}
+
 fn run_toml(workspace: &Workspace, parts: &[Vec<u8>], accel: AccelKind) -> bool {
     let parsed = parse_scene(&text(&parts[0]), &workspace.path("scene.toml"));
-    parsed.map(|scene| exercise(scene, accel)).is_ok()
+    render_or_check_report(parsed, parts, accel)
 }
 
 fn run_nff(workspace: &Workspace, parts: &[Vec<u8>], accel: AccelKind) -> bool {
     let parsed = parse_nff(&text(&parts[0]), &workspace.path("scene.nff"));
-    parsed.map(|scene| exercise(scene, accel)).is_ok()
+    render_or_check_report(parsed, parts, accel)
 }
 
 fn run_obj(workspace: &Workspace, parts: &[Vec<u8>], accel: AccelKind) -> bool {
     let library = workspace.path("fuzz.mtl");
     std::fs::write(&library, &parts[1]).expect("the material library written");
     let parsed = parse_obj(&text(&parts[0]), &workspace.path("model.obj"));
-    parsed.map(|loaded| exercise(loaded.scene, accel)).is_ok()
+    render_or_check_report(parsed.map(|loaded| loaded.scene), parts, accel)
 }
 
 fn run_obj_positions(workspace: &Workspace, parts: &[Vec<u8>], accel: AccelKind) -> bool {
-    let Ok(soup) = parse_obj_positions(&text(&parts[0]), &workspace.path("mesh.obj")) else {
-        return false;
+    let soup = match parse_obj_positions(&text(&parts[0]), &workspace.path("mesh.obj")) {
+        Ok(soup) => soup,
+        Err(error) => return render_or_check_report(Err(error), parts, accel),
     };
     let camera = Camera::framing(&soup.bounds(), 4.0 / 3.0, 50.0)
         .or_else(|_| Camera::new(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 50.0));

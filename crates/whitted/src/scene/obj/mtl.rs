@@ -11,7 +11,7 @@ use super::maps::{MapSlot, MapStatement, read_map};
 use super::text::lines;
 use crate::material::Material;
 use crate::math::Color;
-use crate::scene::Diagnostic;
+use crate::scene::{Diagnostic, Severity, push_limited};
 use crate::texture::{ImageCache, ImageTexture, Texture};
 
 /// The materials of one library by name, or its errors; with its warnings.
@@ -96,12 +96,14 @@ fn check(source: &str, path: &Path) -> Vec<Diagnostic> {
                 } else {
                     "a number"
                 };
-                diagnostics.push(Diagnostic::new(
-                    path,
-                    source,
-                    span,
-                    format!("expected {what} after `{keyword}`, found `{word}`"),
-                ));
+                push_limited(&mut diagnostics, Severity::Error, || {
+                    Diagnostic::new(
+                        path,
+                        source,
+                        span,
+                        format!("expected {what} after `{keyword}`, found `{word}`"),
+                    )
+                });
                 found = wanted;
                 break;
             }
@@ -112,7 +114,9 @@ fn check(source: &str, path: &Path) -> Vec<Diagnostic> {
                 "`{keyword}` needs {wanted} number{}",
                 if wanted == 1 { "" } else { "s" }
             );
-            diagnostics.push(Diagnostic::new(path, source, at, message));
+            push_limited(&mut diagnostics, Severity::Error, || {
+                Diagnostic::new(path, source, at, message)
+            });
         }
     }
     if let Some((at, count)) = maps {
@@ -189,12 +193,9 @@ fn load_maps(
                     "{error}; `{}` keeps its constant colour",
                     statement.slot.color_name()
                 );
-                diagnostics.push(Diagnostic::warning(
-                    path,
-                    source,
-                    statement.span.clone(),
-                    message,
-                ));
+                push_limited(diagnostics, Severity::Warning, || {
+                    Diagnostic::warning(path, source, statement.span.clone(), message)
+                });
                 continue;
             }
         };

@@ -13,7 +13,7 @@ use toml_span::Span;
 use toml_span::value::{Key, Table, Value};
 
 use crate::math::{Color, Vec3, unit};
-use crate::scene::{Diagnostic, SceneError};
+use crate::scene::{Diagnostic, SceneError, Severity, push_limited};
 use crate::texture::{ImageCache, ImageData};
 
 /// A value was wrong and its error has been recorded. Only [`Reader::error`]
@@ -121,12 +121,10 @@ impl<'s> Reader<'s> {
 
     /// Records an error at `span`.
     pub(super) fn error(&mut self, span: Span, message: impl Into<String>) -> Reported {
-        self.diagnostics.push(Diagnostic::new(
-            self.path,
-            self.source,
-            span.start..span.end,
-            message,
-        ));
+        let (path, source) = (self.path, self.source);
+        push_limited(&mut self.diagnostics, Severity::Error, || {
+            Diagnostic::new(path, source, span.start..span.end, message)
+        });
         Reported(())
     }
 
