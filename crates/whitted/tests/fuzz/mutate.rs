@@ -214,6 +214,7 @@ impl<'a> Mutator<'a> {
                 };
                 let mut word = input[start..end].to_vec();
                 word.push(b' ');
+                let copies = copies.min(MAX_INPUT / word.len() + 1);
                 input.splice(start..start, word.repeat(copies));
             }
             5 if words.len() >= 2 => {
