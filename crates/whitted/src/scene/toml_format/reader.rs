@@ -342,8 +342,14 @@ impl<'s> Reader<'s> {
         }
     }
 
-    /// An integer `>= min` that fits in a `u32`.
-    pub(super) fn count(&mut self, value: &Value<'_>, key: &str, min: u32) -> Parsed<u32> {
+    /// An integer from `min` to `max`.
+    pub(super) fn count(
+        &mut self,
+        value: &Value<'_>,
+        key: &str,
+        min: u32,
+        max: u32,
+    ) -> Parsed<u32> {
         let Some(integer) = value.as_integer() else {
             return Err(self.wrong_type(value, key, "an integer"));
         };
@@ -353,12 +359,13 @@ impl<'s> Reader<'s> {
                 format!("`{key}` must be at least {min}, got {integer}"),
             ));
         }
-        u32::try_from(integer).map_err(|_| {
-            self.error(
+        if integer > i64::from(max) {
+            return Err(self.error(
                 value.span,
-                format!("`{key}` must be at most {}, got {integer}", u32::MAX),
-            )
-        })
+                format!("`{key}` must be at most {max}, got {integer}"),
+            ));
+        }
+        Ok(integer as u32)
     }
 
     /// `true` or `false`.
@@ -478,17 +485,20 @@ mod tests {
             read("x = 0", Reader::positive),
             Err(vec!["`x` must be greater than 0, got 0".into()])
         );
-        let count = |r: &mut Reader<'_>, v: &Value<'_>, k: &str| r.count(v, k, 1);
+        let count = |r: &mut Reader<'_>, v: &Value<'_>, k: &str| r.count(v, k, 1, 9);
         assert_eq!(read("x = 7", count), Ok(7));
+        assert_eq!(read("x = 9", count), Ok(9));
+        assert_eq!(
+            read("x = 10", count),
+            Err(vec!["`x` must be at most 9, got 10".into()])
+        );
         assert_eq!(
             read("x = 0", count),
             Err(vec!["`x` must be at least 1, got 0".into()])
         );
         assert_eq!(
             read("x = 5000000000", count),
-            Err(vec![
-                "`x` must be at most 4294967295, got 5000000000".into()
-            ])
+            Err(vec!["`x` must be at most 9, got 5000000000".into()])
         );
         assert_eq!(
             read("x = 1.5", count),
