@@ -429,6 +429,21 @@ pub fn png_header(width: u32, height: u32) -> Vec<u8> {
     bytes
 }
 
+/// The repository's JPEG fixture with its size fields set to `width` and
+/// `height`, its data left as it is (too short for a large size).
+pub fn jpeg_claiming(width: u16, height: u16) -> Vec<u8> {
+    let mut bytes = include_bytes!("../textures/two_blocks.jpg").to_vec();
+    if let Some(sof) = bytes
+        .windows(2)
+        .position(|w| w == [0xff, 0xc0] || w == [0xff, 0xc2])
+    {
+        // Marker, length, precision, then height and width.
+        bytes[sof + 5..sof + 7].copy_from_slice(&height.to_be_bytes());
+        bytes[sof + 7..sof + 9].copy_from_slice(&width.to_be_bytes());
+    }
+    bytes
+}
+
 /// The CRC-32 of PNG chunks (ISO 3309), bit by bit.
 fn crc32(bytes: &[u8]) -> u32 {
     let mut crc = u32::MAX;

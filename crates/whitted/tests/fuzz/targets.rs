@@ -355,7 +355,11 @@ pub fn image() -> Target {
         text: false,
         corpus: vec![corpus],
         vocabulary: Vec::new(),
-        generate: |rng, _| match rng.below(4) {
+        generate: |rng, _| match rng.below(5) {
+            1 => {
+                let side = |rng: &mut Rng| [1, 1000, 4096, 16384, 65535][rng.below(5) as usize];
+                corpus::jpeg_claiming(side(rng), side(rng))
+            }
             0 => {
                 let side = |rng: &mut Rng| {
                     [1, 65535, 100_000, 1 << 24, u32::MAX >> 1][rng.below(5) as usize]
