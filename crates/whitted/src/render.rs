@@ -28,6 +28,9 @@ fn worker_stack_bytes(max_depth: u32) -> usize {
     (2 << 20) + max_depth as usize * (16 << 10)
 }
 
+/// Longest side of an image a render accepts, in pixels.
+pub const MAX_SIDE: u32 = 65535;
+
 /// Largest image (in pixels) a render accepts: a few gigabytes of film.
 pub const MAX_PIXELS: u64 = 1 << 28;
 
@@ -108,7 +111,9 @@ pub struct RenderOutput {
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
     /// Width or height is zero, or the image is too large to address.
-    #[error("the image size {width}x{height} is not valid: both sides must be between 1 and 65535")]
+    #[error(
+        "the image size {width}x{height} is not valid: both sides must be between 1 and {MAX_SIDE}"
+    )]
     BadSize {
         /// Requested width.
         width: u32,
@@ -159,7 +164,7 @@ pub fn render(
 ) -> Result<RenderOutput, RenderError> {
     let settings = scene.settings.clone();
     let (width, height) = (settings.width, settings.height);
-    if width == 0 || height == 0 || width > 65535 || height > 65535 {
+    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
         return Err(RenderError::BadSize { width, height });
     }
     if settings.samples_per_pixel == 0 {

@@ -15,7 +15,7 @@ use crate::camera::Camera;
 use crate::material::Material;
 use crate::math::{Aabb, Transform, Vec3};
 use crate::mesh::{MeshError, TriangleMesh};
-use crate::scene::{Diagnostic, Scene, SceneError};
+use crate::scene::{Diagnostic, Scene, SceneError, Severity, push_limited};
 
 /// Positions and triangles as they appear in the file.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -69,7 +69,9 @@ pub fn parse_obj_positions(source: &str, path: &Path) -> Result<TriangleSoup, Sc
             continue;
         };
         let mut report = |span: Range<usize>, message: String| {
-            diagnostics.push(Diagnostic::new(path, source, span, message));
+            push_limited(&mut diagnostics, Severity::Error, || {
+                Diagnostic::new(path, source, span, message)
+            });
         };
         match keyword {
             "v" => {

@@ -99,11 +99,78 @@ pub struct Diagnostic {
     pub column: usize,
     /// What is wrong, and what was expected.
     pub message: String,
-    /// The text of the offending line (without its line break).
+    /// The text of the offending line (without its line break). Of a line
+    /// longer than [`MAX_SHOWN_CHARS`], only the part around the problem,
+    /// with `…` where the line was cut.
     pub source_line: String,
+    /// The column `source_line` starts at: 1, or where it was cut (the
+    /// column of the leading `…`).
+    pub shown_from: usize,
     /// How many characters of the line the problem covers (at least 1; a span
-    /// running over several lines is cut at the end of its first line).
+    /// running over several lines is cut at the end of its first line, and
+    /// one running past a cut line's excerpt at its end).
     pub width: usize,
+}
+
+/// The longest source line a diagnostic shows whole. Of a longer one (a
+/// whole file on one line) only this many characters around the problem are
+/// kept, so that a diagnostic's size never depends on the file's.
+pub const MAX_SHOWN_CHARS: usize = 160;
+
+/// How many characters before the problem a cut line keeps.
+const SHOWN_BEFORE: usize = 60;
+
+/// The most errors, and separately the most warnings, one reader reports
+/// for one file. Building a diagnostic takes time in proportion to its place
+/// in the file, so a file with an error in every word would otherwise take
+/// time quadratic in its size (and print as much).
+pub const MAX_DIAGNOSTICS: usize = 100;
+
+/// Adds the diagnostic `make` builds to `list`, unless `list` already holds
+/// [`MAX_DIAGNOSTICS`] of that `severity`. The first diagnostic over the
+/// limit is kept, its message replaced by one saying that reporting stopped
+/// there; later ones are not even built.
+pub fn push_limited(
+    list: &mut Vec<Diagnostic>,
+    severity: Severity,
+    make: impl FnOnce() -> Diagnostic,
+) {
+    let count = list.iter().filter(|d| d.severity == severity).count();
+    if count > MAX_DIAGNOSTICS {
+        return;
+    }
+    let mut diagnostic = make();
+    if count == MAX_DIAGNOSTICS {
+        let kind = match severity {
+            Severity::Error => "errors",
+            Severity::Warning => "warnings",
+        };
+        diagnostic.message = format!(
+            "too many {kind}: the first {MAX_DIAGNOSTICS} are reported, the rest from here on are not"
+        );
+    }
+    list.push(diagnostic);
+}
+
+/// The part of `line` shown for a problem at `column`, and the column it
+/// starts at (see [`Diagnostic::shown_from`]), with the index of the
+/// character after its last.
+fn excerpt(line: &str, column: usize) -> (String, usize, usize) {
+    let length = line.chars().count();
+    if length <= MAX_SHOWN_CHARS {
+        return (line.to_string(), 1, length);
+    }
+    let first = column.saturating_sub(1).saturating_sub(SHOWN_BEFORE);
+    let last = (first + MAX_SHOWN_CHARS).min(length);
+    let mut text = String::new();
+    if first > 0 {
+        text.push('…');
+    }
+    text.extend(line.chars().skip(first).take(last - first));
+    if last < length {
+        text.push('…');
+    }
+    (text, first.max(1), last)
 }
 
 impl Diagnostic {
@@ -129,16 +196,23 @@ impl Diagnostic {
         while !source.is_char_boundary(end) {
             end += 1;
         }
+        let column = source[line_start..start].chars().count() + 1;
+        let line = source[line_start..line_end].trim_end_matches('\r');
+        let (source_line, shown_from, shown_end) = excerpt(line, column);
+        let width = source[start..end]
+            .chars()
+            .count()
+            .min(shown_end.saturating_sub(column - 1))
+            .max(1);
         Self {
             severity: Severity::Error,
             path: path.to_path_buf(),
             line: source[..line_start].matches('\n').count() + 1,
-            column: source[line_start..start].chars().count() + 1,
+            column,
             message: message.into(),
-            source_line: source[line_start..line_end]
-                .trim_end_matches('\r')
-                .to_string(),
-            width: source[start..end].chars().count().max(1),
+            source_line,
+            shown_from,
+            width,
         }
     }
 }
@@ -166,7 +240,7 @@ impl fmt::Display for Diagnostic {
         let indent: String = self
             .source_line
             .chars()
-            .take(self.column.saturating_sub(1))
+            .take(self.column.saturating_sub(self.shown_from))
             .map(|c| if c == '\t' { '\t' } else { ' ' })
             .collect();
         let severity = match self.severity {
@@ -242,6 +316,50 @@ mod tests {
         assert_eq!((d.column, d.width), (9, 1));
         let d = at("é", 1..1);
         assert_eq!(d.column, 1);
+    }
+
+    #[test]
+    fn of_a_very_long_line_only_the_part_around_the_problem_is_shown() {
+        let source = format!("{}bad{}", "s ".repeat(5000), " x".repeat(5000));
+        let d = at(&source, 10_000..10_003);
+        assert_eq!((d.line, d.column, d.width), (1, 10_001, 3));
+        assert_eq!(d.source_line.chars().count(), MAX_SHOWN_CHARS + 2);
+        let shown = d.to_string();
+        let caret = shown.lines().last().unwrap();
+        let text = shown.lines().nth(2).unwrap();
+        let caret_at = caret.chars().position(|c| c == '^').unwrap();
+        let under: String = text.chars().skip(caret_at).take(3).collect();
+        assert_eq!(under, "bad", "{shown}");
+        assert!(
+            text.starts_with("1 | …s s") && text.ends_with('…'),
+            "{text}"
+        );
+        // Near the start, nothing is cut before; a long span stops at the cut.
+        let d = at(&source, 2..source.len());
+        assert_eq!((d.column, d.shown_from), (3, 1));
+        assert_eq!(d.width, MAX_SHOWN_CHARS - 2);
+        let carets = "^".repeat(MAX_SHOWN_CHARS - 2);
+        assert!(d.to_string().ends_with(&format!(" |   {carets}")));
+    }
+
+    #[test]
+    fn reporting_stops_after_the_most_diagnostics_of_a_severity() {
+        let source = "x ".repeat(1000);
+        let mut list = Vec::new();
+        for i in 0..1000 {
+            push_limited(&mut list, Severity::Error, || at(&source, 2 * i..2 * i + 1));
+        }
+        push_limited(&mut list, Severity::Warning, || {
+            Diagnostic::warning(Path::new("a"), &source, 0..1, "still reported")
+        });
+        assert_eq!(list.len(), MAX_DIAGNOSTICS + 2);
+        let last_error = &list[MAX_DIAGNOSTICS];
+        assert_eq!(last_error.column, 2 * MAX_DIAGNOSTICS + 1);
+        assert_eq!(
+            last_error.message,
+            "too many errors: the first 100 are reported, the rest from here on are not"
+        );
+        assert_eq!(list[MAX_DIAGNOSTICS + 1].message, "still reported");
     }
 
     #[test]

@@ -11,7 +11,9 @@ pub mod obj;
 mod toml_format;
 
 pub use camera_override::CameraOverride;
-pub use diagnostic::{Diagnostic, SceneError, Severity};
+pub use diagnostic::{
+    Diagnostic, MAX_DIAGNOSTICS, MAX_SHOWN_CHARS, SceneError, Severity, push_limited,
+};
 pub use nff::{load_nff, parse_nff};
 pub use obj::{load_obj, parse_obj};
 pub use toml_format::{load_scene, parse_scene};

@@ -166,12 +166,33 @@ fn decode_png(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
     ImageData::new(width, height, texels).ok_or_else(|| "the image data is truncated".to_string())
 }
 
+/// Pixels any JPEG may claim, whatever its length.
+const FREE_PIXELS: u64 = 1 << 20;
+
+/// Beyond [`FREE_PIXELS`], the most pixels a JPEG may claim per byte of
+/// file. zune-jpeg fills what a truncated file lacks, so without this a
+/// 640-byte file claiming 16000×16000 pixels decoded, in 39 s, into 3.7 GB
+/// of texels. Baseline JPEG needs at least two bits per 8×8 block and
+/// channel (about 256 pixels per byte); only a progressive file of nearly
+/// one flat colour could exceed this, and such a texture can be smaller.
+const MAX_PIXELS_PER_BYTE: u64 = 4096;
+
 fn decode_jpeg(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
     use zune_jpeg::zune_core::bytestream::ZCursor;
     use zune_jpeg::zune_core::colorspace::ColorSpace;
     use zune_jpeg::zune_core::options::DecoderOptions;
     let options = DecoderOptions::default().jpeg_set_out_colorspace(ColorSpace::RGB);
     let mut decoder = zune_jpeg::JpegDecoder::new_with_options(ZCursor::new(bytes), options);
+    decoder.decode_headers().map_err(|e| e.to_string())?;
+    let (width, height) = decoder.dimensions().ok_or("no image size")?;
+    let claimed = width as u64 * height as u64;
+    if claimed > FREE_PIXELS + MAX_PIXELS_PER_BYTE * bytes.len() as u64 {
+        return Err(format!(
+            "the header claims {width}x{height} pixels, far more than {} bytes can hold: \
+             the file is truncated or corrupt",
+            bytes.len()
+        ));
+    }
     let pixels = decoder.decode().map_err(|e| e.to_string())?;
     let (width, height) = decoder.dimensions().ok_or("no image size")?;
     let table = eight_bit_table(decoding);
@@ -264,6 +285,34 @@ pub(crate) mod tests {
                 .max_element()
                 < 0.01
         );
+    }
+
+    #[test]
+    fn a_short_jpeg_claiming_a_huge_size_is_refused_before_decoding() {
+        let mut bytes = include_bytes!("../../tests/textures/two_blocks.jpg").to_vec();
+        let sof = bytes
+            .windows(2)
+            .position(|w| w == [0xff, 0xc0] || w == [0xff, 0xc2])
+            .unwrap();
+        // Marker, length, precision, then height and width.
+        for at in [sof + 5, sof + 7] {
+            bytes[at..at + 2].copy_from_slice(&16000u16.to_be_bytes());
+        }
+        let error = decode_image(&bytes, Decoding::Color).unwrap_err();
+        assert_eq!(
+            error,
+            format!(
+                "the header claims 16000x16000 pixels, far more than {} bytes can hold: \
+                 the file is truncated or corrupt",
+                bytes.len()
+            )
+        );
+        // A size within the allowance still decodes (the missing data filled).
+        for at in [sof + 5, sof + 7] {
+            bytes[at..at + 2].copy_from_slice(&1000u16.to_be_bytes());
+        }
+        let data = decode_image(&bytes, Decoding::Color).unwrap();
+        assert_eq!((data.width(), data.height()), (1000, 1000));
     }
 
     #[test]

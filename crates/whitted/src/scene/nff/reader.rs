@@ -13,7 +13,7 @@ use std::path::Path;
 
 use super::lexer::{Lexer, Token, is_entity_keyword};
 use crate::math::Vec3;
-use crate::scene::Diagnostic;
+use crate::scene::{Diagnostic, Severity, push_limited};
 
 /// A problem that has been recorded; the entity being read is abandoned.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,8 +29,8 @@ pub(super) struct Reader<'a> {
     tokens: Peekable<Lexer<'a>>,
     /// End of the last token taken: where an entity being read ends.
     last_end: usize,
-    /// Every problem, with the byte where it starts (to sort by).
-    diagnostics: Vec<(usize, Diagnostic)>,
+    /// Every problem (up to the limit of [`push_limited`]).
+    diagnostics: Vec<Diagnostic>,
 }
 
 impl<'a> Reader<'a> {
@@ -47,16 +47,17 @@ impl<'a> Reader<'a> {
 
     /// Records a problem at `span`.
     pub(super) fn error(&mut self, span: Range<usize>, message: impl Into<String>) -> Reported {
-        let start = span.start;
-        let diagnostic = Diagnostic::new(self.path, self.source, span, message);
-        self.diagnostics.push((start, diagnostic));
+        let (path, source) = (self.path, self.source);
+        push_limited(&mut self.diagnostics, Severity::Error, || {
+            Diagnostic::new(path, source, span, message)
+        });
         Reported
     }
 
     /// Every problem recorded, in the order they appear in the file.
     pub(super) fn into_diagnostics(mut self) -> Vec<Diagnostic> {
-        self.diagnostics.sort_by_key(|(start, _)| *start);
-        self.diagnostics.into_iter().map(|(_, d)| d).collect()
+        self.diagnostics.sort_by_key(|d| (d.line, d.column));
+        self.diagnostics
     }
 
     /// The next token, taken.

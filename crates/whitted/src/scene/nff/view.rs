@@ -21,6 +21,7 @@ use std::ops::Range;
 use super::reader::{Parsed, Reader};
 use crate::camera::{Camera, CameraError};
 use crate::math::Vec3;
+use crate::render::MAX_SIDE;
 
 /// What the `v` block says.
 #[derive(Clone, Debug, PartialEq)]
@@ -70,8 +71,8 @@ pub(super) fn read_view(r: &mut Reader<'_>, at: Range<usize>) -> Parsed<View> {
         ));
     }
     r.word("resolution")?;
-    let (width, _) = r.count("the view's resolution (width)", 1)?;
-    let (height, _) = r.count("the view's resolution (height)", 1)?;
+    let width = side(r, "width")?;
+    let height = side(r, "height")?;
     if !(angle > 0.0 && angle < 180.0) {
         return Err(r.error(
             angle_span,
@@ -100,6 +101,18 @@ pub(super) fn read_view(r: &mut Reader<'_>, at: Range<usize>) -> Parsed<View> {
         width,
         height,
     })
+}
+
+/// One side of the view's `resolution`, from 1 to [`MAX_SIDE`] pixels.
+fn side(r: &mut Reader<'_>, name: &str) -> Parsed<u32> {
+    let (pixels, span) = r.count(&format!("the view's resolution ({name})"), 1)?;
+    if pixels > MAX_SIDE {
+        return Err(r.error(
+            span,
+            format!("the view's resolution ({name}) must be at most {MAX_SIDE}, got {pixels}"),
+        ));
+    }
+    Ok(pixels)
 }
 
 /// A line `name X Y Z` of the view: the vector and the span of its

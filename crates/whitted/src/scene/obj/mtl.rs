@@ -12,7 +12,7 @@ use super::text::lines;
 use crate::bump::Bump;
 use crate::material::Material;
 use crate::math::Color;
-use crate::scene::Diagnostic;
+use crate::scene::{Diagnostic, Severity, push_limited};
 use crate::texture::{Decoding, DissolveMap, ImageCache, ImageData, ImageTexture, Texture};
 
 /// The materials of one library by name, or its errors; with its warnings.
@@ -97,12 +97,14 @@ fn check(source: &str, path: &Path) -> Vec<Diagnostic> {
                 } else {
                     "a number"
                 };
-                diagnostics.push(Diagnostic::new(
-                    path,
-                    source,
-                    span,
-                    format!("expected {what} after `{keyword}`, found `{word}`"),
-                ));
+                push_limited(&mut diagnostics, Severity::Error, || {
+                    Diagnostic::new(
+                        path,
+                        source,
+                        span,
+                        format!("expected {what} after `{keyword}`, found `{word}`"),
+                    )
+                });
                 found = wanted;
                 break;
             }
@@ -113,7 +115,9 @@ fn check(source: &str, path: &Path) -> Vec<Diagnostic> {
                 "`{keyword}` needs {wanted} number{}",
                 if wanted == 1 { "" } else { "s" }
             );
-            diagnostics.push(Diagnostic::new(path, source, at, message));
+            push_limited(&mut diagnostics, Severity::Error, || {
+                Diagnostic::new(path, source, at, message)
+            });
         }
     }
     if let Some((at, count)) = maps {
@@ -210,12 +214,9 @@ fn load_maps(
             Ok(data) => data,
             Err(error) => {
                 let message = format!("{error}; {}", statement.slot.fallback());
-                diagnostics.push(Diagnostic::warning(
-                    path,
-                    source,
-                    statement.span.clone(),
-                    message,
-                ));
+                push_limited(diagnostics, Severity::Warning, || {
+                    Diagnostic::warning(path, source, statement.span.clone(), message)
+                });
                 continue;
             }
         };

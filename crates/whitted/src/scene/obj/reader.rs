@@ -9,7 +9,7 @@ use std::path::Path;
 
 use super::text::{Line, Words, lines};
 use crate::math::{DVec2, Vec3};
-use crate::scene::Diagnostic;
+use crate::scene::{Diagnostic, Severity, push_limited};
 
 /// An absent index (a corner without texture coordinates or normal).
 pub(super) const NONE: u32 = u32::MAX;
@@ -84,15 +84,19 @@ struct Reported;
 
 impl Reader<'_> {
     fn error(&mut self, span: Range<usize>, message: impl Into<String>) -> Reported {
-        let d = Diagnostic::new(self.path, self.source, span, message);
-        self.data.diagnostics.push(d);
+        let (path, source) = (self.path, self.source);
+        push_limited(&mut self.data.diagnostics, Severity::Error, || {
+            Diagnostic::new(path, source, span, message)
+        });
         Reported
     }
 
     fn warn_once(&mut self, keyword: &str, span: Range<usize>, message: String) {
         if self.warned.insert(keyword.to_string()) {
-            let d = Diagnostic::warning(self.path, self.source, span, message);
-            self.data.diagnostics.push(d);
+            let (path, source) = (self.path, self.source);
+            push_limited(&mut self.data.diagnostics, Severity::Warning, || {
+                Diagnostic::warning(path, source, span, message)
+            });
         }
     }
 

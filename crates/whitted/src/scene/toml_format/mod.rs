@@ -51,6 +51,7 @@ use crate::camera::{Camera, CameraError};
 use crate::color_space::ColorSpace;
 use crate::material::{Material, MaterialId};
 use crate::math::{Color, Vec3};
+use crate::render::{MAX_DEPTH, MAX_SIDE};
 use crate::scene::{Diagnostic, RenderSettings, Scene, SceneError};
 
 /// Reads a scene from the text of a scene file; `path` is only used in
@@ -150,12 +151,15 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
     let f = r.table(value, "render", "[render]")?;
     let keys = r.check_keys(&f, RENDER_KEYS);
     let d = RenderSettings::default();
-    let width = r.or_default(&f, "width", d.width, |r, v, k| r.count(v, k, 1));
-    let height = r.or_default(&f, "height", d.height, |r, v, k| r.count(v, k, 1));
+    let side = |r: &mut Reader<'_>, v: &Value<'_>, k: &str| r.count(v, k, 1, MAX_SIDE);
+    let width = r.or_default(&f, "width", d.width, side);
+    let height = r.or_default(&f, "height", d.height, side);
     let samples = r.or_default(&f, "samples", d.samples_per_pixel, |r, v, k| {
-        r.count(v, k, 1)
+        r.count(v, k, 1, u32::MAX)
     });
-    let max_depth = r.or_default(&f, "max_depth", d.max_depth, |r, v, k| r.count(v, k, 0));
+    let max_depth = r.or_default(&f, "max_depth", d.max_depth, |r, v, k| {
+        r.count(v, k, 0, MAX_DEPTH)
+    });
     let min_weight = r.or_default(&f, "min_weight", d.min_weight, Reader::non_negative);
     let background = r.or_default(&f, "background", Color::ZERO, Reader::color);
     let ambient = r.or_default(&f, "ambient", Color::ZERO, Reader::color);

@@ -14,7 +14,7 @@ use toml_span::value::{Key, Table, Value};
 
 use crate::color_space::ColorSpace;
 use crate::math::{Color, Vec3, unit};
-use crate::scene::{Diagnostic, SceneError};
+use crate::scene::{Diagnostic, SceneError, Severity, push_limited};
 use crate::texture::{Decoding, ImageCache, ImageData};
 
 /// A value was wrong and its error has been recorded. Only [`Reader::error`]
@@ -146,12 +146,10 @@ impl<'s> Reader<'s> {
 
     /// Records an error at `span`.
     pub(super) fn error(&mut self, span: Span, message: impl Into<String>) -> Reported {
-        self.diagnostics.push(Diagnostic::new(
-            self.path,
-            self.source,
-            span.start..span.end,
-            message,
-        ));
+        let (path, source) = (self.path, self.source);
+        push_limited(&mut self.diagnostics, Severity::Error, || {
+            Diagnostic::new(path, source, span.start..span.end, message)
+        });
         Reported(())
     }
 
@@ -369,8 +367,14 @@ impl<'s> Reader<'s> {
         }
     }
 
-    /// An integer `>= min` that fits in a `u32`.
-    pub(super) fn count(&mut self, value: &Value<'_>, key: &str, min: u32) -> Parsed<u32> {
+    /// An integer from `min` to `max`.
+    pub(super) fn count(
+        &mut self,
+        value: &Value<'_>,
+        key: &str,
+        min: u32,
+        max: u32,
+    ) -> Parsed<u32> {
         let Some(integer) = value.as_integer() else {
             return Err(self.wrong_type(value, key, "an integer"));
         };
@@ -380,12 +384,13 @@ impl<'s> Reader<'s> {
                 format!("`{key}` must be at least {min}, got {integer}"),
             ));
         }
-        u32::try_from(integer).map_err(|_| {
-            self.error(
+        if integer > i64::from(max) {
+            return Err(self.error(
                 value.span,
-                format!("`{key}` must be at most {}, got {integer}", u32::MAX),
-            )
-        })
+                format!("`{key}` must be at most {max}, got {integer}"),
+            ));
+        }
+        Ok(integer as u32)
     }
 
     /// `true` or `false`.
@@ -505,17 +510,20 @@ mod tests {
             read("x = 0", Reader::positive),
             Err(vec!["`x` must be greater than 0, got 0".into()])
         );
-        let count = |r: &mut Reader<'_>, v: &Value<'_>, k: &str| r.count(v, k, 1);
+        let count = |r: &mut Reader<'_>, v: &Value<'_>, k: &str| r.count(v, k, 1, 9);
         assert_eq!(read("x = 7", count), Ok(7));
+        assert_eq!(read("x = 9", count), Ok(9));
+        assert_eq!(
+            read("x = 10", count),
+            Err(vec!["`x` must be at most 9, got 10".into()])
+        );
         assert_eq!(
             read("x = 0", count),
             Err(vec!["`x` must be at least 1, got 0".into()])
         );
         assert_eq!(
             read("x = 5000000000", count),
-            Err(vec![
-                "`x` must be at most 4294967295, got 5000000000".into()
-            ])
+            Err(vec!["`x` must be at most 9, got 5000000000".into()])
         );
         assert_eq!(
             read("x = 1.5", count),
