@@ -21,7 +21,15 @@ pub(super) fn newell_normal(points: &[Vec3]) -> Vec3 {
 
 /// Triangles over the corners `0..points.len()` covering the polygon, each
 /// wound like the polygon. Degenerate or self-intersecting polygons still
-/// give `n - 2` triangles (the leftovers are clipped as a fan).
+/// give `n - 2` triangles: when no corner is an ear, a convex corner (or
+/// else the one where the search stands) is clipped anyway.
+///
+/// The search for the next ear goes on from the corner before the last one
+/// clipped, whose neighbour changed, and only corners that are not convex
+/// can lie inside a candidate ear: so a simple face of `n` corners costs
+/// about `n` times its count of reflex corners, not `n³`. A face that is
+/// not simple can make every search fail; after [`EAR_TESTS`] corner tests
+/// the rest of such a face is clipped as a fan.
 pub(super) fn triangulate(points: &[Vec3]) -> Vec<[usize; 3]> {
     let n = points.len();
     if n < 3 {
@@ -33,20 +41,57 @@ pub(super) fn triangulate(points: &[Vec3]) -> Vec<[usize; 3]> {
     let normal = newell_normal(points);
     let flat = project(points, normal);
     let mut remaining: Vec<usize> = (0..n).collect();
+    let mut blocking: Vec<usize> = (0..n)
+        .filter(|&i| !is_convex(&flat, &remaining, i))
+        .collect();
     let mut triangles = Vec::with_capacity(n - 2);
-    while remaining.len() > 3 {
+    let (mut at, mut misses, mut tests) = (0, 0, 0);
+    while remaining.len() > 3 && tests < EAR_TESTS {
         let count = remaining.len();
-        let ear = (0..count)
-            .find(|&i| is_ear(&flat, &remaining, i))
-            .or_else(|| (0..count).find(|&i| is_convex(&flat, &remaining, i)))
-            .unwrap_or(0);
-        let [a, b, c] = corners(&remaining, ear);
-        triangles.push([a, b, c]);
+        at %= count;
+        tests += blocking.len();
+        let clip = if is_ear(&flat, &remaining, &blocking, at) {
+            Some(at)
+        } else if misses + 1 >= count {
+            Some(
+                (0..count)
+                    .find(|&i| is_convex(&flat, &remaining, i))
+                    .unwrap_or(at),
+            )
+        } else {
+            None
+        };
+        let Some(ear) = clip else {
+            misses += 1;
+            at += 1;
+            continue;
+        };
+        triangles.push(corners(&remaining, ear));
+        blocking.retain(|&k| k != remaining[ear]);
         remaining.remove(ear);
+        // The clipped corner's neighbours may have become convex.
+        let count = remaining.len();
+        let before = (ear + count - 1) % count;
+        for i in [before, ear % count] {
+            let corner = remaining[i];
+            let convex = is_convex(&flat, &remaining, i);
+            let listed = blocking.contains(&corner);
+            if convex && listed {
+                blocking.retain(|&k| k != corner);
+            } else if !convex && !listed {
+                blocking.push(corner);
+            }
+        }
+        at = before;
+        misses = 0;
     }
-    triangles.push([remaining[0], remaining[1], remaining[2]]);
+    triangles
+        .extend((1..remaining.len() - 1).map(|k| [remaining[0], remaining[k], remaining[k + 1]]));
     triangles
 }
+
+/// The most corner-in-ear tests spent on one face (a fraction of a second).
+const EAR_TESTS: usize = 100_000_000;
 
 /// The points in 2D, dropping the normal's largest axis and keeping the
 /// winding counter-clockwise.
@@ -85,14 +130,17 @@ fn is_convex(flat: &[DVec2], remaining: &[usize], i: usize) -> bool {
     cross(a, b, c) > 0.0
 }
 
-/// A convex corner whose triangle holds no other remaining corner.
-fn is_ear(flat: &[DVec2], remaining: &[usize], i: usize) -> bool {
+/// A convex corner whose triangle holds none of the `blocking` corners
+/// (those remaining that are not convex: a convex corner cannot lie inside
+/// an ear of a simple polygon). Points on the triangle's edges count as
+/// inside.
+fn is_ear(flat: &[DVec2], remaining: &[usize], blocking: &[usize], i: usize) -> bool {
     if !is_convex(flat, remaining, i) {
         return false;
     }
     let ids = corners(remaining, i);
     let [a, b, c] = ids.map(|k| flat[k]);
-    remaining.iter().all(|&k| {
+    blocking.iter().all(|&k| {
         let p = flat[k];
         ids.contains(&k)
             || p == a
@@ -141,6 +189,54 @@ mod tests {
         for &[a, b, c] in &triangles {
             assert!((quad[b] - quad[a]).cross(quad[c] - quad[a]).dot(n) > 0.0);
         }
+    }
+
+    /// A star of `teeth` spikes, concave at every other corner.
+    fn star(teeth: usize) -> Vec<Vec3> {
+        (0..2 * teeth)
+            .map(|k| {
+                let angle = std::f64::consts::TAU * k as f64 / (2 * teeth) as f64;
+                let radius = if k % 2 == 0 { 1.0 } else { 0.5 };
+                radius * Vec3::new(angle.cos(), angle.sin(), 0.0)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_star_is_covered_exactly_by_counter_clockwise_triangles() {
+        for teeth in [3, 5, 72, 1000] {
+            let points = star(teeth);
+            let triangles = triangulate(&points);
+            assert_eq!(triangles.len(), points.len() - 2);
+            // The star's area: 2·teeth triangles (centre, tip, notch).
+            let step = std::f64::consts::TAU / (2 * teeth) as f64;
+            let exact = 2.0 * teeth as f64 * 0.5 * 0.5 * step.sin();
+            assert!(
+                (area(&points, &triangles) - exact).abs() < 1e-9 * exact,
+                "{teeth}"
+            );
+            for &[a, b, c] in &triangles {
+                let z = (points[b] - points[a]).cross(points[c] - points[a]).z;
+                assert!(z > 0.0, "{teeth} teeth: a clockwise triangle");
+            }
+        }
+    }
+
+    #[test]
+    fn a_huge_self_intersecting_face_still_gives_n_minus_2_triangles() {
+        // 20,000 corners at pseudo-random places, as a fuzzed face gives
+        // (the search without a bound took many seconds on such a face).
+        let mut state = 1u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let points: Vec<Vec3> = (0..20_000)
+            .map(|_| Vec3::new(next(), next(), 0.0))
+            .collect();
+        assert_eq!(triangulate(&points).len(), points.len() - 2);
     }
 
     #[test]
