@@ -14,6 +14,11 @@ use crate::math::{Aabb, DVec2, Ray, Transform, Vec3};
 use crate::mesh::TriangleMesh;
 use crate::scene::{MeshInstance, Primitive, Scene, TransformId};
 use crate::shape::{LocalSurface, RayShear, ShapeHit, watertight};
+use rayon::prelude::*;
+
+/// Triangles per parallel task when preparing meshes: fewer are prepared
+/// on the calling thread.
+const PARALLEL_CHUNK: usize = 4096;
 
 /// The closest hit found by [`Geometry::intersect`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -138,18 +143,34 @@ impl<'a> Geometry<'a> {
             }
             refs.push(PrimitiveRef::Shape(i as u32));
         }
+        // A mesh's triangles are prepared in parallel: on the bunny this
+        // loop, and the fresh memory it touches, took a fifth of the time
+        // `whitted bench` reports as the BVH build.
         for (instance, m) in scene.mesh_instances.iter().enumerate() {
             let mesh = &scene.meshes[m.mesh.0 as usize];
-            for triangle in 0..mesh.len() as u32 {
-                boxes.push(to_world(m.transform, mesh.triangle_bounds(triangle)));
-                bounded.push(refs.len() as u32);
-                slot_triangles.push(m.transform.is_none().then(|| mesh.corners(triangle)));
-                refs.push(PrimitiveRef::Triangle {
+            let triangles = || {
+                (0..mesh.len() as u32)
+                    .into_par_iter()
+                    .with_min_len(PARALLEL_CHUNK)
+            };
+            let first = refs.len() as u32;
+            boxes.par_extend(triangles().map(|t| to_world(m.transform, mesh.triangle_bounds(t))));
+            slot_triangles
+                .par_extend(triangles().map(|t| m.transform.is_none().then(|| mesh.corners(t))));
+            bounded.extend(first..first + mesh.len() as u32);
+            refs.extend(
+                (0..mesh.len() as u32).map(|triangle| PrimitiveRef::Triangle {
                     instance: instance as u32,
                     triangle,
-                });
-            }
+                }),
+            );
         }
+        let bounds = boxes
+            .par_chunks(PARALLEL_CHUNK)
+            .map(|chunk| chunk.iter().fold(Aabb::EMPTY, |a, b| a.union(b)))
+            .collect::<Vec<Aabb>>()
+            .iter()
+            .fold(Aabb::EMPTY, |a, b| a.union(b));
         Self {
             primitives: &scene.primitives,
             instances: &scene.mesh_instances,
@@ -157,7 +178,7 @@ impl<'a> Geometry<'a> {
             transforms: &scene.transforms,
             refs,
             accel: Accelerator::build(kind, &boxes),
-            bounds: boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(b)),
+            bounds,
             bounded,
             slot_triangles,
             unbounded,

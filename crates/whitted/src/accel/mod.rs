@@ -26,6 +26,7 @@ pub mod bvh;
 pub mod grid;
 pub mod kdtree;
 pub mod linear;
+mod mailbox;
 
 #[cfg(test)]
 pub(crate) mod conformance;

@@ -5,16 +5,23 @@
 //!
 //! - `node`: the wide node, the build's binary node, and the outward
 //!   rounding of their `f32` boxes.
-//! - `build`: the binned SAH build, parallel and deterministic.
+//! - `build`: the SAH build, parallel and deterministic, over `prims` (the
+//!   primitives' indices and boxes, reordered together), `fbox` (the
+//!   build's `f32` box), `bins` (the binned SAH of large nodes) and `sweep`
+//!   (the exact SAH of small ones).
 //! - `collapse`: binary to four-wide.
 //! - `traverse`: the two ray queries, with the argument that their `f32`
 //!   slab test is conservative; `counters.nodes` counts the nodes and leaves
 //!   the walk enters, `counters.primitives` the primitive tests.
 //! - `validate`: the invariants.
 
+mod bins;
 mod build;
 mod collapse;
+mod fbox;
 mod node;
+mod prims;
+mod sweep;
 mod traverse;
 mod validate;
 

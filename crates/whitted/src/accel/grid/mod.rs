@@ -6,14 +6,13 @@
 //! - `build` chooses the resolution and fills the cells into flat offset and
 //!   index arrays;
 //! - `dda` walks a ray through the cells; `traverse` answers the two queries
-//!   on that walk, with a `mailbox` so a primitive spanning many cells is
-//!   tested once per ray;
+//!   on that walk, with the shared mailbox (`accel/mailbox.rs`) so a
+//!   primitive spanning many cells is tested once per ray;
 //! - `validate` checks a built grid.
 
 mod build;
 mod dda;
 mod lattice;
-mod mailbox;
 mod traverse;
 mod validate;
 

@@ -10,8 +10,8 @@
 
 use super::Grid;
 use super::dda::DdaCells;
-use super::mailbox::Mailbox;
 use crate::accel::TraversalCounters;
+use crate::accel::mailbox::Mailbox;
 use crate::math::Ray;
 
 impl Grid {
