@@ -13,7 +13,8 @@ use crate::material::MaterialId;
 use crate::math::{Aabb, DVec2, Ray, Transform, Vec3};
 use crate::mesh::TriangleMesh;
 use crate::scene::{MeshInstance, Primitive, Scene, TransformId};
-use crate::shape::{LocalSurface, RayShear, ShapeHit, watertight};
+use crate::shape::{LocalSurface, RayShear, Shape, ShapeHit, watertight};
+use crate::triangle_clip::clipped_triangle_bounds;
 use rayon::prelude::*;
 
 /// Triangles per parallel task when preparing meshes: fewer are prepared
@@ -171,13 +172,35 @@ impl<'a> Geometry<'a> {
             .collect::<Vec<Aabb>>()
             .iter()
             .fold(Aabb::EMPTY, |a, b| a.union(b));
+        // Perfect splits for the kd-tree: an untransformed triangle's
+        // bounds in a cell are those of its part inside the cell; other
+        // primitives keep their box ∩ the cell.
+        let corners = |slot: u32| match slot_triangles[slot as usize] {
+            Some(c) => Some(c),
+            None => match refs[bounded[slot as usize] as usize] {
+                PrimitiveRef::Shape(i) => match &scene.primitives[i as usize] {
+                    Primitive {
+                        shape: Shape::Triangle(t),
+                        transform: None,
+                        ..
+                    } => Some(t.vertices()),
+                    _ => None,
+                },
+                PrimitiveRef::Triangle { .. } => None,
+            },
+        };
+        let clip = |slot: u32, cell: &Aabb| match corners(slot) {
+            Some(c) => clipped_triangle_bounds(c, cell),
+            None => boxes[slot as usize].intersection(cell),
+        };
+        let accel = Accelerator::build_clipped(kind, &boxes, &clip);
         Self {
             primitives: &scene.primitives,
             instances: &scene.mesh_instances,
             meshes: &scene.meshes,
             transforms: &scene.transforms,
             refs,
-            accel: Accelerator::build(kind, &boxes),
+            accel,
             bounds,
             bounded,
             slot_triangles,

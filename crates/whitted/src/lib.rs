@@ -62,3 +62,4 @@ pub mod shape;
 pub mod tangent_frame;
 pub mod texture;
 pub mod trace;
+pub mod triangle_clip;

@@ -136,6 +136,16 @@ impl Aabb {
         }
     }
 
+    /// The common part of both, or `None` when they do not meet (boxes
+    /// that only touch meet in a flat box).
+    pub fn intersection(&self, other: &Self) -> Option<Self> {
+        let common = Self {
+            min: self.min.max(other.min),
+            max: self.max.min(other.max),
+        };
+        common.min.cmple(common.max).all().then_some(common)
+    }
+
     /// The smallest box around `self` and `p`.
     pub fn union_point(&self, p: Vec3) -> Self {
         Self {

@@ -33,7 +33,7 @@ pub(crate) mod conformance;
 
 pub use bvh::{Bvh, BvhBuildParams};
 pub use grid::{Grid, GridBuildParams};
-pub use kdtree::{KdTree, KdTreeBuildParams};
+pub use kdtree::{Clipper, KdTree, KdTreeBuildParams};
 pub use linear::Linear;
 
 use crate::math::{Aabb, Ray};
@@ -133,6 +133,20 @@ impl Accelerator {
             AccelKind::Linear => Accelerator::Linear(Linear::build(boxes)),
             AccelKind::Grid => Accelerator::Grid(Grid::build(boxes)),
             AccelKind::KdTree => Accelerator::KdTree(KdTree::build(boxes)),
+        }
+    }
+
+    /// Builds a structure of `kind` over primitives `0..boxes.len()`; a
+    /// kd-tree clips its straddling primitives to the cells with `clip`
+    /// ([`KdTree::build_clipped`]), the other structures ignore it.
+    pub fn build_clipped(kind: AccelKind, boxes: &[Aabb], clip: Clipper) -> Self {
+        match kind {
+            AccelKind::KdTree => Accelerator::KdTree(KdTree::build_clipped(
+                boxes,
+                &KdTreeBuildParams::default(),
+                clip,
+            )),
+            _ => Self::build(kind, boxes),
         }
     }
 

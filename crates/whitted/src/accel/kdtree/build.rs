@@ -6,6 +6,7 @@
 //! below, above or both against it, and each axis's list is split into the
 //! children's lists by one pass that keeps its order. Only the primitives
 //! on both sides need new events (their boxes clipped to each child's
+//! cell, or with perfect splits the boxes of their parts inside each
 //! cell): those few are sorted and merged in. A node becomes a leaf when no
 //! plane is cheaper than testing its primitives, or at the depth limit that
 //! stops degenerate input (identical boxes, one box around everything).
@@ -14,7 +15,7 @@ use super::events::{Event, EventKind, EventLists, merge, push_events, snap_outwa
 use super::node::{KdNode, MAX_FIELD};
 use super::sah::{Costs, Split, best_split};
 use super::traverse::STACK_CAPACITY;
-use super::{KdTree, KdTreeBuildParams, split_cell};
+use super::{Clipper, KdTree, KdTreeBuildParams, split_cell};
 use crate::math::Aabb;
 
 /// Work done by a build, to check its complexity without timing it.
@@ -55,8 +56,23 @@ pub(super) fn placed_box(i: usize, b: &Aabb) -> Option<Aabb> {
     snap_outward(b).filter(|_| i < MAX_FIELD as usize)
 }
 
+/// The box of the part of primitive `p` (with box `b`) inside `cell`:
+/// `b` ∩ `cell`, or with `clip` the clipped bounds widened to the `f32`
+/// grid, ∩ `b` ∩ `cell`. `None` when it does not meet the cell.
+pub(super) fn bounds_in(p: u32, b: &Aabb, cell: &Aabb, clip: Option<Clipper>) -> Option<Aabb> {
+    let within = b.intersection(cell)?;
+    match clip {
+        Some(clip) => snap_outward(&clip(p, cell)?)?.intersection(&within),
+        None => Some(within),
+    }
+}
+
 /// Builds the tree over `boxes` and reports the work done.
-pub(super) fn build(boxes: &[Aabb], params: &KdTreeBuildParams) -> (KdTree, BuildCounters) {
+pub(super) fn build(
+    boxes: &[Aabb],
+    params: &KdTreeBuildParams,
+    clip: Option<Clipper>,
+) -> (KdTree, BuildCounters) {
     let mut snapped = Vec::with_capacity(boxes.len());
     let mut loose = Vec::new();
     let mut events = EventLists::default();
@@ -75,6 +91,7 @@ pub(super) fn build(boxes: &[Aabb], params: &KdTreeBuildParams) -> (KdTree, Buil
     events.iter_mut().for_each(|l| sort_events(l));
     let count = boxes.len() - loose.len();
     let mut builder = Builder {
+        clip,
         sides: vec![Side::Both; boxes.len()],
         boxes: snapped,
         costs: Costs {
@@ -103,7 +120,9 @@ pub(super) fn build(boxes: &[Aabb], params: &KdTreeBuildParams) -> (KdTree, Buil
     (tree, builder.counters)
 }
 
-struct Builder {
+struct Builder<'c> {
+    /// Clips straddling primitives to the children's cells, if given.
+    clip: Option<Clipper<'c>>,
     /// Every primitive's box widened to the `f32` grid (empty for loose
     /// ones).
     boxes: Vec<Aabb>,
@@ -116,7 +135,7 @@ struct Builder {
     counters: BuildCounters,
 }
 
-impl Builder {
+impl Builder<'_> {
     /// Builds the subtree of `cell`, holding `count` primitives with these
     /// events, at index `self.nodes.len()`.
     fn node(&mut self, cell: Aabb, events: EventLists, count: usize, depth: usize) {
@@ -152,7 +171,8 @@ impl Builder {
     }
 
     /// Splits `cell` and its events at `split`. A box that straddles the
-    /// plane goes to both sides, one that touches it to the side it lies
+    /// plane goes to each side its primitive meets (both, without a
+    /// clipper), one that touches it to the side it lies
     /// on, and one lying flat in it to the side the split chose. The plane
     /// is exactly the stored `f32` and the boxes are widened to the `f32`
     /// grid, so each box is inside the closed cells it is given to.
@@ -192,10 +212,17 @@ impl Builder {
 
         let mut new_below = EventLists::default();
         let mut new_above = EventLists::default();
+        let (mut straddling_below, mut straddling_above) = (0, 0);
         for &p in &straddling {
             let b = self.boxes[p as usize];
-            push_events(&clip(&b, &below_cell), p, &mut new_below);
-            push_events(&clip(&b, &above_cell), p, &mut new_above);
+            if let Some(c) = bounds_in(p, &b, &below_cell, self.clip) {
+                push_events(&c, p, &mut new_below);
+                straddling_below += 1;
+            }
+            if let Some(c) = bounds_in(p, &b, &above_cell, self.clip) {
+                push_events(&c, p, &mut new_above);
+                straddling_above += 1;
+            }
         }
         for list in new_below.iter_mut().chain(&mut new_above) {
             sort_events(list);
@@ -210,22 +237,14 @@ impl Builder {
             Child {
                 cell: below_cell,
                 events: merged(below, new_below),
-                count: below_count + straddling.len(),
+                count: below_count + straddling_below,
             },
             Child {
                 cell: above_cell,
                 events: merged(above, new_above),
-                count: above_count + straddling.len(),
+                count: above_count + straddling_above,
             },
         ]
-    }
-}
-
-/// The part of `b` inside `cell` (they overlap).
-fn clip(b: &Aabb, cell: &Aabb) -> Aabb {
-    Aabb {
-        min: b.min.max(cell.min),
-        max: b.max.min(cell.max),
     }
 }
 
@@ -239,8 +258,16 @@ mod tests {
     #[test]
     fn work_grows_like_n_log_n_and_events_are_sorted_about_once() {
         let params = KdTreeBuildParams::default();
-        let (_, small) = build(&random_boxes(&mut Rng::new(1), 2_000, 100.0, 2.0), &params);
-        let (tree, large) = build(&random_boxes(&mut Rng::new(1), 8_000, 100.0, 2.0), &params);
+        let (_, small) = build(
+            &random_boxes(&mut Rng::new(1), 2_000, 100.0, 2.0),
+            &params,
+            None,
+        );
+        let (tree, large) = build(
+            &random_boxes(&mut Rng::new(1), 8_000, 100.0, 2.0),
+            &params,
+            None,
+        );
         // N log N predicts a ratio of about 4.6 for 4x the boxes; N² gives 16.
         let ratio = large.events_swept as f64 / small.events_swept as f64;
         assert!(ratio > 3.0 && ratio < 6.0, "swept events grew {ratio}x");
@@ -276,7 +303,7 @@ mod tests {
             Vec3::new(-1.0, 0.25, 0.25),
             Vec3::new(200.0, 0.75, 0.75),
         ));
-        let (tree, _) = build(&boxes, &KdTreeBuildParams::default());
+        let (tree, _) = build(&boxes, &KdTreeBuildParams::default(), None);
         assert!(tree.validate(&boxes).is_ok());
         let bar_copies = tree.indices.iter().filter(|&&p| p == 64).count();
         assert!(bar_copies > 8, "the bar is in {bar_copies} leaves");

@@ -1,10 +1,10 @@
 //! Checking a built tree against its boxes (`validate`) and measuring it
 //! (`stats`).
 
-use super::build::placed_box;
+use super::build::{bounds_in, placed_box};
 use super::node::NodeKind;
 use super::traverse::STACK_CAPACITY;
-use super::{KdTree, split_cell};
+use super::{Clipper, KdTree, split_cell};
 use crate::accel::AccelStats;
 use crate::math::Aabb;
 
@@ -20,6 +20,18 @@ impl KdTree {
     ///   primitive not placed in the tree is kept aside with its box,
     ///   because the box cannot be placed.
     pub fn validate(&self, boxes: &[Aabb]) -> Result<(), String> {
+        self.validate_impl(boxes, None)
+    }
+
+    /// Checks a tree built by [`KdTree::build_clipped`] with `clip`, as
+    /// [`KdTree::validate`] does, except that a primitive must be held
+    /// only where the box of its part inside a cell (by `clip`, widened
+    /// as the build does) reaches.
+    pub fn validate_clipped(&self, boxes: &[Aabb], clip: Clipper) -> Result<(), String> {
+        self.validate_impl(boxes, Some(clip))
+    }
+
+    fn validate_impl(&self, boxes: &[Aabb], clip: Option<Clipper>) -> Result<(), String> {
         let mut aside = vec![false; boxes.len()];
         for &(i, b) in &self.loose {
             let given = boxes
@@ -51,7 +63,7 @@ impl KdTree {
             }
             required.push(i as u32);
         }
-        self.check_coverage(0, self.bounds, required, boxes)
+        self.check_coverage(0, self.bounds, required, boxes, clip)
     }
 
     /// Checks that the nodes form a tree within the stack's depth, with
@@ -104,20 +116,30 @@ impl KdTree {
     }
 
     /// Checks that every point of a `required` primitive's box inside
-    /// `cell` (the cell of node `index`) lies in a leaf of the subtree that
-    /// holds it. The shape is already checked.
+    /// `cell` (the cell of node `index`), clipped by `clip` if given, lies
+    /// in a leaf of the subtree that holds it. The shape is already
+    /// checked.
     fn check_coverage(
         &self,
         index: usize,
         cell: Aabb,
         required: Vec<u32>,
         boxes: &[Aabb],
+        clip: Option<Clipper>,
     ) -> Result<(), String> {
+        // Each primitive's box inside this cell; gone where it is clipped
+        // away.
+        let required = required
+            .into_iter()
+            .filter_map(|p| bounds_in(p, &boxes[p as usize], &cell, clip).map(|b| (p, b)));
         match self.nodes[index].kind() {
             NodeKind::Leaf { offset, count } => {
                 let mut held = self.leaf_primitives(offset, count).unwrap_or(&[]).to_vec();
                 held.sort_unstable();
-                match required.iter().find(|p| held.binary_search(p).is_err()) {
+                match required
+                    .map(|(p, _)| p)
+                    .find(|p| held.binary_search(p).is_err())
+                {
                     Some(p) => Err(format!(
                         "primitive {p} overlaps leaf {index}'s cell {cell:?} but is not in it"
                     )),
@@ -127,8 +149,7 @@ impl KdTree {
             NodeKind::Interior { axis, split, above } => {
                 let plane = f64::from(split);
                 let (mut below_required, mut above_required) = (Vec::new(), Vec::new());
-                for p in required {
-                    let b = &boxes[p as usize];
+                for (p, b) in required {
                     let (low, high) = (b.min[axis], b.max[axis]);
                     if low == plane && high == plane {
                         // Flat in the plane: wholly on the side it was given.
@@ -147,8 +168,8 @@ impl KdTree {
                     }
                 }
                 let [below_cell, above_cell] = split_cell(&cell, axis, plane);
-                self.check_coverage(index + 1, below_cell, below_required, boxes)?;
-                self.check_coverage(above as usize, above_cell, above_required, boxes)
+                self.check_coverage(index + 1, below_cell, below_required, boxes, clip)?;
+                self.check_coverage(above as usize, above_cell, above_required, boxes, clip)
             }
         }
     }

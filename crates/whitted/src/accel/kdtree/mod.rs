@@ -18,6 +18,13 @@
 //! beyond `f32`) are kept aside and tested for every ray, as brute force
 //! would.
 //!
+//! "Perfect splits" (Wald and Havran 2006, section 4.4): a build may be
+//! given a [`Clipper`], the bounds of a primitive inside a cell. A
+//! primitive straddling a split then gets, in each child, the box of its
+//! own part inside that child's cell instead of its box ∩ the cell, and
+//! goes to no child it does not meet: a triangle crossing a cell
+//! diagonally is not copied into every cell its box reaches.
+//!
 //! Limits: at most 2^30 − 1 primitives are placed in the tree (more are
 //! kept aside) and at most 2^32 references.
 
@@ -82,9 +89,22 @@ impl KdTree {
 
     /// A tree over primitives `0..boxes.len()` with these boxes.
     pub fn build_with(boxes: &[Aabb], params: &KdTreeBuildParams) -> Self {
-        build::build(boxes, params).0
+        build::build(boxes, params, None).0
+    }
+
+    /// A tree over primitives `0..boxes.len()` with these boxes, whose
+    /// straddling primitives are clipped to the cells by `clip` ("perfect
+    /// splits"). Validate it with [`KdTree::validate_clipped`].
+    pub fn build_clipped(boxes: &[Aabb], params: &KdTreeBuildParams, clip: Clipper) -> Self {
+        build::build(boxes, params, Some(clip)).0
     }
 }
+
+/// The bounds of primitive `i` inside the closed box `cell`, or `None`
+/// when the primitive does not meet it. It must be conservative: every
+/// point of the primitive inside `cell` lies in the returned box (which
+/// the build then intersects with the primitive's box and the cell).
+pub type Clipper<'a> = &'a dyn Fn(u32, &Aabb) -> Option<Aabb>;
 
 /// The cells below and above `plane` on `axis`.
 fn split_cell(cell: &Aabb, axis: usize, plane: f64) -> [Aabb; 2] {

@@ -12,6 +12,8 @@ use crate::accel::conformance::{assert_conforms, random_boxes};
 use crate::accel::{AccelKind, Accelerator, TraversalCounters};
 use crate::math::{Aabb, Ray, Vec3};
 use crate::random::Rng;
+use crate::shape::Triangle;
+use crate::triangle_clip::clipped_triangle_bounds;
 
 /// Where `ray` enters `b` within `(ray.t_min, t_max)`.
 fn box_hit(b: &Aabb, ray: &Ray, t_max: f64) -> Option<f64> {
@@ -384,4 +386,96 @@ fn build_params_bound_the_depth_and_the_cost_model_decides_leaves() {
     let leaf = KdTree::build_with(&boxes, &costly_traversal).stats();
     assert_eq!((leaf.nodes, leaf.references), (1, 2_000));
     assert_eq!(leaf.sah_cost, 2_000.0);
+}
+
+/// Random triangles on a coarse grid, so many lie flat in or touch split
+/// planes at a vertex or an edge, with thin slivers and large diagonal
+/// ones that cross many cells.
+fn awkward_triangles(rng: &mut Rng, n: usize) -> Vec<Triangle> {
+    let mut triangles = Vec::new();
+    while triangles.len() < n {
+        let base = Vec3::from_array([0; 3].map(|_| f64::from(rng.below(16))));
+        let corner = |rng: &mut Rng, size: u32| {
+            base + Vec3::from_array([0; 3].map(|_| f64::from(rng.below(size)) * 0.5))
+        };
+        let (a, b, mut c) = match rng.below(3) {
+            0 => (corner(rng, 24), corner(rng, 24), corner(rng, 24)),
+            1 => (corner(rng, 4), corner(rng, 4), corner(rng, 4)),
+            // A sliver: the third corner barely off the first edge.
+            _ => {
+                let (a, b) = (corner(rng, 12), corner(rng, 12));
+                (a, b, a + (b - a) * 0.375 + Vec3::splat(1e-7))
+            }
+        };
+        // A quarter lie in a grid plane.
+        if rng.below(4) == 3 {
+            let axis = rng.below(3) as usize;
+            c[axis] = a[axis];
+            let mut b2 = b;
+            b2[axis] = a[axis];
+            if let Ok(t) = Triangle::new(a, b2, c) {
+                triangles.push(t);
+            }
+        } else if let Ok(t) = Triangle::new(a, b, c) {
+            triangles.push(t);
+        }
+    }
+    triangles
+}
+
+#[test]
+fn perfect_splits_keep_every_triangle_where_it_meets_a_cell_and_match_brute_force() {
+    let mut rng = Rng::new(23);
+    let triangles = awkward_triangles(&mut rng, 1_500);
+    let boxes: Vec<Aabb> = triangles.iter().map(Triangle::bounds).collect();
+    let clip =
+        |i: u32, cell: &Aabb| clipped_triangle_bounds(triangles[i as usize].vertices(), cell);
+    let tree = KdTree::build_clipped(&boxes, &KdTreeBuildParams::default(), &clip);
+    tree.validate_clipped(&boxes, &clip).unwrap();
+    // Clipping must pay: fewer references than clipping the boxes.
+    let plain = KdTree::build(&boxes).stats().references;
+    let clipped = tree.stats().references;
+    assert!(
+        clipped < plain,
+        "{clipped} references, {plain} without clipping"
+    );
+
+    // Rays at the corners and along the edges (on the grid, so often in
+    // split planes), axis-parallel and random.
+    let mut rays = random_rays(&mut rng, 2_000, 20.0);
+    for t in triangles.iter().take(500) {
+        let [a, b, c] = t.vertices();
+        let origin = rng.point_in(Vec3::splat(-10.0), Vec3::splat(40.0));
+        for target in [a, b, c, (a + b) * 0.5, (b + c) * 0.25 + c * 0.5] {
+            rays.push(Ray::new(origin, target - origin));
+            let axis = rng.below(3) as usize;
+            let mut dir = Vec3::ZERO;
+            dir[axis] = 1.0;
+            rays.push(Ray::new(target - dir * 50.0, dir));
+        }
+    }
+    let hit = |i: u32, ray: &Ray, t_max: f64| {
+        let mut r = *ray;
+        r.t_max = t_max;
+        triangles[i as usize].intersect(&r).map(|h| h.t)
+    };
+    let oracle = Accelerator::build(AccelKind::Linear, &boxes);
+    let accel = Accelerator::KdTree(tree);
+    let mut hits = 0;
+    for ray in &rays {
+        let mut c = TraversalCounters::default();
+        let expected = oracle.intersect(ray, &mut c, |i, t| hit(i, ray, t));
+        let actual = accel.intersect(ray, &mut c, |i, t| hit(i, ray, t));
+        assert_eq!(actual, expected, "{ray:?}");
+        let any = |a: &Accelerator, c: &mut TraversalCounters| {
+            a.occluded(ray, c, |i| hit(i, ray, ray.t_max).is_some())
+        };
+        assert_eq!(any(&accel, &mut c), expected.is_some(), "{ray:?}");
+        hits += usize::from(expected.is_some());
+    }
+    assert!(
+        hits > rays.len() / 4,
+        "only {hits} of {} rays hit",
+        rays.len()
+    );
 }
