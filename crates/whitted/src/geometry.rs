@@ -202,17 +202,19 @@ impl<'a> Geometry<'a> {
         }
     }
 
-    /// Structure slot `slot` (primitive `index`) hit by the query's ray,
-    /// closer than `t_max`.
+    /// Structure slot `slot` hit by the query's ray, closer than `t_max`.
+    /// The slot's primitive number is looked up only when it is not a plain
+    /// mesh triangle: that load, for every triangle tested, was a random
+    /// access into `bounded`.
     #[inline]
-    fn intersect_slot(&self, slot: u32, index: u32, query: &Query, t_max: f64) -> Option<ShapeHit> {
+    fn intersect_slot(&self, slot: u32, query: &Query, t_max: f64) -> Option<ShapeHit> {
         match &self.slot_triangles[slot as usize] {
             Some([p0, p1, p2]) => {
                 let mut ray = *query.ray;
                 ray.t_max = t_max;
                 watertight(*p0, *p1, *p2, &ray, &query.shear())
             }
-            None => self.intersect_primitive(index, query, t_max),
+            None => self.intersect_primitive(self.bounded[slot as usize], query, t_max),
         }
     }
 
@@ -275,10 +277,9 @@ impl<'a> Geometry<'a> {
         let mut clipped = *ray;
         clipped.t_max = t_max;
         self.accel.intersect(&clipped, counters, |slot, t_max| {
-            let i = self.bounded[slot as usize];
-            let h = self.intersect_slot(slot, i, &query, t_max)?;
+            let h = self.intersect_slot(slot, &query, t_max)?;
             best = Some(Hit {
-                primitive: i,
+                primitive: self.bounded[slot as usize],
                 shape_hit: h,
             });
             Some(h.t)
@@ -296,10 +297,9 @@ impl<'a> Geometry<'a> {
         let query = self.query(ray);
         self.unbounded.iter().any(|&i| self.occluded_by(i, &query))
             || self.accel.occluded(ray, counters, |slot| {
-                let i = self.bounded[slot as usize];
                 match &self.slot_triangles[slot as usize] {
-                    Some(_) => self.intersect_slot(slot, i, &query, ray.t_max).is_some(),
-                    None => self.occluded_by(i, &query),
+                    Some(_) => self.intersect_slot(slot, &query, ray.t_max).is_some(),
+                    None => self.occluded_by(self.bounded[slot as usize], &query),
                 }
             })
     }
