@@ -259,6 +259,21 @@ impl Bvh {
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
+        mut hit: impl FnMut(u32, f64) -> Option<f64>,
+    ) -> Option<f64> {
+        self.intersect_in_leaf_order(ray, counters, |entry, t_max| {
+            hit(self.indices[entry as usize], t_max)
+        })
+    }
+
+    /// [`Self::intersect`], with `hit` given each primitive's position in
+    /// [`Self::indices`] instead of its number: a caller that keeps what it
+    /// needs of the primitives in that order reads each leaf's together.
+    #[inline]
+    pub fn intersect_in_leaf_order(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
         hit: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<f64> {
         if self.nodes.is_empty() {
@@ -272,7 +287,7 @@ impl Bvh {
         }
     }
 
-    /// [`Self::intersect`] with a stack of `N` entries.
+    /// [`Self::intersect_in_leaf_order`] with a stack of `N` entries.
     #[inline(always)]
     fn closest<const N: usize>(
         &self,
@@ -292,9 +307,9 @@ impl Bvh {
             work.nodes += 1;
             let first = current.child as usize;
             if current.count > 0 {
-                for &prim in &self.indices[first..first + current.count as usize] {
+                for entry in current.child..current.child + current.count {
                     work.primitives += 1;
-                    if let Some(t) = hit(prim, closest) {
+                    if let Some(t) = hit(entry, closest) {
                         closest = t;
                         found = Some(t);
                     }
@@ -347,6 +362,21 @@ impl Bvh {
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
+        mut occludes: impl FnMut(u32) -> bool,
+    ) -> bool {
+        self.occluded_in_leaf_order(ray, counters, |entry| {
+            occludes(self.indices[entry as usize])
+        })
+    }
+
+    /// [`Self::occluded`], with `occludes` given each primitive's position
+    /// in [`Self::indices`] instead of its number (see
+    /// [`Self::intersect_in_leaf_order`]).
+    #[inline]
+    pub fn occluded_in_leaf_order(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
         occludes: impl FnMut(u32) -> bool,
     ) -> bool {
         if self.nodes.is_empty() {
@@ -360,7 +390,7 @@ impl Bvh {
         }
     }
 
-    /// [`Self::occluded`] with a stack of `N` entries.
+    /// [`Self::occluded_in_leaf_order`] with a stack of `N` entries.
     #[inline(always)]
     fn any<const N: usize>(
         &self,
@@ -378,10 +408,9 @@ impl Bvh {
             work.nodes += 1;
             let first = current.child as usize;
             if current.count > 0 {
-                let prims = &self.indices[first..first + current.count as usize];
-                if prims.iter().any(|&prim| {
+                if (current.child..current.child + current.count).any(|entry| {
                     work.primitives += 1;
-                    occludes(prim)
+                    occludes(entry)
                 }) {
                     break true;
                 }
