@@ -77,10 +77,10 @@
 //! primary/shadow/diffuse. The kitchen's tree (depth 16) took the stack
 //! for [`MAX_DEPTH`] and cleared 2.3 kB a ray; the middle-sized stack took
 //! its shadow rays from 9.6 to 12.1 Mrays/s (1 thread, interleaved runs).
-//! Reading each axis's entry and exit planes through rows chosen once per
-//! ray, instead of a branch per axis and node, took 1/3/5% fewer
-//! instructions (primary/shadow/diffuse, bunny, callgrind); user time over
-//! interleaved runs was the same within the noise.
+//! Tried and not kept: reading each axis's entry and exit planes through
+//! rows chosen once per ray instead of a branch per axis and node: 1 to 5%
+//! fewer instructions (callgrind), but no faster (kitchen shadow rays 2%
+//! slower, interleaved runs): the row is one more load before the node's.
 
 use glam::Vec4;
 
@@ -150,10 +150,8 @@ struct Slabs {
     entry_origin: [Vec4; 3],
     exit_origin: [Vec4; 3],
     inv_dir: [Vec4; 3],
-    /// Per axis, the row of [`BvhNode::bounds`] the ray enters through (the
-    /// max face's when it goes towards −) and the row it leaves through.
-    entry_row: [usize; 3],
-    exit_row: [usize; 3],
+    /// Per axis: the ray enters through the box's max face.
+    negative: [bool; 3],
     t_min: Vec4,
 }
 
@@ -164,8 +162,7 @@ impl Slabs {
             entry_origin: [Vec4::ZERO; 3],
             exit_origin: [Vec4::ZERO; 3],
             inv_dir: [Vec4::ZERO; 3],
-            entry_row: [0, 1, 2],
-            exit_row: [3, 4, 5],
+            negative: [false; 3],
             t_min: Vec4::splat(round_down(ray.t_min)),
         };
         for axis in 0..3 {
@@ -182,9 +179,7 @@ impl Slabs {
             slabs.entry_origin[axis] = Vec4::splat(entry);
             slabs.exit_origin[axis] = Vec4::splat(exit);
             slabs.inv_dir[axis] = Vec4::splat(inv);
-            if negative && inv < 0.0 {
-                (slabs.entry_row[axis], slabs.exit_row[axis]) = (axis + 3, axis);
-            }
+            slabs.negative[axis] = negative && inv < 0.0;
         }
         slabs
     }
@@ -197,8 +192,15 @@ impl Slabs {
         let mut near = self.t_min;
         let mut far = t_max;
         for axis in 0..3 {
-            let enter = Vec4::from_array(node.bounds[self.entry_row[axis]]);
-            let exit = Vec4::from_array(node.bounds[self.exit_row[axis]]);
+            let (min, max) = (
+                Vec4::from_array(node.bounds[axis]),
+                Vec4::from_array(node.bounds[axis + 3]),
+            );
+            let (enter, exit) = if self.negative[axis] {
+                (max, min)
+            } else {
+                (min, max)
+            };
             let t_enter = (enter - self.entry_origin[axis]) * self.inv_dir[axis];
             let t_exit = (exit - self.exit_origin[axis]) * self.inv_dir[axis];
             near = max_keeping(t_enter, near);
