@@ -98,7 +98,8 @@ impl Triangle {
 /// that turns the ray into the +z axis from the origin.
 #[derive(Clone, Copy, Debug)]
 pub struct RayShear {
-    axes: [usize; 3],
+    /// The axis that becomes z (the next two, cyclically, become x and y).
+    kz: usize,
     shear: Vec3,
 }
 
@@ -110,18 +111,22 @@ impl RayShear {
         let ky = (kx + 1) % 3;
         let d = Vec3::new(ray.dir[kx], ray.dir[ky], ray.dir[kz]);
         Self {
-            axes: [kx, ky, kz],
+            kz,
             shear: Vec3::new(-d.x / d.z, -d.y / d.z, 1.0 / d.z),
         }
     }
 
-    /// A point in the ray's sheared space (z not yet scaled).
-    #[inline]
-    fn apply(&self, p: Vec3, origin: Vec3) -> Vec3 {
+    /// A point in the ray's sheared space (z not yet scaled), the axes
+    /// permuted by `KX`, `KY`, `KZ`.
+    #[inline(always)]
+    fn apply<const KX: usize, const KY: usize, const KZ: usize>(
+        &self,
+        p: Vec3,
+        origin: Vec3,
+    ) -> Vec3 {
         let q = p - origin;
-        let [kx, ky, kz] = self.axes;
-        let z = q[kz];
-        Vec3::new(q[kx] + self.shear.x * z, q[ky] + self.shear.y * z, z)
+        let z = q[KZ];
+        Vec3::new(q[KX] + self.shear.x * z, q[KY] + self.shear.y * z, z)
     }
 }
 
@@ -132,10 +137,30 @@ impl RayShear {
 /// never hit.
 #[inline]
 pub fn watertight(p0: Vec3, p1: Vec3, p2: Vec3, ray: &Ray, shear: &RayShear) -> Option<ShapeHit> {
+    // One copy per permutation, so the axes are constants: indexing the
+    // vertices by a run-time axis made the bunny's shadow and diffuse rays
+    // take 15% more instructions (callgrind).
+    match shear.kz {
+        0 => watertight_permuted::<1, 2, 0>(p0, p1, p2, ray, shear),
+        1 => watertight_permuted::<2, 0, 1>(p0, p1, p2, ray, shear),
+        _ => watertight_permuted::<0, 1, 2>(p0, p1, p2, ray, shear),
+    }
+}
+
+/// [`watertight`] with the shear's axis permutation given as `KX`, `KY`,
+/// `KZ`.
+#[inline(always)]
+fn watertight_permuted<const KX: usize, const KY: usize, const KZ: usize>(
+    p0: Vec3,
+    p1: Vec3,
+    p2: Vec3,
+    ray: &Ray,
+    shear: &RayShear,
+) -> Option<ShapeHit> {
     let (mut a, mut b, mut c) = (
-        shear.apply(p0, ray.origin),
-        shear.apply(p1, ray.origin),
-        shear.apply(p2, ray.origin),
+        shear.apply::<KX, KY, KZ>(p0, ray.origin),
+        shear.apply::<KX, KY, KZ>(p1, ray.origin),
+        shear.apply::<KX, KY, KZ>(p2, ray.origin),
     );
     let shear = shear.shear;
 
@@ -210,6 +235,28 @@ mod tests {
         let s = unit().surface(&ray, &hit);
         assert_eq!(s.normal, Vec3::Z);
         assert_eq!(s.point, Vec3::new(0.25, 0.5, 0.0));
+    }
+
+    #[test]
+    fn rays_along_each_axis_hit_with_the_same_t_and_barycentrics() {
+        // The unit triangle with its coordinates rotated so each axis in
+        // turn is the normal (and the ray's largest component).
+        let turn = |v: Vec3, k: usize| match k {
+            0 => Vec3::new(v.z, v.x, v.y),
+            1 => Vec3::new(v.y, v.z, v.x),
+            _ => v,
+        };
+        for k in 0..3 {
+            let triangle =
+                Triangle::new(turn(Vec3::ZERO, k), turn(Vec3::X, k), turn(Vec3::Y, k)).unwrap();
+            let dir = turn(Vec3::new(0.01, -0.02, -4.0), k);
+            let ray = Ray::new(turn(Vec3::new(0.25, 0.5, 2.0), k), dir);
+            let hit = triangle.intersect(&ray).unwrap();
+            assert_eq!(hit.t, 0.5, "axis {k}");
+            assert!((hit.u - 0.255).abs() < 1e-15 && (hit.v - 0.49).abs() < 1e-15);
+            let miss = Ray::new(turn(Vec3::new(0.6, 0.5, 2.0), k), dir);
+            assert_eq!(triangle.intersect(&miss), None, "axis {k}");
+        }
     }
 
     #[test]
