@@ -84,8 +84,8 @@ pub struct Geometry<'a> {
     accel: Accelerator,
     bounds: Aabb,
     bounded: Vec<u32>,
-    /// The corners of each untransformed mesh triangle (`None` for other
-    /// primitives), in the order the structure's queries name them: per
+    /// The corners of each untransformed triangle, of a mesh or a triangle
+    /// shape (`None` for other primitives), in the order the structure's queries name them: per
     /// structure slot, or for a BVH per entry of its index array, so that a
     /// leaf's triangles lie together. The hot case reaches its vertices
     /// without going through `refs`, the instance and the mesh's index
@@ -94,12 +94,15 @@ pub struct Geometry<'a> {
     /// measurable change on the bunny (10.5/3.4/2.65 Mrays/s either way),
     /// a slower build.
     corners: Vec<Option<[Vec3; 3]>>,
+    /// Whether some entry of `corners` is a triangle, so queries compute
+    /// the ray's shear up front.
+    has_triangles: bool,
     unbounded: Vec<u32>,
 }
 
 /// A world-space ray with what the triangle test needs of it, computed once
-/// per query when the scene has mesh triangles (a scene of analytic shapes
-/// does not pay for it).
+/// per query when the scene has untransformed triangles (a scene of other
+/// shapes does not pay for it).
 struct Query<'r> {
     ray: &'r Ray,
     shear: Option<RayShear>,
@@ -141,7 +144,12 @@ impl<'a> Geometry<'a> {
             if local.is_finite() {
                 boxes.push(to_world(p.transform, local));
                 bounded.push(refs.len() as u32);
-                slot_triangles.push(None);
+                // An untransformed triangle shape takes the mesh triangles'
+                // path: the same watertight test on the same corners.
+                slot_triangles.push(match (&p.shape, p.transform) {
+                    (Shape::Triangle(t), None) => Some(t.vertices()),
+                    _ => None,
+                });
             } else {
                 unbounded.push(refs.len() as u32);
             }
@@ -178,25 +186,12 @@ impl<'a> Geometry<'a> {
         // Perfect splits for the kd-tree: an untransformed triangle's
         // bounds in a cell are those of its part inside the cell; other
         // primitives keep their box ∩ the cell.
-        let triangle_of = |slot: u32| match slot_triangles[slot as usize] {
-            Some(c) => Some(c),
-            None => match refs[bounded[slot as usize] as usize] {
-                PrimitiveRef::Shape(i) => match &scene.primitives[i as usize] {
-                    Primitive {
-                        shape: Shape::Triangle(t),
-                        transform: None,
-                        ..
-                    } => Some(t.vertices()),
-                    _ => None,
-                },
-                PrimitiveRef::Triangle { .. } => None,
-            },
-        };
-        let clip = |slot: u32, cell: &Aabb| match triangle_of(slot) {
+        let clip = |slot: u32, cell: &Aabb| match slot_triangles[slot as usize] {
             Some(c) => clipped_triangle_bounds(c, cell),
             None => boxes[slot as usize].intersection(cell),
         };
         let accel = Accelerator::build_clipped(kind, &boxes, &clip);
+        let has_triangles = slot_triangles.iter().any(Option::is_some);
         let corners = match &accel {
             Accelerator::Bvh(bvh) => bvh
                 .indices()
@@ -215,6 +210,7 @@ impl<'a> Geometry<'a> {
             bounds,
             bounded,
             corners,
+            has_triangles,
             unbounded,
         }
     }
@@ -228,7 +224,7 @@ impl<'a> Geometry<'a> {
     fn query<'r>(&self, ray: &'r Ray) -> Query<'r> {
         Query {
             ray,
-            shear: (!self.instances.is_empty()).then(|| RayShear::new(ray)),
+            shear: self.has_triangles.then(|| RayShear::new(ray)),
         }
     }
 
