@@ -9,7 +9,9 @@
 //!
 //! The opacity `α` dissolves the surface: its own light and mirror
 //! reflection are weighted by `α`, and what is behind shows through by
-//! `1 - α`, on the refracted ray (straight on, with `ior` 1). An opaque
+//! `1 - α`, on the refracted ray: straight on only when `ior` is 1, bent
+//! (or moved onto the mirror ray by total internal reflection) by a glass's
+//! index otherwise. An opaque
 //! surface (`α` = 1, the default) is the plain Whitted model; a clear one
 //! (`α` = 0) is invisible. A shadow ray crossing the surface keeps
 //! `α kt + 1 - α` of the light.
