@@ -4,48 +4,20 @@
 
 use std::sync::Arc;
 
-use whitted::camera::Camera;
-use whitted::image::Film;
 use whitted::light::{Attenuation, Light};
 use whitted::material::Material;
 use whitted::math::{Color, DVec2, Transform, Vec3};
-use whitted::render::{RenderOptions, render};
 use whitted::scene::Scene;
 use whitted::shape::{Parallelogram, Plane, Shape, Sphere};
 use whitted::texture::{DissolveMap, ImageData, ImageTexture, Texture, Wrap};
 
-fn black() -> Material {
-    Material {
-        ambient: Texture::default(),
-        diffuse: Texture::default(),
-        ..Material::default()
-    }
-}
-
-/// A camera at z = 5 looking down -z at the origin, 16x16.
-fn scene_looking_down_z() -> Scene {
-    let camera = Camera::new(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 60.0).unwrap();
-    let mut scene = Scene::new(camera);
-    scene.settings.width = 16;
-    scene.settings.height = 16;
-    scene
-}
-
-fn rendered(scene: &Scene) -> Film {
-    render(scene, &RenderOptions::default(), &|_| {})
-        .unwrap()
-        .image
-}
-
-fn pixel(film: &Film, x: u32, y: u32) -> Color {
-    let p = film.pixel(x, y);
-    Color::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
-}
+mod common;
+use common::{black, pixel, rendered, scene_looking_down_z};
 
 /// A white floor at z = 0 lit by a point light off the axis, with a
 /// sphere of `material` between them and the camera.
 fn floor_and_sphere(material: Option<Material>) -> Scene {
-    let mut scene = scene_looking_down_z();
+    let mut scene = scene_looking_down_z(16, 16, 60.0);
     scene.ambient = Color::splat(0.1);
     let floor = scene.add_material(Material {
         diffuse: Color::ONE.into(),
@@ -132,7 +104,7 @@ fn an_opaque_dissolve_map_changes_nothing() {
 
 #[test]
 fn half_opacity_shows_half_the_surface_and_half_what_is_behind() {
-    let mut scene = scene_looking_down_z();
+    let mut scene = scene_looking_down_z(16, 16, 60.0);
     let back = scene.add_material(Material {
         emission: Color::new(0.0, 0.2, 1.0).into(),
         ..black()
@@ -167,7 +139,7 @@ fn half_opacity_shows_half_the_surface_and_half_what_is_behind() {
 
 #[test]
 fn light_passes_a_cut_out_where_its_dissolve_map_is_clear() {
-    let mut scene = scene_looking_down_z();
+    let mut scene = scene_looking_down_z(16, 16, 60.0);
     let floor = scene.add_material(Material {
         diffuse: Color::ONE.into(),
         ..black()

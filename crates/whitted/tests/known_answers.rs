@@ -1,41 +1,14 @@
 //! Renders of analytic scenes whose correct pixel values are known exactly.
 
-use whitted::camera::Camera;
-use whitted::image::Film;
 use whitted::light::{Attenuation, Light};
 use whitted::material::Material;
 use whitted::math::{Color, Transform, Vec3};
 use whitted::render::{RenderOptions, render};
 use whitted::scene::Scene;
 use whitted::shape::{Plane, Shape, Sphere};
-use whitted::texture::Texture;
 
-fn black() -> Material {
-    Material {
-        ambient: Texture::default(),
-        diffuse: Texture::default(),
-        ..Material::default()
-    }
-}
-
-fn scene_looking_down_z(width: u32, height: u32, fov: f64) -> Scene {
-    let camera = Camera::new(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, fov).unwrap();
-    let mut scene = Scene::new(camera);
-    scene.settings.width = width;
-    scene.settings.height = height;
-    scene
-}
-
-fn rendered(scene: &Scene) -> Film {
-    render(scene, &RenderOptions::default(), &|_| {})
-        .unwrap()
-        .image
-}
-
-fn pixel(film: &Film, x: u32, y: u32) -> Color {
-    let p = film.pixel(x, y);
-    Color::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
-}
+mod common;
+use common::{black, pixel, rendered, scene_looking_down_z};
 
 fn assert_close(actual: Color, expected: Color, tolerance: f64) {
     assert!(

@@ -1,0 +1,41 @@
+//! Helpers shared by the known-answer render tests.
+
+use whitted::camera::Camera;
+use whitted::image::Film;
+use whitted::material::Material;
+use whitted::math::{Color, Vec3};
+use whitted::render::{RenderOptions, render};
+use whitted::scene::Scene;
+use whitted::texture::Texture;
+
+/// A material with no ambient and no diffuse colour.
+pub fn black() -> Material {
+    Material {
+        ambient: Texture::default(),
+        diffuse: Texture::default(),
+        ..Material::default()
+    }
+}
+
+/// A scene of `width` x `height` pixels seen from z = 5 down -z at the
+/// origin, with a vertical field of view of `fov` degrees.
+pub fn scene_looking_down_z(width: u32, height: u32, fov: f64) -> Scene {
+    let camera = Camera::new(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, fov).unwrap();
+    let mut scene = Scene::new(camera);
+    scene.settings.width = width;
+    scene.settings.height = height;
+    scene
+}
+
+/// The scene's picture.
+pub fn rendered(scene: &Scene) -> Film {
+    render(scene, &RenderOptions::default(), &|_| {})
+        .unwrap()
+        .image
+}
+
+/// Pixel (x, y) of `film` as a colour.
+pub fn pixel(film: &Film, x: u32, y: u32) -> Color {
+    let p = film.pixel(x, y);
+    Color::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
+}
