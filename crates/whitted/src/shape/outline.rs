@@ -77,7 +77,13 @@ impl Bands {
         let height = top - bottom;
         // The mean number of edges a horizontal line meets: a band list
         // holds about that many edges per band.
-        let crossings: f64 = (0..count).map(|i| edge(i).1 - edge(i).0).sum::<f64>() / height;
+        let crossings: f64 = (0..count)
+            .map(|i| {
+                let (low, high) = edge(i);
+                high - low
+            })
+            .sum::<f64>()
+            / height;
         let band_count = if height > 0.0 && height.is_finite() && crossings.is_finite() {
             (ENTRIES_PER_EDGE as f64 * count as f64 / crossings.max(1.0)).clamp(1.0, count as f64)
                 as usize

@@ -47,7 +47,9 @@ pub struct Sphere {
 /// NaN never culls.
 #[inline]
 fn beyond(a: f64, b: f64, c: f64, disc: f64, t_min: f64, t_max: f64) -> bool {
-    let t = t_max * (1.0 + f64::powi(2.0, -40));
+    /// `1 + 2⁻⁴⁰`, the factor from `t_max` to `t′`.
+    const MARGIN: f64 = 1.0 + 1.0 / (1u64 << 40) as f64;
+    let t = t_max * MARGIN;
     let root_beyond = |left: f64, error: f64| {
         let left = left - gamma(4) * error;
         left > 0.0 && left * left >= t * t * disc * (1.0 + gamma(4))
