@@ -8,7 +8,7 @@
 //! `2n - 2` slots for its descendants (a binary tree with `n` non-empty
 //! leaves never needs more), so the two halves of a split write to
 //! disjoint slices and the result is the same whatever the number of
-//! threads. The binary tree is then collapsed into four-wide nodes
+//! threads. The binary tree is then collapsed into eight-wide nodes
 //! (`collapse`).
 
 use super::MAX_DEPTH;

@@ -1,13 +1,13 @@
-//! Collapsing the binary tree into four-wide nodes.
+//! Collapsing the binary tree into wide nodes of [`WIDTH`] children.
 //!
 //! Each wide node starts from a binary node's two children and, while it has
-//! fewer than four, replaces the interior child of largest surface area by
+//! fewer than [`WIDTH`], replaces the interior child of largest surface area by
 //! its two children (the child most rays enter, so removing it saves the
 //! most steps). Leaves stay in their parent's slots; the wide tree is never
 //! deeper than the binary one. Nodes are numbered depth first, each one when
 //! its parent is filled, so a subtree's nodes lie close together.
 
-use super::node::{BinaryNode, BvhNode};
+use super::node::{BinaryNode, BvhNode, WIDTH};
 
 /// The wide nodes, root first, and the deepest leaf's depth (the leaves in
 /// the root's slots are at depth 0). `scratch` holds the binary tree, root
@@ -24,13 +24,13 @@ pub(super) fn collapse(scratch: &[BinaryNode]) -> (Vec<BvhNode>, usize) {
     while let Some((wide, binary, depth)) = todo.pop() {
         max_depth = max_depth.max(depth);
         let node = &scratch[binary];
-        let mut slots = [binary; 4];
+        let mut slots = [binary; WIDTH];
         let mut used = 1;
         if !node.is_leaf() {
             let first = node.first as usize;
             slots[..2].copy_from_slice(&[first, first + 1]);
             used = 2;
-            while used < 4 {
+            while used < WIDTH {
                 let widest =
                     (0..used)
                         .filter(|&i| !scratch[slots[i]].is_leaf())

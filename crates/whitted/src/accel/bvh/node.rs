@@ -1,4 +1,4 @@
-//! The nodes: the 128-byte four-wide node the queries walk, the 32-byte
+//! The nodes: the 256-byte eight-wide node the queries walk, the 32-byte
 //! binary node the build works in, and the outward rounding of their `f32`
 //! boxes.
 //!
@@ -7,8 +7,11 @@
 
 use crate::math::{Aabb, Vec3};
 
-/// One node of a [`super::Bvh`]: up to four children, their boxes stored
-/// axis by axis so one SIMD slab test covers all four.
+/// Children per node of a [`super::Bvh`].
+pub const WIDTH: usize = 8;
+
+/// One node of a [`super::Bvh`]: up to [`WIDTH`] children, their boxes
+/// stored axis by axis so one SIMD slab test covers all of them.
 ///
 /// Child slot `i` is a leaf when `counts[i] > 0` (the primitives listed at
 /// `children[i]..children[i] + counts[i]` of the BVH's index array), an
@@ -20,23 +23,23 @@ use crate::math::{Aabb, Vec3};
 pub struct BvhNode {
     /// `[min_x, min_y, min_z, max_x, max_y, max_z]`, each per child slot;
     /// minima rounded down, maxima up.
-    pub bounds: [[f32; 4]; 6],
+    pub bounds: [[f32; WIDTH]; 6],
     /// Interior: the child node's index. Leaf: its first index-array entry.
-    pub children: [u32; 4],
+    pub children: [u32; WIDTH],
     /// Primitives of a leaf slot; 0 for an interior or unused slot.
-    pub counts: [u32; 4],
+    pub counts: [u32; WIDTH],
 }
 
-const _: () = assert!(size_of::<BvhNode>() == 128);
+const _: () = assert!(size_of::<BvhNode>() == 256);
 
 impl Default for BvhNode {
-    /// Four unused slots.
+    /// Unused slots only.
     fn default() -> Self {
-        let (min, max) = ([f32::INFINITY; 4], [f32::NEG_INFINITY; 4]);
+        let (min, max) = ([f32::INFINITY; WIDTH], [f32::NEG_INFINITY; WIDTH]);
         Self {
             bounds: [min, min, min, max, max, max],
-            children: [u32::MAX; 4],
-            counts: [0; 4],
+            children: [u32::MAX; WIDTH],
+            counts: [0; WIDTH],
         }
     }
 }
@@ -130,8 +133,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_node_is_128_bytes_on_a_cache_line_boundary() {
-        assert_eq!(size_of::<BvhNode>(), 128);
+    fn a_node_is_256_bytes_on_a_cache_line_boundary() {
+        assert_eq!(size_of::<BvhNode>(), 256);
         assert_eq!(align_of::<BvhNode>(), 64);
     }
 

@@ -1,6 +1,8 @@
-//! Ray queries: an iterative walk over the four-wide nodes with a fixed
-//! stack, testing a node's four child boxes at once in `f32` SIMD; the
-//! closest-hit query visits the children the ray meets nearest first.
+//! Ray queries: an iterative walk over the eight-wide nodes with a fixed
+//! stack, testing a node's child boxes at once in `f32` SIMD (`slabs`: one
+//! AVX register where the processor has AVX, checked at run time, two SSE
+//! halves otherwise); the closest-hit query visits the children the ray
+//! meets nearest first.
 //!
 //! # Why the `f32` test never culls a box the `f64` ray meets
 //!
@@ -80,63 +82,47 @@
 //! The any-hit walk goes on to the last child it meets and pushes only the
 //! others, in the order it visited them before (3% and 6% fewer
 //! instructions on the bunny's and the kitchen's shadow rays, the same
-//! nodes visited). Tried and not kept: reading each axis's entry and exit planes through
-//! rows chosen once per ray instead of a branch per axis and node: 1 to 5%
-//! fewer instructions (callgrind), but no faster (kitchen shadow rays 2%
-//! slower, interleaved runs): the row is one more load before the node's.
+//! nodes visited). With four-wide nodes, reading each axis's entry and
+//! exit planes through rows chosen once per ray instead of a branch per
+//! axis and node took 1 to 5% fewer instructions (callgrind) but was no
+//! faster; the eight-wide walk below reads them so.
+//!
+//! Eight children a node, tested in one AVX register, with the stack left
+//! uncleared: on the bunny's rays (1 thread, interleaved runs, best of
+//! two) primary/shadow/diffuse rays went from 12.3/4.3/3.0 to 13.4/4.9/3.5
+//! Mrays/s, nodes visited per ray from 4.2/14.7/14.0 to 3.1/10.3/10.0, and
+//! the shadow rays' instructions fell 13% (callgrind). The same tree
+//! walked with two SSE halves (processors without AVX) ran at
+//! 9.0/4.1/2.9: eight-wide nodes pay only with eight-wide registers. Built
+//! the first time with the slab test written lane by lane for the compiler
+//! to vectorise, it was slower than the four-wide walk (10.2/3.7/2.7): the
+//! compiler mixed scalar and vector code; and the ray setup's `array::map`
+//! closures, compiled without AVX, were calls (6% of the instructions)
+//! until written out.
 
-use glam::Vec4;
+use std::mem::MaybeUninit;
 
-use super::node::{BvhNode, round_down, round_up};
+use super::node::{BvhNode, WIDTH, round_up};
+use super::slabs::{Halves, Planes, SlabTest};
+#[cfg(target_arch = "x86_64")]
+use super::slabs_avx::Avx;
 use super::{Bvh, MAX_DEPTH};
 use crate::accel::TraversalCounters;
 use crate::math::Ray;
 
 /// Entries the stack needs for a tree whose leaves lie at most `depth` deep:
-/// a node at depth `d` finds at most `3d` entries pending and pushes its
-/// (at most four) children before it pops the nearest.
+/// a node at depth `d` finds at most `(WIDTH − 1)·d` entries pending and
+/// pushes its (at most [`WIDTH`]) children before it pops the nearest.
 const fn stack_size(depth: usize) -> usize {
-    3 * depth + 4
+    (WIDTH - 1) * depth + WIDTH
 }
 
-/// Trees at most this deep use a short stack: initialising the one for
-/// [`MAX_DEPTH`] took 8% of the time on the bunny.
-const SHALLOW: usize = 15;
+/// Trees at most this deep use a short stack.
+const SHALLOW: usize = 12;
 
-/// Trees deeper than [`SHALLOW`] but at most this deep (the kitchen's is
-/// 16) use a middle-sized stack, half the one for [`MAX_DEPTH`].
-const MIDDLE: usize = 31;
-
-/// `1 − 8u` and `1 + 8u` with `u = 2⁻²⁴`: the widening factors (see the
-/// module documentation), exact in `f32`.
-const SHRINK: f32 = 1.0 - 1.0 / (1 << 21) as f32;
-const GROW: f32 = 1.0 + 1.0 / (1 << 21) as f32;
-
-/// The inverse direction of an axis that must not cull (see the module
-/// documentation).
-const NEVER_CULLS: f32 = (1u128 << 100) as f32;
-
-/// `a > b ? a : b` per lane: `b` when `a` is NaN. On x86-64 glam's `max`
-/// is `maxps`, which is exactly that (and its scalar fallback returns the
-/// number too); a `select` written out was not turned into `maxps`.
-#[inline(always)]
-fn max_keeping(a: Vec4, b: Vec4) -> Vec4 {
-    if cfg!(target_arch = "x86_64") {
-        a.max(b)
-    } else {
-        Vec4::select(a.cmpgt(b), a, b)
-    }
-}
-
-/// `a < b ? a : b` per lane: `b` when `a` is NaN (`minps` on x86-64).
-#[inline(always)]
-fn min_keeping(a: Vec4, b: Vec4) -> Vec4 {
-    if cfg!(target_arch = "x86_64") {
-        a.min(b)
-    } else {
-        Vec4::select(a.cmplt(b), a, b)
-    }
-}
+/// Trees deeper than [`SHALLOW`] but at most this deep use a middle-sized
+/// stack, under half the one for [`MAX_DEPTH`].
+const MIDDLE: usize = 24;
 
 /// A child to visit: a node (`count == 0`) or a leaf, and a lower bound on
 /// the parameter where the ray enters its box.
@@ -147,78 +133,10 @@ struct Entry {
     t: f32,
 }
 
-/// What the slab test needs of a ray, computed once per ray.
-struct Slabs {
-    /// Per axis, the origin rounded for the entry and for the exit.
-    entry_origin: [Vec4; 3],
-    exit_origin: [Vec4; 3],
-    inv_dir: [Vec4; 3],
-    /// Per axis: the ray enters through the box's max face.
-    negative: [bool; 3],
-    t_min: Vec4,
-}
-
-impl Slabs {
-    #[inline(always)]
-    fn new(ray: &Ray) -> Self {
-        let mut slabs = Self {
-            entry_origin: [Vec4::ZERO; 3],
-            exit_origin: [Vec4::ZERO; 3],
-            inv_dir: [Vec4::ZERO; 3],
-            negative: [false; 3],
-            t_min: Vec4::splat(round_down(ray.t_min)),
-        };
-        for axis in 0..3 {
-            let (o, i) = (ray.origin[axis], ray.inv_dir[axis]);
-            let (down, up, negative) = (round_down(o), round_up(o), i.is_sign_negative());
-            let (entry, exit, inv) = if i.is_finite() && i.abs() > f64::from(f32::MAX) {
-                // Beyond `f32`: an axis that culls only the empty box.
-                (f32::MAX, -f32::MAX, NEVER_CULLS)
-            } else if negative {
-                (down, up, i as f32)
-            } else {
-                (up, down, i as f32)
-            };
-            slabs.entry_origin[axis] = Vec4::splat(entry);
-            slabs.exit_origin[axis] = Vec4::splat(exit);
-            slabs.inv_dir[axis] = Vec4::splat(inv);
-            slabs.negative[axis] = negative && inv < 0.0;
-        }
-        slabs
-    }
-
-    /// Which of the node's children the ray may meet within
-    /// `(t_min, t_max]` (bit `i` for slot `i`), and lower bounds on where it
-    /// enters them.
-    #[inline(always)]
-    fn test(&self, node: &BvhNode, t_max: Vec4) -> (u32, [f32; 4]) {
-        let mut near = self.t_min;
-        let mut far = t_max;
-        for axis in 0..3 {
-            let (min, max) = (
-                Vec4::from_array(node.bounds[axis]),
-                Vec4::from_array(node.bounds[axis + 3]),
-            );
-            let (enter, exit) = if self.negative[axis] {
-                (max, min)
-            } else {
-                (min, max)
-            };
-            let t_enter = (enter - self.entry_origin[axis]) * self.inv_dir[axis];
-            let t_exit = (exit - self.exit_origin[axis]) * self.inv_dir[axis];
-            near = max_keeping(t_enter, near);
-            far = min_keeping(t_exit, far);
-        }
-        let near = (near * SHRINK).min(near * GROW);
-        let far = (far * SHRINK).max(far * GROW);
-        (near.cmple(far).bitmask(), near.to_array())
-    }
-}
-
-/// Slot `slot` (at most 3) of `node` as a child to visit.
+/// Slot `slot` (below [`WIDTH`]) of `node` as a child to visit.
 #[inline(always)]
-fn child_entry(node: &BvhNode, slot: usize, near: &[f32; 4]) -> Entry {
-    let slot = slot & 3;
+fn child_entry(node: &BvhNode, slot: usize, near: &[f32; WIDTH]) -> Entry {
+    let slot = slot % WIDTH;
     Entry {
         child: node.children[slot],
         count: node.counts[slot],
@@ -226,37 +144,58 @@ fn child_entry(node: &BvhNode, slot: usize, near: &[f32; 4]) -> Entry {
     }
 }
 
-/// Pushes the children in `mask` on `stack` at `depth`, farthest first;
-/// returns how many. Sorting them in place on the stack: building them in a
-/// separate array and copying it over stalled on store forwarding (16% of
-/// the walk's samples on the bunny).
-#[inline(always)]
-fn push_hits(
-    node: &BvhNode,
-    mask: u32,
-    near: &[f32; 4],
-    stack: &mut [Entry],
-    depth: usize,
-) -> usize {
-    let mut n = 0;
-    let mut bits = mask;
-    while bits != 0 {
-        let slot = bits.trailing_zeros() as usize;
-        bits &= bits - 1;
-        let entry = Entry {
-            child: node.children[slot],
-            count: node.counts[slot],
-            t: near[slot],
-        };
-        let mut j = depth + n;
-        while j > depth && stack[j - 1].t < entry.t {
-            stack[j] = stack[j - 1];
-            j -= 1;
+/// A traversal stack of `N` entries, its slots written before they are
+/// read: clearing it for every ray took 4% of the instructions on the
+/// bunny's rays.
+struct Stack<const N: usize> {
+    entries: [MaybeUninit<Entry>; N],
+    len: usize,
+}
+
+impl<const N: usize> Stack<N> {
+    #[inline(always)]
+    fn new() -> Self {
+        Self {
+            entries: [const { MaybeUninit::uninit() }; N],
+            len: 0,
         }
-        stack[j] = entry;
-        n += 1;
     }
-    n
+
+    #[inline(always)]
+    fn push(&mut self, entry: Entry) {
+        self.entries[self.len].write(entry);
+        self.len += 1;
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<Entry> {
+        self.len = self.len.checked_sub(1)?;
+        // SAFETY: slots below `len` have been written (by `push` or
+        // `push_sorted`), and entries are `Copy`.
+        Some(unsafe { self.entries[self.len].assume_init() })
+    }
+
+    /// Pushes the children in `mask` so that the nearest ends on top;
+    /// sorting them in place: building them in a separate array and
+    /// copying it over stalled on store forwarding (16% of the walk's
+    /// samples on the bunny).
+    #[inline(always)]
+    fn push_sorted(&mut self, node: &BvhNode, mask: u32, near: &[f32; WIDTH]) {
+        let base = self.len;
+        let mut bits = mask;
+        while bits != 0 {
+            let entry = child_entry(node, bits.trailing_zeros() as usize, near);
+            bits &= bits - 1;
+            let mut j = self.len;
+            // SAFETY: `base <= j - 1 < len`, written above in this call.
+            while j > base && unsafe { self.entries[j - 1].assume_init() }.t < entry.t {
+                self.entries[j] = self.entries[j - 1];
+                j -= 1;
+            }
+            self.entries[j].write(entry);
+            self.len += 1;
+        }
+    }
 }
 
 impl Bvh {
@@ -286,29 +225,57 @@ impl Bvh {
         if self.nodes.is_empty() {
             None
         } else if self.max_depth <= SHALLOW {
-            self.closest::<{ stack_size(SHALLOW) }>(ray, counters, hit)
+            self.closest_on_this_cpu::<{ stack_size(SHALLOW) }>(ray, counters, hit)
         } else if self.max_depth <= MIDDLE {
-            self.closest::<{ stack_size(MIDDLE) }>(ray, counters, hit)
+            self.closest_on_this_cpu::<{ stack_size(MIDDLE) }>(ray, counters, hit)
         } else {
-            self.closest::<{ stack_size(MAX_DEPTH) }>(ray, counters, hit)
+            self.closest_on_this_cpu::<{ stack_size(MAX_DEPTH) }>(ray, counters, hit)
         }
     }
 
-    /// [`Self::intersect_in_leaf_order`] with a stack of `N` entries.
+    /// [`Self::closest`] with the widest slab test this processor has.
     #[inline(always)]
-    fn closest<const N: usize>(
+    fn closest_on_this_cpu<const N: usize>(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        hit: impl FnMut(u32, f64) -> Option<f64>,
+    ) -> Option<f64> {
+        #[cfg(target_arch = "x86_64")]
+        if is_x86_feature_detected!("avx") {
+            // SAFETY: the processor has AVX.
+            return unsafe { self.closest_avx::<N>(ray, counters, hit) };
+        }
+        self.closest::<N, Halves>(ray, counters, hit)
+    }
+
+    /// [`Self::closest`] with AVX, compiled for it.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn closest_avx<const N: usize>(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        hit: impl FnMut(u32, f64) -> Option<f64>,
+    ) -> Option<f64> {
+        self.closest::<N, Avx>(ray, counters, hit)
+    }
+
+    /// [`Self::intersect_in_leaf_order`] with a stack of `N` entries and
+    /// the slab test `S`.
+    #[inline(always)]
+    fn closest<const N: usize, S: SlabTest>(
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
         mut hit: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<f64> {
-        let slabs = Slabs::new(ray);
+        let slabs = S::new(&Planes::new(ray));
         let mut closest = ray.t_max;
-        let mut far = Vec4::splat(round_up(closest));
+        let mut far = round_up(closest);
         let mut found = None;
         let mut work = TraversalCounters::default();
-        let mut stack = [Entry::default(); N];
-        let mut depth = 0;
+        let mut stack = Stack::<N>::new();
         let mut current = Entry::default();
         loop {
             work.nodes += 1;
@@ -321,7 +288,7 @@ impl Bvh {
                         found = Some(t);
                     }
                 }
-                far = Vec4::splat(round_up(closest));
+                far = round_up(closest);
             } else if let Some(node) = self.nodes.get(first) {
                 let (mask, near) = slabs.test(node, far);
                 if mask & (mask.wrapping_sub(1)) == 0 && mask != 0 {
@@ -335,28 +302,26 @@ impl Bvh {
                     let a = child_entry(node, mask.trailing_zeros() as usize, &near);
                     let b = child_entry(node, rest.trailing_zeros() as usize, &near);
                     let (nearer, farther) = if b.t < a.t { (b, a) } else { (a, b) };
-                    stack[depth] = farther;
-                    depth += 1;
+                    stack.push(farther);
                     current = nearer;
                     continue;
                 }
                 if mask != 0 {
                     // All but the nearest stay on the stack.
-                    depth += push_hits(node, mask, &near, &mut stack, depth) - 1;
-                    current = stack[depth];
+                    stack.push_sorted(node, mask, &near);
+                    current = stack.pop().unwrap_or_default();
                     continue;
                 }
             }
             // Resume with the nearest pending child the closest hit has not
             // yet put out of reach.
             loop {
-                if depth == 0 {
+                let Some(next) = stack.pop() else {
                     *counters += work;
                     return found;
-                }
-                depth -= 1;
-                current = stack[depth];
-                if f64::from(current.t) <= closest {
+                };
+                if f64::from(next.t) <= closest {
+                    current = next;
                     break;
                 }
             }
@@ -389,27 +354,55 @@ impl Bvh {
         if self.nodes.is_empty() {
             false
         } else if self.max_depth <= SHALLOW {
-            self.any::<{ stack_size(SHALLOW) }>(ray, counters, occludes)
+            self.any_on_this_cpu::<{ stack_size(SHALLOW) }>(ray, counters, occludes)
         } else if self.max_depth <= MIDDLE {
-            self.any::<{ stack_size(MIDDLE) }>(ray, counters, occludes)
+            self.any_on_this_cpu::<{ stack_size(MIDDLE) }>(ray, counters, occludes)
         } else {
-            self.any::<{ stack_size(MAX_DEPTH) }>(ray, counters, occludes)
+            self.any_on_this_cpu::<{ stack_size(MAX_DEPTH) }>(ray, counters, occludes)
         }
     }
 
-    /// [`Self::occluded_in_leaf_order`] with a stack of `N` entries.
+    /// [`Self::any`] with the widest slab test this processor has.
     #[inline(always)]
-    fn any<const N: usize>(
+    fn any_on_this_cpu<const N: usize>(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        occludes: impl FnMut(u32) -> bool,
+    ) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if is_x86_feature_detected!("avx") {
+            // SAFETY: the processor has AVX.
+            return unsafe { self.any_avx::<N>(ray, counters, occludes) };
+        }
+        self.any::<N, Halves>(ray, counters, occludes)
+    }
+
+    /// [`Self::any`] with AVX, compiled for it.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn any_avx<const N: usize>(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        occludes: impl FnMut(u32) -> bool,
+    ) -> bool {
+        self.any::<N, Avx>(ray, counters, occludes)
+    }
+
+    /// [`Self::occluded_in_leaf_order`] with a stack of `N` entries and the
+    /// slab test `S`.
+    #[inline(always)]
+    fn any<const N: usize, S: SlabTest>(
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
         mut occludes: impl FnMut(u32) -> bool,
     ) -> bool {
-        let slabs = Slabs::new(ray);
-        let far = Vec4::splat(round_up(ray.t_max));
+        let slabs = S::new(&Planes::new(ray));
+        let far = round_up(ray.t_max);
         let mut work = TraversalCounters::default();
-        let mut stack = [Entry::default(); N];
-        let mut depth = 0;
+        let mut stack = Stack::<N>::new();
         let mut current = Entry::default();
         let occluded = loop {
             work.nodes += 1;
@@ -432,19 +425,17 @@ impl Bvh {
                     let last = 31 - mask.leading_zeros();
                     let mut bits = mask & !(1 << last);
                     while bits != 0 {
-                        stack[depth] = child_entry(node, bits.trailing_zeros() as usize, &near);
+                        stack.push(child_entry(node, bits.trailing_zeros() as usize, &near));
                         bits &= bits - 1;
-                        depth += 1;
                     }
                     current = child_entry(node, last as usize, &near);
                     continue;
                 }
             }
-            if depth == 0 {
-                break false;
+            match stack.pop() {
+                Some(next) => current = next,
+                None => break false,
             }
-            depth -= 1;
-            current = stack[depth];
         };
         *counters += work;
         occluded

@@ -1,7 +1,7 @@
 //! The invariants of a built BVH, checked against the boxes it was built
 //! from.
 
-use super::{Bvh, MAX_DEPTH};
+use super::{Bvh, MAX_DEPTH, WIDTH};
 use crate::math::Aabb;
 
 /// True when `inner` lies inside `outer` (an empty `inner` always does).
@@ -44,7 +44,7 @@ impl Bvh {
             }
             max_depth = max_depth.max(depth);
             let node = &self.nodes[i];
-            for slot in 0..4 {
+            for slot in 0..WIDTH {
                 let bounds = node.child_bounds(slot);
                 if !node.is_used(slot) {
                     if !bounds.is_empty() || node.counts[slot] != 0 {
