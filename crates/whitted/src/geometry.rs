@@ -86,8 +86,8 @@ pub struct Geometry<'a> {
     bounded: Vec<u32>,
     /// The corners of each untransformed triangle, of a mesh or a triangle
     /// shape (`None` for other primitives), in the order the structure's queries name them: per
-    /// structure slot, or for a BVH per entry of its index array, so that a
-    /// leaf's triangles lie together. The hot case reaches its vertices
+    /// structure slot, or for a BVH or a kd-tree per entry of its index
+    /// array, so that a leaf's triangles lie together. The hot case reaches its vertices
     /// without going through `refs`, the instance and the mesh's index
     /// array (same test, same result). Tried and not kept before this:
     /// renumbering the BVH's primitives to leaf order in its build, no
@@ -192,12 +192,13 @@ impl<'a> Geometry<'a> {
         };
         let accel = Accelerator::build_clipped(kind, &boxes, &clip);
         let has_triangles = slot_triangles.iter().any(Option::is_some);
+        let in_order = |indices: &[u32]| {
+            let corners = indices.iter().map(|&slot| slot_triangles[slot as usize]);
+            corners.collect()
+        };
         let corners = match &accel {
-            Accelerator::Bvh(bvh) => bvh
-                .indices()
-                .iter()
-                .map(|&slot| slot_triangles[slot as usize])
-                .collect(),
+            Accelerator::Bvh(bvh) => in_order(bvh.indices()),
+            Accelerator::KdTree(kd) => in_order(kd.indices()),
             _ => slot_triangles,
         };
         Self {
@@ -357,6 +358,12 @@ impl<'a> Geometry<'a> {
                     self.hit_entry(entry, slot, &query, t_max, &mut best)
                 })
             }
+            Accelerator::KdTree(kd) => {
+                let slot = |entry: u32| kd.indices()[entry as usize];
+                kd.intersect_in_leaf_order(&clipped, counters, |entry, t_max| {
+                    self.hit_entry(entry, slot, &query, t_max, &mut best)
+                })
+            }
             accel => accel.intersect(&clipped, counters, |slot, t_max| {
                 self.hit_entry(slot, |slot| slot, &query, t_max, &mut best)
             }),
@@ -377,6 +384,12 @@ impl<'a> Geometry<'a> {
                 Accelerator::Bvh(bvh) => {
                     let slot = |entry: u32| bvh.indices()[entry as usize];
                     bvh.occluded_in_leaf_order(ray, counters, |entry| {
+                        self.entry_occludes(entry, slot, &query)
+                    })
+                }
+                Accelerator::KdTree(kd) => {
+                    let slot = |entry: u32| kd.indices()[entry as usize];
+                    kd.occluded_in_leaf_order(ray, counters, |entry| {
                         self.entry_occludes(entry, slot, &query)
                     })
                 }

@@ -12,7 +12,7 @@
 //! stops degenerate input (identical boxes, one box around everything).
 
 use super::events::{Event, EventKind, EventLists, merge, push_events, snap_outward, sort_events};
-use super::node::{KdNode, MAX_FIELD};
+use super::node::{KdNode, MAX_FIELD, MAX_NODE};
 use super::sah::{Costs, Split, best_split};
 use super::traverse::STACK_CAPACITY;
 use super::{Clipper, KdTree, KdTreeBuildParams, split_cell};
@@ -111,9 +111,11 @@ pub(super) fn build(
         },
     };
     builder.node(bounds, events, count, 0);
+    let mut indices = builder.indices;
+    indices.extend(loose.iter().map(|&(i, _)| i));
     let tree = KdTree {
         nodes: builder.nodes,
-        indices: builder.indices,
+        indices,
         bounds,
         loose,
     };
@@ -141,7 +143,7 @@ impl Builder<'_> {
     fn node(&mut self, cell: Aabb, events: EventLists, count: usize, depth: usize) {
         // Room for this node, its children and the above children still
         // pending on the path, so every index fits a node's field.
-        let room = self.nodes.len() + 2 + STACK_CAPACITY <= MAX_FIELD as usize;
+        let room = self.nodes.len() + 2 + STACK_CAPACITY <= MAX_NODE as usize;
         let split = if count > 0 && depth < self.max_depth && room {
             self.counters.events_swept += events.iter().map(Vec::len).sum::<usize>();
             best_split(&cell, &events, count, &self.costs)
@@ -155,10 +157,20 @@ impl Builder<'_> {
         let index = self.nodes.len();
         self.nodes.push(KdNode::leaf(0, 0));
         let [below, above] = self.partition(&cell, &split, events);
-        self.node(below.cell, below.events, below.count, depth + 1);
-        let above_index = self.nodes.len() as u32;
-        self.node(above.cell, above.events, above.count, depth + 1);
-        self.nodes[index] = KdNode::interior(split.axis, split.position as f32, above_index);
+        // A child without primitives is not stored (see `node.rs`).
+        let has_below = below.count > 0;
+        if has_below {
+            self.node(below.cell, below.events, below.count, depth + 1);
+        }
+        let above_index = if above.count > 0 {
+            let above_index = self.nodes.len() as u32;
+            self.node(above.cell, above.events, above.count, depth + 1);
+            above_index
+        } else {
+            0
+        };
+        let plane = split.position as f32;
+        self.nodes[index] = KdNode::interior(split.axis, plane, has_below, above_index);
     }
 
     /// A leaf holding the primitives that have events in `events`.

@@ -47,6 +47,11 @@ impl KdTree {
                 return Err(format!("primitive {i} is kept aside twice"));
             }
         }
+        let tail = self.indices.len().checked_sub(self.loose.len());
+        let listed = tail.map(|tail| &self.indices[tail..]);
+        if !listed.is_some_and(|l| l.iter().eq(self.loose.iter().map(|(i, _)| i))) {
+            return Err("the primitives kept aside do not end the index array".into());
+        }
         self.check_shape(boxes.len(), &aside)?;
 
         let mut required = Vec::new();
@@ -63,7 +68,7 @@ impl KdTree {
             }
             required.push(i as u32);
         }
-        self.check_coverage(0, self.bounds, required, boxes, clip)
+        self.check_coverage(Some(0), self.bounds, required, boxes, clip)
     }
 
     /// Checks that the nodes form a tree within the stack's depth, with
@@ -96,7 +101,12 @@ impl KdTree {
                         return Err(format!("leaf {index} holds primitive {p}, not in the tree"));
                     }
                 }
-                NodeKind::Interior { axis, split, above } => {
+                NodeKind::Interior {
+                    axis,
+                    split,
+                    below,
+                    above,
+                } => {
                     let plane = f64::from(split);
                     if !(cell.min[axis] < plane && plane < cell.max[axis]) {
                         return Err(format!(
@@ -104,8 +114,12 @@ impl KdTree {
                         ));
                     }
                     let [below_cell, above_cell] = split_cell(&cell, axis, plane);
-                    pending.push((index + 1, below_cell, depth + 1));
-                    pending.push((above as usize, above_cell, depth + 1));
+                    if below {
+                        pending.push((index + 1, below_cell, depth + 1));
+                    }
+                    if above != 0 {
+                        pending.push((above as usize, above_cell, depth + 1));
+                    }
                 }
             }
         }
@@ -121,7 +135,7 @@ impl KdTree {
     /// checked.
     fn check_coverage(
         &self,
-        index: usize,
+        index: Option<usize>,
         cell: Aabb,
         required: Vec<u32>,
         boxes: &[Aabb],
@@ -132,6 +146,15 @@ impl KdTree {
         let required = required
             .into_iter()
             .filter_map(|p| bounds_in(p, &boxes[p as usize], &cell, clip).map(|b| (p, b)));
+        let Some(index) = index else {
+            // A child not stored holds nothing.
+            return match required.map(|(p, _)| p).next() {
+                Some(p) => Err(format!(
+                    "primitive {p} overlaps the cell {cell:?} of a child not stored"
+                )),
+                None => Ok(()),
+            };
+        };
         match self.nodes[index].kind() {
             NodeKind::Leaf { offset, count } => {
                 let mut held = self.leaf_primitives(offset, count).unwrap_or(&[]).to_vec();
@@ -146,14 +169,21 @@ impl KdTree {
                     None => Ok(()),
                 }
             }
-            NodeKind::Interior { axis, split, above } => {
+            NodeKind::Interior {
+                axis,
+                split,
+                below,
+                above,
+            } => {
+                let below = below.then_some(index + 1);
+                let above = (above != 0).then_some(above as usize);
                 let plane = f64::from(split);
                 let (mut below_required, mut above_required) = (Vec::new(), Vec::new());
                 for (p, b) in required {
                     let (low, high) = (b.min[axis], b.max[axis]);
                     if low == plane && high == plane {
                         // Flat in the plane: wholly on the side it was given.
-                        if self.subtree_holds(index + 1, p) {
+                        if below.is_some_and(|below| self.subtree_holds(below, p)) {
                             below_required.push(p);
                         } else {
                             above_required.push(p);
@@ -168,8 +198,8 @@ impl KdTree {
                     }
                 }
                 let [below_cell, above_cell] = split_cell(&cell, axis, plane);
-                self.check_coverage(index + 1, below_cell, below_required, boxes, clip)?;
-                self.check_coverage(above as usize, above_cell, above_required, boxes, clip)
+                self.check_coverage(below, below_cell, below_required, boxes, clip)?;
+                self.check_coverage(above, above_cell, above_required, boxes, clip)
             }
         }
     }
@@ -180,16 +210,18 @@ impl KdTree {
             NodeKind::Leaf { offset, count } => self
                 .leaf_primitives(offset, count)
                 .is_some_and(|held| held.contains(&primitive)),
-            NodeKind::Interior { above, .. } => {
-                self.subtree_holds(index + 1, primitive)
-                    || self.subtree_holds(above as usize, primitive)
+            NodeKind::Interior { below, above, .. } => {
+                (below && self.subtree_holds(index + 1, primitive))
+                    || (above != 0 && self.subtree_holds(above as usize, primitive))
             }
         }
     }
 
+    /// A leaf's run of `indices`, if it lies before the loose primitives'.
     fn leaf_primitives(&self, offset: u32, count: u32) -> Option<&[u32]> {
         let start = offset as usize;
-        self.indices.get(start..start + count as usize)
+        let leaves = self.indices.len().checked_sub(self.loose.len())?;
+        self.indices[..leaves].get(start..start + count as usize)
     }
 
     /// Size and quality. The SAH cost counts one per interior node and one
@@ -224,12 +256,21 @@ impl KdTree {
                     stats.references += count as usize;
                     stats.sah_cost += probability(&cell) * f64::from(count);
                 }
-                NodeKind::Interior { axis, split, above } => {
+                NodeKind::Interior {
+                    axis,
+                    split,
+                    below,
+                    above,
+                } => {
                     stats.sah_cost += probability(&cell);
                     if depth < STACK_CAPACITY {
                         let [below_cell, above_cell] = split_cell(&cell, axis, f64::from(split));
-                        pending.push((index + 1, below_cell, depth + 1));
-                        pending.push((above as usize, above_cell, depth + 1));
+                        if below {
+                            pending.push((index + 1, below_cell, depth + 1));
+                        }
+                        if above != 0 {
+                            pending.push((above as usize, above_cell, depth + 1));
+                        }
                     }
                 }
             }
@@ -281,21 +322,32 @@ mod tests {
     }
 
     #[test]
+    fn validate_finds_a_primitive_in_the_cell_of_a_child_not_stored() {
+        let mut tree = KdTree::build(&boxes());
+        assert_eq!(tree.indices, [0, 1]);
+        // The root's above child, holding cube 1, left out.
+        tree.nodes = vec![KdNode::interior(0, 1.0, true, 0), KdNode::leaf(0, 1)];
+        let why = tree.validate(&boxes()).unwrap_err();
+        assert!(why.contains("primitive 1 overlaps the cell"), "{why}");
+        assert!(why.contains("child not stored"), "{why}");
+    }
+
+    #[test]
     fn validate_finds_bad_indices_and_misplaced_planes() {
         let mut tree = KdTree::build(&boxes());
-        tree.nodes[0] = KdNode::interior(0, 1.0, 7);
+        tree.nodes[0] = KdNode::interior(0, 1.0, true, 7);
         assert!(
             tree.validate(&boxes())
                 .unwrap_err()
                 .contains("out of range")
         );
-        tree.nodes[0] = KdNode::interior(0, 3.0, 2);
+        tree.nodes[0] = KdNode::interior(0, 3.0, true, 2);
         assert!(
             tree.validate(&boxes())
                 .unwrap_err()
                 .contains("outside its cell")
         );
-        tree.nodes[0] = KdNode::interior(0, 1.0, 1);
+        tree.nodes[0] = KdNode::interior(0, 1.0, true, 1);
         assert!(
             tree.validate(&boxes())
                 .unwrap_err()
@@ -313,7 +365,20 @@ mod tests {
     fn validate_finds_a_box_kept_aside_that_fits_the_tree() {
         let mut tree = KdTree::build(&boxes());
         tree.loose.push((0, boxes()[0]));
+        tree.indices.push(0);
         let why = tree.validate(&boxes()).unwrap_err();
         assert!(why.contains("fits the tree"), "{why}");
+    }
+
+    #[test]
+    fn validate_finds_primitives_kept_aside_missing_from_the_index_array() {
+        let mut with_loose = boxes().to_vec();
+        with_loose.push(Aabb::INFINITE);
+        let mut tree = KdTree::build(&with_loose);
+        assert_eq!(tree.validate(&with_loose), Ok(()));
+        assert_eq!(tree.indices.last(), Some(&2));
+        tree.indices.pop();
+        let why = tree.validate(&with_loose).unwrap_err();
+        assert!(why.contains("do not end the index array"), "{why}");
     }
 }

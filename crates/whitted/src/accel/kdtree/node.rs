@@ -1,11 +1,21 @@
 //! The 8-byte kd-tree node, after pbrt-v4's `KdTreeNode`: one word holds
 //! the split position (an `f32`) or a leaf's offset into the primitive-index
 //! array; the other holds the split axis (or the leaf tag) in its low two
-//! bits and the above child's index (or the leaf's primitive count) in the
-//! rest. The below child always follows its parent.
+//! bits and, for a leaf, its primitive count in the rest. An interior node
+//! has there one bit saying whether its below child is stored (right after
+//! it) and its above child's index, 0 when that child is not stored: a
+//! child that would be an empty leaf is left out, so the walk never steps
+//! into it.
 
-/// The largest above-child index or leaf primitive count a node can hold.
+/// The largest leaf primitive count a node can hold.
 pub(super) const MAX_FIELD: u32 = (1 << 30) - 1;
+
+/// The largest above-child index a node can hold.
+pub(super) const MAX_NODE: u32 = (1 << 29) - 1;
+
+/// The bit above the axis that marks an interior node without a below
+/// child.
+const NO_BELOW: u32 = 4;
 
 /// The tag in the low two bits that marks a leaf (axes are 0, 1, 2).
 const LEAF_TAG: u32 = 3;
@@ -25,14 +35,19 @@ const _: () = assert!(size_of::<KdNode>() == 8);
 /// A node, decoded.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) enum NodeKind {
-    /// Splits its cell at `split` on `axis`; the below child is the next
-    /// node, the above child is node `above`.
+    /// Splits its cell at `split` on `axis`; the below child, if `below`,
+    /// is the next node, the above child is node `above` (none if 0). A
+    /// child not stored holds nothing.
     Interior {
         /// 0, 1 or 2 for x, y, z.
         axis: usize,
         /// The plane's position on `axis`.
         split: f32,
-        /// Index of the child holding the cell's part above the plane.
+        /// Whether the child holding the cell's part below the plane is
+        /// stored (as the next node).
+        below: bool,
+        /// Index of the child holding the cell's part above the plane, 0
+        /// when it is not stored.
         above: u32,
     },
     /// Holds primitives `indices[offset..offset + count]`.
@@ -46,12 +61,14 @@ pub(super) enum NodeKind {
 
 impl KdNode {
     /// An interior node; `axis` is below 3 and `above` at most
-    /// [`MAX_FIELD`].
-    pub(super) fn interior(axis: usize, split: f32, above: u32) -> Self {
-        debug_assert!(axis < 3 && above <= MAX_FIELD);
+    /// [`MAX_NODE`] (0: no above child); `below` says whether the below
+    /// child follows.
+    pub(super) fn interior(axis: usize, split: f32, below: bool, above: u32) -> Self {
+        debug_assert!(axis < 3 && above <= MAX_NODE);
+        let no_below = if below { 0 } else { NO_BELOW };
         Self {
             word: split.to_bits(),
-            flags: (above << 2) | (axis as u32 & 3),
+            flags: (above << 3) | no_below | (axis as u32 & 3),
         }
     }
 
@@ -77,7 +94,8 @@ impl KdNode {
             NodeKind::Interior {
                 axis: tag as usize,
                 split: f32::from_bits(self.word),
-                above: self.flags >> 2,
+                below: self.flags & NO_BELOW == 0,
+                above: self.flags >> 3,
             }
         }
     }
@@ -91,17 +109,21 @@ mod tests {
     fn interior_nodes_round_trip_every_axis_and_extreme_values() {
         for axis in 0..3 {
             for split in [0.0, -0.0, 1.5, -3.25e7, f32::MAX, f32::MIN_POSITIVE] {
-                for above in [0, 1, 12345, MAX_FIELD] {
-                    let node = KdNode::interior(axis, split, above);
+                for (below, above) in [(true, 0), (false, 1), (true, 12345), (false, MAX_NODE)] {
+                    let node = KdNode::interior(axis, split, below, above);
                     let NodeKind::Interior {
                         axis: a,
                         split: s,
-                        above: b,
+                        below: b,
+                        above: c,
                     } = node.kind()
                     else {
                         panic!("decoded as a leaf");
                     };
-                    assert_eq!((a, s.to_bits(), b), (axis, split.to_bits(), above));
+                    assert_eq!(
+                        (a, s.to_bits(), b, c),
+                        (axis, split.to_bits(), below, above)
+                    );
                 }
             }
         }

@@ -6,7 +6,7 @@
 //! the ray enters its box, so both structures see exactly the same hits.
 
 use super::build::default_max_depth;
-use super::node::NodeKind;
+use super::node::{KdNode, NodeKind};
 use super::{KdTree, KdTreeBuildParams};
 use crate::accel::conformance::{assert_conforms, random_boxes};
 use crate::accel::{AccelKind, Accelerator, TraversalCounters};
@@ -92,6 +92,34 @@ fn kdtree_is_listed_before_linear_and_found_by_name() {
     assert_eq!(accel.kind(), AccelKind::KdTree);
 }
 
+/// Stored leaves holding no primitive.
+fn empty_leaves(tree: &KdTree) -> usize {
+    let empty = |n: &&KdNode| matches!(n.kind(), NodeKind::Leaf { count: 0, .. });
+    tree.nodes.iter().filter(empty).count()
+}
+
+/// Interior nodes without a below child, and without an above child.
+fn missing_children(tree: &KdTree) -> (usize, usize) {
+    tree.nodes.iter().fold((0, 0), |(b, a), n| match n.kind() {
+        NodeKind::Interior { below, above, .. } => {
+            (b + usize::from(!below), a + usize::from(above == 0))
+        }
+        NodeKind::Leaf { .. } => (b, a),
+    })
+}
+
+#[test]
+fn children_without_primitives_are_not_stored_and_rays_skip_their_cells() {
+    // Sparse boxes: cutting off empty space pays on both sides of planes.
+    let mut rng = Rng::new(23);
+    let boxes = random_boxes(&mut rng, 2_000, 200.0, 1.0);
+    let rays = random_rays(&mut rng, 2_000, 200.0);
+    let tree = assert_matches_brute_force(&boxes, &rays, "sparse boxes");
+    assert_eq!(empty_leaves(&tree), 0);
+    let (no_below, no_above) = missing_children(&tree);
+    assert!(no_below > 10 && no_above > 10, "{no_below} {no_above}");
+}
+
 #[test]
 fn random_boxes_of_every_size_build_valid_trees_within_the_depth_limit() {
     let mut rng = Rng::new(11);
@@ -106,7 +134,7 @@ fn random_boxes_of_every_size_build_valid_trees_within_the_depth_limit() {
             "{stats:?}"
         );
         assert!(stats.max_depth <= default_max_depth(n), "{stats:?}");
-        assert_eq!(stats.nodes, 2 * stats.leaves - 1);
+        assert_eq!(empty_leaves(&tree), usize::from(n == 0), "{n}");
         if n >= 1_000 {
             // A real tree: far cheaper than testing everything, and few
             // boxes copied into many leaves.

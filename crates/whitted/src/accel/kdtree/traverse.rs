@@ -24,6 +24,7 @@ use super::node::NodeKind;
 use crate::accel::TraversalCounters;
 use crate::accel::mailbox::Mailbox;
 use crate::math::{Ray, gamma};
+use std::ops::Range;
 
 /// Entries of the to-do stack: one per level at most, so this bounds the
 /// tree's depth.
@@ -54,26 +55,42 @@ impl KdTree {
         counters: &mut TraversalCounters,
         mut hit: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<f64> {
+        self.intersect_in_leaf_order(ray, counters, |entry, t_max| {
+            hit(self.indices[entry as usize], t_max)
+        })
+    }
+
+    /// [`Self::intersect`], with `hit` given each primitive's position in
+    /// [`Self::indices`] instead of its number: a caller that keeps what it
+    /// needs of the primitives in that order reads each leaf's together.
+    #[inline]
+    pub fn intersect_in_leaf_order(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        mut hit: impl FnMut(u32, f64) -> Option<f64>,
+    ) -> Option<f64> {
         let mut closest = None;
         let mut t_max = ray.t_max;
         let mut clipped = *ray;
-        for &(i, b) in &self.loose {
+        let first_loose = self.indices.len() - self.loose.len();
+        for (k, (_, b)) in self.loose.iter().enumerate() {
             counters.nodes += 1;
             if b.intersect_ray(&clipped).is_some() {
                 counters.primitives += 1;
-                if let Some(t) = hit(i, t_max) {
+                if let Some(t) = hit((first_loose + k) as u32, t_max) {
                     (t_max, clipped.t_max, closest) = (t, t, Some(t));
                 }
             }
         }
         let mut mailbox = Mailbox::new();
-        self.walk(&clipped, counters, |primitives, counters| {
-            for &i in primitives {
-                if !mailbox.first_visit(i) {
+        self.walk(&clipped, counters, |entries, counters| {
+            for entry in entries {
+                if !mailbox.first_visit(self.indices[entry]) {
                     continue;
                 }
                 counters.primitives += 1;
-                if let Some(t) = hit(i, t_max) {
+                if let Some(t) = hit(entry as u32, t_max) {
                     (t_max, closest) = (t, Some(t));
                 }
             }
@@ -90,26 +107,42 @@ impl KdTree {
         counters: &mut TraversalCounters,
         mut occludes: impl FnMut(u32) -> bool,
     ) -> bool {
-        let loose_hit = self.loose.iter().any(|&(i, b)| {
+        self.occluded_in_leaf_order(ray, counters, |entry| {
+            occludes(self.indices[entry as usize])
+        })
+    }
+
+    /// [`Self::occluded`], with `occludes` given each primitive's position
+    /// in [`Self::indices`] instead of its number (see
+    /// [`Self::intersect_in_leaf_order`]).
+    #[inline]
+    pub fn occluded_in_leaf_order(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        mut occludes: impl FnMut(u32) -> bool,
+    ) -> bool {
+        let first_loose = self.indices.len() - self.loose.len();
+        let loose_hit = self.loose.iter().enumerate().any(|(k, (_, b))| {
             counters.nodes += 1;
             if b.intersect_ray(ray).is_none() {
                 return false;
             }
             counters.primitives += 1;
-            occludes(i)
+            occludes((first_loose + k) as u32)
         });
         if loose_hit {
             return true;
         }
         let mut found = false;
         let mut mailbox = Mailbox::new();
-        self.walk(ray, counters, |primitives, counters| {
-            for &i in primitives {
-                if !mailbox.first_visit(i) {
+        self.walk(ray, counters, |entries, counters| {
+            for entry in entries {
+                if !mailbox.first_visit(self.indices[entry]) {
                     continue;
                 }
                 counters.primitives += 1;
-                if occludes(i) {
+                if occludes(entry as u32) {
                     found = true;
                     return Flow::Stop;
                 }
@@ -119,14 +152,15 @@ impl KdTree {
         found
     }
 
-    /// Calls `leaf` with the primitives of every leaf the ray passes, near
-    /// to far, until it says stop.
+    /// Calls `leaf` with the positions in [`Self::indices`] of the
+    /// primitives of every leaf the ray passes, near to far, until it says
+    /// stop.
     #[inline]
     fn walk(
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
-        mut leaf: impl FnMut(&[u32], &mut TraversalCounters) -> Flow,
+        mut leaf: impl FnMut(Range<usize>, &mut TraversalCounters) -> Flow,
     ) {
         if self.bounds.is_empty() {
             return;
@@ -146,8 +180,14 @@ impl KdTree {
         loop {
             counters.nodes += 1;
             match self.nodes[entry.node as usize].kind() {
-                NodeKind::Interior { axis, split, above } => {
-                    match children(&entry, axis, split, above, &axes) {
+                NodeKind::Interior {
+                    axis,
+                    split,
+                    below,
+                    above,
+                } => {
+                    let below = if below { entry.node + 1 } else { 0 };
+                    match children(&entry, axis, split, [below, above], &axes) {
                         [Some(first), Some(second)] => {
                             stack[pending] = second;
                             pending += 1;
@@ -163,8 +203,7 @@ impl KdTree {
                 }
                 NodeKind::Leaf { offset, count } => {
                     let start = offset as usize;
-                    let primitives = &self.indices[start..start + count as usize];
-                    match leaf(primitives, counters) {
+                    match leaf(start..start + count as usize, counters) {
                         Flow::Continue(t) => horizon = t,
                         Flow::Stop => return,
                     }
@@ -218,10 +257,16 @@ fn max(a: f64, b: f64) -> f64 {
 /// The children of the interior node `entry` that the ray meets, in the
 /// order it meets them, each with its parameter range (never NaN: the
 /// root's range comes from a box test, and a crossing that is NaN is
-/// replaced by infinities).
+/// replaced by infinities). `[below, above]` are the children's indices,
+/// 0 for one that is not stored (and so never met).
 #[inline]
-fn children(entry: &Entry, axis: usize, split: f32, above: u32, ray: &Axes) -> [Option<Entry>; 2] {
-    let below = entry.node + 1;
+fn children(
+    entry: &Entry,
+    axis: usize,
+    split: f32,
+    [below, above]: [u32; 2],
+    ray: &Axes,
+) -> [Option<Entry>; 2] {
     let inv_dir = ray.inv_dir[axis];
     let t_plane = (f64::from(split) - ray.origin[axis]) * inv_dir;
     // The crossing's rounding error is below γ(3) relative; NaN means the
@@ -240,12 +285,12 @@ fn children(entry: &Entry, axis: usize, split: f32, above: u32, ray: &Axes) -> [
     } else {
         (below, above)
     };
-    let near = (entry.t_min <= t_high).then_some(Entry {
+    let near = (first != 0 && entry.t_min <= t_high).then_some(Entry {
         node: first,
         t_min: entry.t_min,
         t_max: min(entry.t_max, t_high),
     });
-    let far = (t_low <= entry.t_max).then_some(Entry {
+    let far = (second != 0 && t_low <= entry.t_max).then_some(Entry {
         node: second,
         t_min: max(entry.t_min, t_low),
         t_max: entry.t_max,
@@ -274,7 +319,7 @@ mod tests {
     fn a_ray_lying_in_the_plane_visits_both_children_over_its_whole_range() {
         for dir in [Vec3::Y, -Vec3::Y, Vec3::new(-0.0, 1.0, 0.0)] {
             let ray = Ray::new(Vec3::new(2.0, 0.0, 0.0), dir);
-            let [a, b] = children(&entry(1.0, 5.0), 0, 2.0, 20, &Axes::new(&ray));
+            let [a, b] = children(&entry(1.0, 5.0), 0, 2.0, [11, 20], &Axes::new(&ray));
             assert_eq!((a.unwrap().t_min, a.unwrap().t_max), (1.0, 5.0));
             assert_eq!((b.unwrap().t_min, b.unwrap().t_max), (1.0, 5.0));
         }
@@ -285,12 +330,24 @@ mod tests {
         for dir in [Vec3::Y, Vec3::new(-0.0, 1.0, 0.0)] {
             let below = Ray::new(Vec3::new(1.5, 0.0, 0.0), dir);
             assert_eq!(
-                nodes(children(&entry(1.0, 5.0), 0, 2.0, 20, &Axes::new(&below))),
+                nodes(children(
+                    &entry(1.0, 5.0),
+                    0,
+                    2.0,
+                    [11, 20],
+                    &Axes::new(&below)
+                )),
                 [11]
             );
             let above = Ray::new(Vec3::new(2.5, 0.0, 0.0), dir);
             assert_eq!(
-                nodes(children(&entry(1.0, 5.0), 0, 2.0, 20, &Axes::new(&above))),
+                nodes(children(
+                    &entry(1.0, 5.0),
+                    0,
+                    2.0,
+                    [11, 20],
+                    &Axes::new(&above)
+                )),
                 [20]
             );
         }
@@ -301,24 +358,54 @@ mod tests {
         // The ray crosses x = 2 at t = 2.
         let up = Ray::new(Vec3::ZERO, Vec3::X);
         assert_eq!(
-            nodes(children(&entry(2.0, 5.0), 0, 2.0, 20, &Axes::new(&up))),
+            nodes(children(
+                &entry(2.0, 5.0),
+                0,
+                2.0,
+                [11, 20],
+                &Axes::new(&up)
+            )),
             [11, 20]
         );
         assert_eq!(
-            nodes(children(&entry(0.0, 2.0), 0, 2.0, 20, &Axes::new(&up))),
+            nodes(children(
+                &entry(0.0, 2.0),
+                0,
+                2.0,
+                [11, 20],
+                &Axes::new(&up)
+            )),
             [11, 20]
         );
         assert_eq!(
-            nodes(children(&entry(0.0, 1.5), 0, 2.0, 20, &Axes::new(&up))),
+            nodes(children(
+                &entry(0.0, 1.5),
+                0,
+                2.0,
+                [11, 20],
+                &Axes::new(&up)
+            )),
             [11]
         );
         assert_eq!(
-            nodes(children(&entry(2.5, 5.0), 0, 2.0, 20, &Axes::new(&up))),
+            nodes(children(
+                &entry(2.5, 5.0),
+                0,
+                2.0,
+                [11, 20],
+                &Axes::new(&up)
+            )),
             [20]
         );
         let down = Ray::new(Vec3::new(4.0, 0.0, 0.0), -Vec3::X);
         assert_eq!(
-            nodes(children(&entry(0.0, 2.0), 0, 2.0, 20, &Axes::new(&down))),
+            nodes(children(
+                &entry(0.0, 2.0),
+                0,
+                2.0,
+                [11, 20],
+                &Axes::new(&down)
+            )),
             [20, 11]
         );
     }
@@ -326,12 +413,12 @@ mod tests {
     #[test]
     fn a_ray_starting_on_the_plane_goes_to_the_side_it_points_to_first() {
         let up = Ray::new(Vec3::new(2.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0));
-        let [near, far] = children(&entry(0.0, 5.0), 0, 2.0, 20, &Axes::new(&up));
+        let [near, far] = children(&entry(0.0, 5.0), 0, 2.0, [11, 20], &Axes::new(&up));
         // The below child is met only at t = 0 itself.
         assert_eq!(near.map(|e| (e.node, e.t_max)), Some((11, 0.0)));
         assert_eq!(far.map(|e| (e.node, e.t_min)), Some((20, 0.0)));
         let down = Ray::new(Vec3::new(2.0, 0.0, 0.0), Vec3::new(-1.0, 1.0, 0.0));
-        let [near, far] = children(&entry(0.0, 5.0), 0, 2.0, 20, &Axes::new(&down));
+        let [near, far] = children(&entry(0.0, 5.0), 0, 2.0, [11, 20], &Axes::new(&down));
         assert_eq!(near.map(|e| (e.node, e.t_max)), Some((20, 0.0)));
         assert_eq!(far.map(|e| (e.node, e.t_min)), Some((11, 0.0)));
     }
