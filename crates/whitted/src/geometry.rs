@@ -13,9 +13,12 @@ use crate::material::MaterialId;
 use crate::math::{Aabb, DVec2, Ray, Transform, Vec3};
 use crate::mesh::TriangleMesh;
 use crate::scene::{MeshInstance, Primitive, Scene, TransformId};
+#[cfg(target_arch = "x86_64")]
+use crate::shape::{Hits4, LANES, watertight4};
 use crate::shape::{LocalSurface, RayShear, Shape, ShapeHit, watertight};
 use crate::triangle_clip::clipped_triangle_bounds;
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// Triangles per parallel task when preparing meshes: fewer are prepared
 /// on the calling thread.
@@ -97,6 +100,10 @@ pub struct Geometry<'a> {
     /// Whether some entry of `corners` is a triangle, so queries compute
     /// the ray's shear up front.
     has_triangles: bool,
+    /// Whether the processor has AVX, so the BVH's leaves test runs of
+    /// triangles four at a time.
+    #[cfg(target_arch = "x86_64")]
+    wide_triangles: bool,
     unbounded: Vec<u32>,
 }
 
@@ -212,6 +219,8 @@ impl<'a> Geometry<'a> {
             bounded,
             corners,
             has_triangles,
+            #[cfg(target_arch = "x86_64")]
+            wide_triangles: is_x86_feature_detected!("avx"),
             unbounded,
         }
     }
@@ -281,6 +290,101 @@ impl<'a> Geometry<'a> {
             shape_hit: h,
         });
         Some(h.t)
+    }
+
+    /// The closest of the primitives of entries `entries` of `corners` hit
+    /// by the query's ray, closer than `t_max`, recorded in `best`; returns
+    /// its `t` (`slot` as for [`Self::hit_entry`]). One by one: testing runs
+    /// of triangles four at a time as [`Self::leaf_occludes`] does made
+    /// the bunny's primary and diffuse rays 10% and 6% slower (1 thread,
+    /// best of four interleaved runs), with 5% more instructions.
+    #[inline(always)]
+    fn hit_leaf(
+        &self,
+        entries: Range<u32>,
+        slot: impl Fn(u32) -> u32 + Copy,
+        query: &Query,
+        mut t_max: f64,
+        best: &mut Option<Hit>,
+    ) -> Option<f64> {
+        let mut found = None;
+        for entry in entries {
+            if let Some(t) = self.hit_entry(entry, slot, query, t_max, best) {
+                t_max = t;
+                found = Some(t);
+            }
+        }
+        found
+    }
+
+    /// True when a primitive of entries `entries` of `corners` lies in the
+    /// query's ray interval (`slot` as for [`Self::hit_entry`]). Where the
+    /// processor has AVX, runs of two to four triangles are tested at once,
+    /// with the same answers as one by one (see [`Self::triangle_run`]):
+    /// the same instructions on the bunny's shadow rays (callgrind), 18%
+    /// faster (5.74 against 4.84 Mrays/s, 1 thread, best of four
+    /// interleaved runs), having fewer branches on the edge tests' signs.
+    #[inline(always)]
+    fn leaf_occludes(
+        &self,
+        entries: Range<u32>,
+        slot: impl Fn(u32) -> u32 + Copy,
+        query: &Query,
+    ) -> bool {
+        let mut entry = entries.start;
+        while entry < entries.end {
+            #[cfg(target_arch = "x86_64")]
+            if let Some((run, hits)) = self.triangle_run(entry, entries.end, query) {
+                if hits.mask != 0 {
+                    return true;
+                }
+                entry += run;
+                continue;
+            }
+            if self.entry_occludes(entry, slot, query) {
+                return true;
+            }
+            entry += 1;
+        }
+        false
+    }
+
+    /// With AVX, the run of two to [`LANES`] triangles that starts at entry
+    /// `entry` of `corners` (and ends before `end`), tested at once against
+    /// the query's ray: its length and the hits, lane `i` for entry
+    /// `entry + i`. `None` without AVX or such a run.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn triangle_run(&self, entry: u32, end: u32, query: &Query) -> Option<(u32, Hits4)> {
+        if !self.wide_triangles {
+            return None;
+        }
+        let available = (end - entry).min(LANES as u32) as usize;
+        let corners = &self.corners[entry as usize..entry as usize + available];
+        let run = corners.iter().take_while(|c| c.is_some()).count();
+        if run < 2 {
+            return None;
+        }
+        let first = corners[0].as_ref()?;
+        // Lanes past the run repeat the first triangle; their answers are
+        // masked out.
+        let lane = |i: usize| {
+            corners[..run]
+                .get(i)
+                .and_then(Option::as_ref)
+                .unwrap_or(first)
+        };
+        // SAFETY: `wide_triangles` is set only where the processor has AVX.
+        let hits = unsafe {
+            watertight4(
+                [lane(0), lane(1), lane(2), lane(3)],
+                query.ray,
+                &query.shear(),
+                query.ray.t_max,
+            )
+        };
+        let mask = hits.mask & ((1 << run) - 1);
+        Some((run as u32, Hits4 { mask, ..hits }))
     }
 
     /// True when the primitive of entry `entry` of `corners` lies in the
@@ -354,8 +458,8 @@ impl<'a> Geometry<'a> {
         match &self.accel {
             Accelerator::Bvh(bvh) => {
                 let slot = |entry: u32| bvh.indices()[entry as usize];
-                bvh.intersect_in_leaf_order(&clipped, counters, |entry, t_max| {
-                    self.hit_entry(entry, slot, &query, t_max, &mut best)
+                bvh.intersect_in_leaf_order(&clipped, counters, |entries, t_max| {
+                    self.hit_leaf(entries, slot, &query, t_max, &mut best)
                 })
             }
             Accelerator::KdTree(kd) => {
@@ -383,8 +487,8 @@ impl<'a> Geometry<'a> {
             || match &self.accel {
                 Accelerator::Bvh(bvh) => {
                     let slot = |entry: u32| bvh.indices()[entry as usize];
-                    bvh.occluded_in_leaf_order(ray, counters, |entry| {
-                        self.entry_occludes(entry, slot, &query)
+                    bvh.occluded_in_leaf_order(ray, counters, |entries| {
+                        self.leaf_occludes(entries, slot, &query)
                     })
                 }
                 Accelerator::KdTree(kd) => {

@@ -31,6 +31,8 @@ mod polygon;
 mod quadratic;
 mod sphere;
 mod triangle;
+#[cfg(target_arch = "x86_64")]
+mod watertight_avx;
 
 pub use axis_box::AxisBox;
 pub use cone::Cone;
@@ -41,6 +43,8 @@ pub use plane::Plane;
 pub use polygon::Polygon;
 pub use sphere::Sphere;
 pub use triangle::{RayShear, Triangle, watertight};
+#[cfg(target_arch = "x86_64")]
+pub use watertight_avx::{Hits4, LANES, watertight4};
 
 use crate::math::{Aabb, DVec2, Ray, Vec3};
 

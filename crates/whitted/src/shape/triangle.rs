@@ -116,6 +116,19 @@ impl RayShear {
         }
     }
 
+    /// The axis that becomes z.
+    #[inline(always)]
+    pub(super) fn kz(&self) -> usize {
+        self.kz
+    }
+
+    /// The shear factors: x and y gain `x` and `y` times z, and z is
+    /// scaled by `z`.
+    #[inline(always)]
+    pub(super) fn factors(&self) -> Vec3 {
+        self.shear
+    }
+
     /// A point in the ray's sheared space (z not yet scaled), the axes
     /// permuted by `KX`, `KY`, `KZ`.
     #[inline(always)]

@@ -101,6 +101,7 @@
 //! until written out.
 
 use std::mem::MaybeUninit;
+use std::ops::Range;
 
 use super::node::{BvhNode, WIDTH, round_up};
 use super::slabs::{Halves, Planes, SlabTest};
@@ -207,20 +208,29 @@ impl Bvh {
         counters: &mut TraversalCounters,
         mut hit: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<f64> {
-        self.intersect_in_leaf_order(ray, counters, |entry, t_max| {
-            hit(self.indices[entry as usize], t_max)
+        self.intersect_in_leaf_order(ray, counters, |entries, mut t_max| {
+            let mut found = None;
+            for entry in entries {
+                if let Some(t) = hit(self.indices[entry as usize], t_max) {
+                    t_max = t;
+                    found = Some(t);
+                }
+            }
+            found
         })
     }
 
-    /// [`Self::intersect`], with `hit` given each primitive's position in
-    /// [`Self::indices`] instead of its number: a caller that keeps what it
-    /// needs of the primitives in that order reads each leaf's together.
+    /// [`Self::intersect`], with `hit` given a whole leaf: the positions in
+    /// [`Self::indices`] of its primitives and the closest parameter so
+    /// far; it returns the closest hit among them closer than that, if
+    /// any. A caller that keeps what it needs of the primitives in that
+    /// order reads each leaf's together, and may test several at once.
     #[inline]
     pub fn intersect_in_leaf_order(
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
-        hit: impl FnMut(u32, f64) -> Option<f64>,
+        hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
     ) -> Option<f64> {
         if self.nodes.is_empty() {
             None
@@ -239,7 +249,7 @@ impl Bvh {
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
-        hit: impl FnMut(u32, f64) -> Option<f64>,
+        hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
     ) -> Option<f64> {
         #[cfg(target_arch = "x86_64")]
         if is_x86_feature_detected!("avx") {
@@ -256,7 +266,7 @@ impl Bvh {
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
-        hit: impl FnMut(u32, f64) -> Option<f64>,
+        hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
     ) -> Option<f64> {
         self.closest::<N, Avx>(ray, counters, hit)
     }
@@ -268,7 +278,7 @@ impl Bvh {
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
-        mut hit: impl FnMut(u32, f64) -> Option<f64>,
+        mut hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
     ) -> Option<f64> {
         let slabs = S::new(&Planes::new(ray));
         let mut closest = ray.t_max;
@@ -281,14 +291,12 @@ impl Bvh {
             work.nodes += 1;
             let first = current.child as usize;
             if current.count > 0 {
-                for entry in current.child..current.child + current.count {
-                    work.primitives += 1;
-                    if let Some(t) = hit(entry, closest) {
-                        closest = t;
-                        found = Some(t);
-                    }
+                work.primitives += u64::from(current.count);
+                if let Some(t) = hit(current.child..current.child + current.count, closest) {
+                    closest = t;
+                    found = Some(t);
+                    far = round_up(closest);
                 }
-                far = round_up(closest);
             } else if let Some(node) = self.nodes.get(first) {
                 let (mask, near) = slabs.test(node, far);
                 if mask & (mask.wrapping_sub(1)) == 0 && mask != 0 {
@@ -336,20 +344,22 @@ impl Bvh {
         counters: &mut TraversalCounters,
         mut occludes: impl FnMut(u32) -> bool,
     ) -> bool {
-        self.occluded_in_leaf_order(ray, counters, |entry| {
-            occludes(self.indices[entry as usize])
+        self.occluded_in_leaf_order(ray, counters, |mut entries| {
+            entries.any(|entry| occludes(self.indices[entry as usize]))
         })
     }
 
-    /// [`Self::occluded`], with `occludes` given each primitive's position
-    /// in [`Self::indices`] instead of its number (see
-    /// [`Self::intersect_in_leaf_order`]).
+    /// [`Self::occluded`], with `occludes` given a whole leaf: the
+    /// positions in [`Self::indices`] of its primitives (see
+    /// [`Self::intersect_in_leaf_order`]); it says whether any of them lies
+    /// in the ray's interval. The leaf counts as tested whole in
+    /// `counters.primitives`, however early the caller stops.
     #[inline]
     pub fn occluded_in_leaf_order(
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
-        occludes: impl FnMut(u32) -> bool,
+        occludes: impl FnMut(Range<u32>) -> bool,
     ) -> bool {
         if self.nodes.is_empty() {
             false
@@ -368,7 +378,7 @@ impl Bvh {
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
-        occludes: impl FnMut(u32) -> bool,
+        occludes: impl FnMut(Range<u32>) -> bool,
     ) -> bool {
         #[cfg(target_arch = "x86_64")]
         if is_x86_feature_detected!("avx") {
@@ -385,7 +395,7 @@ impl Bvh {
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
-        occludes: impl FnMut(u32) -> bool,
+        occludes: impl FnMut(Range<u32>) -> bool,
     ) -> bool {
         self.any::<N, Avx>(ray, counters, occludes)
     }
@@ -397,7 +407,7 @@ impl Bvh {
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
-        mut occludes: impl FnMut(u32) -> bool,
+        mut occludes: impl FnMut(Range<u32>) -> bool,
     ) -> bool {
         let slabs = S::new(&Planes::new(ray));
         let far = round_up(ray.t_max);
@@ -408,10 +418,8 @@ impl Bvh {
             work.nodes += 1;
             let first = current.child as usize;
             if current.count > 0 {
-                if (current.child..current.child + current.count).any(|entry| {
-                    work.primitives += 1;
-                    occludes(entry)
-                }) {
+                work.primitives += u64::from(current.count);
+                if occludes(current.child..current.child + current.count) {
                     break true;
                 }
             } else if let Some(node) = self.nodes.get(first) {
