@@ -452,6 +452,7 @@ impl Bvh {
 
 #[cfg(test)]
 mod tests {
+    use super::{Halves, MAX_DEPTH, stack_size};
     use crate::accel::{Bvh, Linear, TraversalCounters};
     use crate::math::{Aabb, Ray, Vec3};
     use crate::random::Rng;
@@ -543,20 +544,43 @@ mod tests {
     }
 
     /// The BVH finds the same closest box entry as brute force, and the
-    /// same answer to any hit, for every ray; returns how many rays hit.
+    /// same answer to any hit, for every ray, with the slab test this
+    /// processor uses and with the two SSE halves (the only one without
+    /// AVX); returns how many rays hit.
     fn assert_agrees_with_brute_force(boxes: &[Aabb], rays: &[Ray]) -> usize {
         let bvh = Bvh::build(boxes);
         bvh.validate(boxes).unwrap();
         let linear = Linear::build(boxes);
         let mut counters = TraversalCounters::default();
         let mut hits = 0;
+        const N: usize = stack_size(MAX_DEPTH);
         for ray in rays {
             let expected = linear.intersect(ray, &mut counters, |i, t| box_entry(boxes, ray, i, t));
             let actual = bvh.intersect(ray, &mut counters, |i, t| box_entry(boxes, ray, i, t));
             assert_eq!(actual, expected, "{ray:?}");
+            let halves = bvh.closest::<N, Halves>(ray, &mut counters, |entries, mut t_max| {
+                let mut found = None;
+                for entry in entries {
+                    let i = bvh.indices()[entry as usize];
+                    if let Some(t) = box_entry(boxes, ray, i, t_max) {
+                        t_max = t;
+                        found = Some(t);
+                    }
+                }
+                found
+            });
+            assert_eq!(halves, expected, "{ray:?}");
             let occluded = |i: u32| box_entry(boxes, ray, i, ray.t_max).is_some();
             assert_eq!(
                 bvh.occluded(ray, &mut counters, occluded),
+                expected.is_some(),
+                "{ray:?}"
+            );
+            let leaf_occluded = |mut entries: std::ops::Range<u32>| {
+                entries.any(|entry| occluded(bvh.indices()[entry as usize]))
+            };
+            assert_eq!(
+                bvh.any::<N, Halves>(ray, &mut counters, leaf_occluded),
                 expected.is_some(),
                 "{ray:?}"
             );
