@@ -41,7 +41,8 @@ pub struct BenchArgs {
     /// faces).
     scene: PathBuf,
 
-    /// Which structure: bvh, kdtree, grid, linear, or all.
+    /// Which structures: all, or one or more of bvh, kdtree, grid, linear
+    /// separated by commas (measured in that order).
     #[arg(long, default_value = "all", value_name = "NAME")]
     accel: String,
 
@@ -72,18 +73,28 @@ pub struct BenchArgs {
     quiet: bool,
 }
 
-/// The structures asked for.
-fn kinds(name: &str) -> Result<Vec<AccelKind>, String> {
-    if name == "all" {
+/// The structures asked for: `all`, or names separated by commas, each
+/// at most once, in the order given.
+fn kinds(list: &str) -> Result<Vec<AccelKind>, String> {
+    if list == "all" {
         return Ok(AccelKind::ALL.to_vec());
     }
-    AccelKind::from_name(name).map(|k| vec![k]).ok_or_else(|| {
-        let names: Vec<&str> = AccelKind::ALL.iter().map(AccelKind::name).collect();
-        format!(
-            "--accel {name}: expected all or one of: {}",
-            names.join(", ")
-        )
-    })
+    let mut kinds = Vec::new();
+    for name in list.split(',').map(str::trim) {
+        let Some(kind) = AccelKind::from_name(name) else {
+            let names: Vec<&str> = AccelKind::ALL.iter().map(AccelKind::name).collect();
+            return Err(format!(
+                "--accel {list}: `{name}` is not a structure; expected all, or one or more of {} \
+                 separated by commas",
+                names.join(", ")
+            ));
+        };
+        if kinds.contains(&kind) {
+            return Err(format!("--accel {list}: {name} is named twice"));
+        }
+        kinds.push(kind);
+    }
+    Ok(kinds)
 }
 
 /// The scene to measure: a scene file, or a mesh framed by the anchor
@@ -160,7 +171,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
     let mut reports = Vec::new();
     for &kind in &kinds {
         let work = primitives as f64 * total_rays as f64;
-        if kind == AccelKind::Linear && kinds.len() > 1 && work > LINEAR_BUDGET {
+        if kind == AccelKind::Linear && args.accel == "all" && work > LINEAR_BUDGET {
             if !args.quiet && !args.json {
                 eprintln!(
                     "linear skipped: {primitives} primitives x {total_rays} rays is too much \
@@ -342,4 +353,32 @@ fn to_json(args: &BenchArgs, primitives: usize, threads: usize, reports: &[Accel
         "threads": threads,
         "structures": structures,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn accel_lists_name_structures_in_order() {
+        assert_eq!(kinds("all").unwrap(), AccelKind::ALL.to_vec());
+        assert_eq!(kinds("kdtree").unwrap(), vec![AccelKind::KdTree]);
+        assert_eq!(
+            kinds("bvh, kdtree,linear").unwrap(),
+            vec![AccelKind::Bvh, AccelKind::KdTree, AccelKind::Linear]
+        );
+    }
+
+    #[test]
+    fn unknown_repeated_or_empty_names_are_refused() {
+        for (list, says) in [
+            ("bvh,octree", "`octree` is not a structure"),
+            ("bvh,", "`` is not a structure"),
+            ("", "`` is not a structure"),
+            ("grid,grid", "grid is named twice"),
+        ] {
+            let error = kinds(list).unwrap_err();
+            assert!(error.contains(says), "{list}: {error}");
+        }
+    }
 }

@@ -261,7 +261,7 @@ fn bench_refuses_unknown_structures_and_missing_ray_files() {
     );
     assert!(!out.status.success());
     assert!(
-        stderr(&out).contains("expected all or one of"),
+        stderr(&out).contains("`octree` is not a structure; expected all, or one or more of"),
         "{}",
         stderr(&out)
     );
