@@ -117,6 +117,7 @@ impl RayShear {
     }
 
     /// The axis that becomes z.
+    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     pub(super) fn kz(&self) -> usize {
         self.kz
@@ -124,6 +125,7 @@ impl RayShear {
 
     /// The shear factors: x and y gain `x` and `y` times z, and z is
     /// scaled by `z`.
+    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     pub(super) fn factors(&self) -> Vec3 {
         self.shear
