@@ -193,9 +193,14 @@ impl Aabb {
     }
 
     /// The parameter interval where `ray` is inside the box, clipped to the
-    /// ray's own interval, or `None` if they do not meet. Rays parallel to a
-    /// slab and inside it (or on its faces) are inside.
+    /// ray's own interval, or `None` if they do not meet (always for the
+    /// empty box). Rays parallel to a slab and inside it (or on its faces)
+    /// are inside.
     pub fn intersect_ray(&self, ray: &Ray) -> Option<(f64, f64)> {
+        // Its planes at ±∞ would put every ray inside every slab.
+        if self.is_empty() {
+            return None;
+        }
         let t0 = (self.min - ray.origin) * ray.inv_dir;
         let t1 = (self.max - ray.origin) * ray.inv_dir;
         let mut near = ray.t_min;
@@ -207,11 +212,15 @@ impl Aabb {
             if a.is_nan() || b.is_nan() {
                 continue;
             }
-            // Both ends widened by 2γ(3) so rounding never loses a grazing
-            // hit (pbrt-v4 section 6.8.2), nor culls a primitive whose hit
-            // lies an ulp before the box's computed entry.
-            near = near.max(a.min(b) * (1.0 - 2.0 * gamma(3)));
-            far = far.min(a.max(b) * (1.0 + 2.0 * gamma(3)));
+            // Both ends widened by 2γ(3), away from the interval whatever
+            // their sign (a ray may start at a negative `t_min`), so
+            // rounding never loses a grazing hit (pbrt-v4 section 6.8.2),
+            // nor culls a primitive whose hit lies an ulp before the box's
+            // computed entry.
+            let (low, high) = (a.min(b), a.max(b));
+            let (shrink, grow) = (1.0 - 2.0 * gamma(3), 1.0 + 2.0 * gamma(3));
+            near = near.max(low * if low < 0.0 { grow } else { shrink });
+            far = far.min(high * if high < 0.0 { shrink } else { grow });
         }
         (near <= far).then_some((near, far))
     }
@@ -625,5 +634,31 @@ mod tests {
         assert_eq!(b.intersect_ray(&outside), None);
         let on_face = Ray::new(Vec3::new(0.0, 0.5, -1.0), Vec3::Z);
         assert!(b.intersect_ray(&on_face).is_some());
+    }
+
+    #[test]
+    fn box_slab_test_widens_negative_parameters_outward_too() {
+        // The box lies behind the origin, at t in [-3, -2], and the ray's
+        // interval starts at -10: both ends must be widened away from it.
+        let b = Aabb::new(Vec3::new(-3.0, 0.0, 0.0), Vec3::new(-2.0, 1.0, 1.0));
+        let mut ray = Ray::new(Vec3::new(0.0, 0.5, 0.5), Vec3::X);
+        ray.t_min = -10.0;
+        let (near, far) = b.intersect_ray(&ray).unwrap();
+        assert!(near <= -3.0 && near > -3.0 - 1e-14, "{near}");
+        assert!((-2.0..-2.0 + 1e-14).contains(&far), "{far}");
+        // A ray ending exactly where the box starts still meets it.
+        ray.t_max = -3.0;
+        assert!(b.intersect_ray(&ray).is_some());
+    }
+
+    #[test]
+    fn no_ray_meets_the_empty_box() {
+        for dir in [
+            Vec3::X,
+            Vec3::new(1.0, -2.0, 0.5),
+            Vec3::new(0.0, 0.0, -1.0),
+        ] {
+            assert_eq!(Aabb::EMPTY.intersect_ray(&Ray::new(Vec3::ZERO, dir)), None);
+        }
     }
 }
