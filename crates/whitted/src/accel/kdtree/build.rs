@@ -43,11 +43,12 @@ struct Child {
     count: usize,
 }
 
-/// The depth limit used when none is given: 8 + 1.3 log2 N (pbrt's rule),
-/// within the traversal stack.
+/// The depth limit used when none is given: 4 + 1.3 log2 N (pbrt's rule
+/// is 8 + 1.3 log2 N; see the module doc of `kdtree` for why 4), within
+/// the traversal stack.
 pub(super) fn default_max_depth(count: usize) -> usize {
     let log = (count.max(1) as f64).log2();
-    (8 + (1.3 * log).round() as usize).min(STACK_CAPACITY)
+    (4 + (1.3 * log).round() as usize).min(STACK_CAPACITY)
 }
 
 /// The box primitive `i` with box `b` has in the tree, widened to the `f32`
@@ -103,6 +104,7 @@ pub(super) fn build(
             .max_depth
             .unwrap_or_else(|| default_max_depth(count))
             .min(STACK_CAPACITY),
+        deepest: 0,
         nodes: Vec::new(),
         indices: Vec::new(),
         counters: BuildCounters {
@@ -118,6 +120,7 @@ pub(super) fn build(
         indices,
         bounds,
         loose,
+        max_depth: builder.deepest,
     };
     (tree, builder.counters)
 }
@@ -132,6 +135,8 @@ struct Builder<'c> {
     sides: Vec<Side>,
     costs: Costs,
     max_depth: usize,
+    /// The depth of the deepest leaf built so far.
+    deepest: usize,
     nodes: Vec<KdNode>,
     indices: Vec<u32>,
     counters: BuildCounters,
@@ -151,6 +156,7 @@ impl Builder<'_> {
             None
         };
         let Some(split) = split else {
+            self.deepest = self.deepest.max(depth);
             self.leaf(&events[0]);
             return;
         };
@@ -296,8 +302,8 @@ mod tests {
 
     #[test]
     fn the_depth_limit_is_within_the_stack_for_any_count() {
-        assert_eq!(default_max_depth(0), 8);
-        assert_eq!(default_max_depth(1 << 20), 34);
+        assert_eq!(default_max_depth(0), 4);
+        assert_eq!(default_max_depth(1 << 20), 30);
         assert!(default_max_depth(usize::MAX) <= STACK_CAPACITY);
     }
 

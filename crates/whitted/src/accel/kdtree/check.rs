@@ -11,7 +11,8 @@ use crate::math::Aabb;
 impl KdTree {
     /// Checks the tree against the boxes it was built from:
     /// - its shape: node and primitive indices in range, every node reached
-    ///   exactly once from the root, depth within the traversal stack,
+    ///   exactly once from the root, depth within the one stated (which
+    ///   picks the traversal stack) and within the largest stack,
     ///   every split plane strictly inside its node's cell;
     /// - every primitive reachable: every point of its box lies in a
     ///   (closed) leaf cell that holds it. So each leaf whose cell the box
@@ -71,15 +72,22 @@ impl KdTree {
         self.check_coverage(Some(0), self.bounds, required, boxes, clip)
     }
 
-    /// Checks that the nodes form a tree within the stack's depth, with
+    /// Checks that the nodes form a tree within the stated depth, with
     /// indices in range and every split inside its cell.
     fn check_shape(&self, primitives: usize, aside: &[bool]) -> Result<(), String> {
+        if self.max_depth > STACK_CAPACITY {
+            return Err(format!(
+                "the tree's depth {} is beyond the stack's {STACK_CAPACITY}",
+                self.max_depth
+            ));
+        }
         let mut reached = vec![false; self.nodes.len()];
         let mut pending = vec![(0, self.bounds, 0)];
         while let Some((index, cell, depth)) = pending.pop() {
-            if depth > STACK_CAPACITY {
+            if depth > self.max_depth {
                 return Err(format!(
-                    "node {index} is at depth {depth}, beyond the stack's {STACK_CAPACITY}"
+                    "node {index} is at depth {depth}, beyond the tree's stated {}",
+                    self.max_depth
                 ));
             }
             let node = self

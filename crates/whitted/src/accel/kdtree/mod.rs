@@ -40,43 +40,59 @@
 //! 132 MB instead of 70 MB).
 //!
 //! kd-tree time / BVH time, 1 thread, best of 3 interleaved rounds of
-//! `whitted bench MODEL.obj --rays /tmp/anchor_rays/MODEL --accel bvh`
-//! and `--accel kdtree` (Embree-harness rays), before → after:
+//! `python3 bench.py 3 base=OLD after=NEW`, which runs
+//! `whitted bench MODEL.obj --rays /tmp/anchor_rays/MODEL --runs 3 --json`
+//! with `--accel bvh` and `--accel kdtree` for each binary in turn
+//! (Embree-harness rays; the machine is shared, so cells move by about
+//! 10% between runs). Main at b30b870 (eight-wide BVH) → this version:
 //!
 //! | model | primary | shadow | diffuse |
 //! |---|---|---|---|
-//! | bunny | 1.45 → 1.31 | 1.66 → 1.54 | 2.05 → 1.81 |
-//! | kitchen | 1.11 → 1.13 | 1.43 → 1.46 | 1.25 → 1.21 |
-//! | dragon | 1.45 → 1.26 | 2.02 → 1.75 | 1.92 → 1.53 |
+//! | bunny | 1.57 → 1.24 | 1.84 → 1.54 | 2.44 → 2.07 |
+//! | kitchen | 1.49 → 1.18 | 2.94 → 1.35 | 1.57 → 1.47 |
+//! | dragon | 1.39 → 1.60 | 1.79 → 1.70 | 1.94 → 1.68 |
 //!
-//! Node steps per ray fell by 13 to 17% (bunny diffuse 51.3 → 44.0), the
-//! same primitives are tested; the bunny's nodes 666,665 → 469,697
-//! (6.87 → 5.30 MB with the indices). Build times moved by 2 to 6%
-//! (bunny 720 → 731 ms, kitchen 411 → 438, dragon 4195 → 4280).
-//! Leaving out empty children gave most of the gain on the bunny and the
-//! kitchen; the leaf-ordered corners alone gave nothing measurable on the
-//! bunny and took the dragon's diffuse rays from 0.73 to 0.84 Mrays/s.
+//! (Bunny diffuse: 1.94 in the two runs before, at 1.77 Mrays/s against
+//! the BVH's 3.06 to 3.43; dragon primary: 1.21 to 1.32 in two of four
+//! runs, 1.60 to 1.71 in the other two, not explained.) Three changes:
+//! - The to-do stack is no longer cleared for every ray (1.5 kB): 93
+//!   fewer instructions a ray (callgrind, an eighth of the bunny's rays),
+//!   kitchen shadow rays 8.2 → 11.4 Mrays/s. Its size follows the tree's
+//!   depth (32 entries up to depth 32, else 64), like the BVH's; that
+//!   alone measured the same as an uncleared 64-entry stack.
+//! - The plane crossing has no NaN branch: the tests and bounds are
+//!   written so a NaN crossing keeps both children over the node's range
+//!   (6% fewer instructions on the kitchen's rays).
+//! - The depth limit is 4 + 1.3 log2 N instead of pbrt's 8 + 1.3 log2 N
+//!   (bunny 29 → 25): the same trace speed with fewer, slightly larger
+//!   leaves; nodes 469,697 → 248,868 and references 384k → 275k on the
+//!   bunny (5.30 → 3.09 MB, corners 31 → 22 MB), kitchen 2.87 → 2.14 MB,
+//!   dragon 25.7 → 22.3 MB (1.65M → 1.52M references, corners 132 →
+//!   122 MB); builds 735 → 539 ms, 415 → 342, 4081 → 3798.
+//!
+//! Earlier, empty children left out (above) took node steps per ray down
+//! by 13 to 17% (bunny diffuse 51.3 → 44.0) and the kd/BVH ratios from
+//! 1.45/1.66/2.05 to 1.31/1.54/1.81 on the bunny (against the four-wide
+//! BVH); the leaf-ordered corners alone took the dragon's diffuse rays
+//! from 0.73 to 0.84 Mrays/s and gave nothing measurable on the bunny.
 //!
 //! Where the time goes (perf, bunny): the walk is about four fifths of the
 //! trace time and waits on the node loads (a step is about 3 ns for the
 //! coherent primary rays, about 11 ns for diffuse ones). Tried and not
-//! kept, bunny, 1 thread, same runs:
+//! kept:
 //! - Choosing the next node without a branch (the far child written to
 //!   the stack every step, the next entry picked by a select): primary
 //!   rays 8.2 → 5.6 Mrays/s, kitchen shadow 9.3 → 4.0. The select makes
 //!   each node load wait for the previous step's arithmetic, where a
 //!   predicted branch lets the load start early.
-//! - Stopping earlier: a depth limit of 4 + 1.3 log2 N (25 on the bunny)
-//!   halved the nodes and took the build from 730 to 535 ms, but with
-//!   6.3 instead of 4.6 triangles per diffuse ray it ran at the same speed
-//!   (1.59 against 1.60 Mrays/s); 0 + 1.3 log2 N: diffuse 1.25 against
-//!   1.43. No split of cells of 3 or fewer primitives: the same speed
-//!   (1.62 / 1.60). Cost constants: intersection 3 the same (1.58), an
-//!   empty factor of 0.6 slower (1.31), 1.0 the same.
-//! - A to-do stack of 32 instead of 64 entries (clearing 768 instead of
-//!   1,536 bytes a ray): kitchen shadow rays 9.4 → 10.4 Mrays/s, the
-//!   bunny within noise. Not kept: the dragon's tree needs 34; sizing the
-//!   stack by the tree's depth, as the BVH does, is the next step.
+//! - Stopping still earlier: 0 + 1.3 log2 N: bunny diffuse 1.25 against
+//!   1.43 Mrays/s. No split of cells of 3 or fewer primitives: the same
+//!   speed (1.62 / 1.60). Cost constants: intersection 3 the same (1.58),
+//!   an empty factor of 0.6 slower (1.31), 1.0 the same.
+//! - Any-hit rays without the mailbox: 3% fewer instructions on the
+//!   kitchen, but more triangle tests (bunny 5.01 → 5.76, dragon 5.51 →
+//!   5.91 a shadow ray); kitchen shadow 11.1 → 12.2 Mrays/s, bunny 3.25 →
+//!   3.17, dragon 1.49 → 1.37 (one run of three rounds): no clear gain.
 
 mod build;
 mod check;
@@ -101,7 +117,7 @@ pub struct KdTreeBuildParams {
     /// Multiplies the cost of a split that leaves one side empty (below 1
     /// favours cutting off empty space).
     pub empty_factor: f64,
-    /// Deepest leaf allowed; `None` means 8 + 1.3 log2 N. Always capped at
+    /// Deepest leaf allowed; `None` means 4 + 1.3 log2 N. Always capped at
     /// the traversal stack's 64 entries.
     pub max_depth: Option<usize>,
 }
@@ -130,6 +146,9 @@ pub struct KdTree {
     /// Primitives whose boxes could not be placed, with their boxes (also
     /// at the end of `indices`).
     loose: Vec<(u32, Aabb)>,
+    /// The depth of the deepest leaf (the root's is 0), at most the
+    /// traversal stack's capacity: it picks the stack a walk uses.
+    max_depth: usize,
 }
 
 impl KdTree {

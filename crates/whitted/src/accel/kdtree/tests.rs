@@ -7,6 +7,7 @@
 
 use super::build::default_max_depth;
 use super::node::{KdNode, NodeKind};
+use super::traverse::{SHALLOW, STACK_CAPACITY};
 use super::{KdTree, KdTreeBuildParams};
 use crate::accel::conformance::{assert_conforms, random_boxes};
 use crate::accel::{AccelKind, Accelerator, TraversalCounters};
@@ -414,6 +415,58 @@ fn build_params_bound_the_depth_and_the_cost_model_decides_leaves() {
     let leaf = KdTree::build_with(&boxes, &costly_traversal).stats();
     assert_eq!((leaf.nodes, leaf.references), (1, 2_000));
     assert_eq!(leaf.sah_cost, 2_000.0);
+}
+
+#[test]
+fn trees_deeper_than_the_short_stack_are_walked_like_brute_force() {
+    // Cubes halving towards the origin, each cut off by its own planes: a
+    // chain of splits deeper than the short stack holds.
+    let boxes: Vec<Aabb> = (0..60)
+        .map(|i| {
+            let s = 0.5f64.powi(i);
+            Aabb::new(Vec3::splat(s), Vec3::splat(1.5 * s))
+        })
+        .collect();
+    let deep = KdTreeBuildParams {
+        max_depth: Some(STACK_CAPACITY),
+        ..KdTreeBuildParams::default()
+    };
+    let tree = KdTree::build_with(&boxes, &deep);
+    tree.validate(&boxes).unwrap();
+    assert!(tree.max_depth > SHALLOW, "depth {}", tree.max_depth);
+    assert_eq!(tree.max_depth, tree.stats().max_depth);
+    let accel = Accelerator::KdTree(tree);
+    let oracle = Accelerator::build(AccelKind::Linear, &boxes);
+    let mut rng = Rng::new(23);
+    for i in 0..2_000 {
+        // From far away towards the cubes, and out from among them.
+        let origin = rng.point_in(Vec3::splat(-4.0), Vec3::splat(4.0));
+        let target = Vec3::splat(1.25 * 0.5f64.powi(i % 60));
+        for ray in [
+            Ray::new(origin, target - origin),
+            Ray::new(target * 0.9, origin - target),
+        ] {
+            assert_eq!(
+                trace(&accel, &boxes, &ray),
+                trace(&oracle, &boxes, &ray),
+                "{ray:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn validate_finds_a_tree_deeper_than_it_states() {
+    let mut rng = Rng::new(24);
+    let boxes = random_boxes(&mut rng, 500, 20.0, 1.0);
+    let mut tree = KdTree::build(&boxes);
+    assert!(tree.validate(&boxes).is_ok());
+    tree.max_depth -= 1;
+    let why = tree.validate(&boxes).unwrap_err();
+    assert!(why.contains("beyond the tree's stated"), "{why}");
+    tree.max_depth = STACK_CAPACITY + 1;
+    let why = tree.validate(&boxes).unwrap_err();
+    assert!(why.contains("beyond the stack's"), "{why}");
 }
 
 /// Random triangles on a coarse grid, so many lie flat in or touch split

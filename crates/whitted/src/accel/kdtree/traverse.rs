@@ -24,14 +24,18 @@ use super::node::NodeKind;
 use crate::accel::TraversalCounters;
 use crate::accel::mailbox::Mailbox;
 use crate::math::{Ray, gamma};
+use std::mem::MaybeUninit;
 use std::ops::Range;
 
-/// Entries of the to-do stack: one per level at most, so this bounds the
-/// tree's depth.
+/// Entries of the largest to-do stack: one per level at most, so this
+/// bounds the tree's depth.
 pub(super) const STACK_CAPACITY: usize = 64;
 
+/// Trees at most this deep walk with a stack of this many entries.
+pub(super) const SHALLOW: usize = 32;
+
 /// A node to visit over a parameter range.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 struct Entry {
     node: u32,
     t_min: f64,
@@ -154,9 +158,25 @@ impl KdTree {
 
     /// Calls `leaf` with the positions in [`Self::indices`] of the
     /// primitives of every leaf the ray passes, near to far, until it says
-    /// stop.
+    /// stop; with the smallest stack that holds this tree's depth.
     #[inline]
     fn walk(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        leaf: impl FnMut(Range<usize>, &mut TraversalCounters) -> Flow,
+    ) {
+        if self.max_depth <= SHALLOW {
+            self.walk_with::<SHALLOW>(ray, counters, leaf);
+        } else {
+            self.walk_with::<STACK_CAPACITY>(ray, counters, leaf);
+        }
+    }
+
+    /// [`Self::walk`] with a stack of `N` entries, at least the tree's
+    /// depth.
+    #[inline(always)]
+    fn walk_with<const N: usize>(
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
@@ -170,15 +190,15 @@ impl KdTree {
         };
         let mut horizon = ray.t_max;
         let axes = Axes::new(ray);
-        let mut stack = [Entry::default(); STACK_CAPACITY];
-        let mut pending = 0;
+        let mut work = TraversalCounters::default();
+        let mut stack = Stack::<N>::new();
         let mut entry = Entry {
             node: 0,
             t_min,
             t_max,
         };
         loop {
-            counters.nodes += 1;
+            work.nodes += 1;
             match self.nodes[entry.node as usize].kind() {
                 NodeKind::Interior {
                     axis,
@@ -189,8 +209,7 @@ impl KdTree {
                     let below = if below { entry.node + 1 } else { 0 };
                     match children(&entry, axis, split, [below, above], &axes) {
                         [Some(first), Some(second)] => {
-                            stack[pending] = second;
-                            pending += 1;
+                            stack.push(second);
                             entry = first;
                             continue;
                         }
@@ -203,24 +222,61 @@ impl KdTree {
                 }
                 NodeKind::Leaf { offset, count } => {
                     let start = offset as usize;
-                    match leaf(start..start + count as usize, counters) {
+                    match leaf(start..start + count as usize, &mut work) {
                         Flow::Continue(t) => horizon = t,
-                        Flow::Stop => return,
+                        Flow::Stop => break,
                     }
                 }
             }
             // The next pending cell that starts before the closest hit.
-            loop {
-                if pending == 0 {
-                    return;
-                }
-                pending -= 1;
-                entry = stack[pending];
-                if entry.t_min <= horizon {
-                    break;
-                }
+            let Some(next) = stack.pop_until(|e| e.t_min <= horizon) else {
+                break;
+            };
+            entry = next;
+        }
+        *counters += work;
+    }
+}
+
+/// The to-do stack of `N` entries, its slots written before they are read:
+/// clearing all [`STACK_CAPACITY`] entries (1.5 kB) for every ray cost
+/// more than the walk of a short ray.
+struct Stack<const N: usize> {
+    entries: [MaybeUninit<Entry>; N],
+    len: usize,
+}
+
+impl<const N: usize> Stack<N> {
+    #[inline(always)]
+    fn new() -> Self {
+        Self {
+            entries: [const { MaybeUninit::uninit() }; N],
+            len: 0,
+        }
+    }
+
+    /// Adds an entry on top; the walk pushes at most one per level, so
+    /// never more than the tree's depth.
+    #[inline(always)]
+    fn push(&mut self, entry: Entry) {
+        self.entries[self.len].write(entry);
+        self.len += 1;
+    }
+
+    /// Removes entries from the top until one satisfies `keep`, and returns
+    /// it; `None` once the stack is empty.
+    #[inline(always)]
+    fn pop_until(&mut self, keep: impl Fn(&Entry) -> bool) -> Option<Entry> {
+        while self.len > 0 {
+            self.len -= 1;
+            // SAFETY: the slots below the old `len` were written by `push`,
+            // and entries are `Copy`.
+            let entry = unsafe { self.entries[self.len].assume_init() };
+            if keep(&entry) {
+                return Some(entry);
             }
         }
+        None
     }
 }
 
@@ -241,23 +297,33 @@ impl Axes {
     }
 }
 
-/// The smaller of two numbers, neither NaN (`minsd`; `f64::min` also
-/// handles NaN, with three more instructions).
+/// The smaller of two numbers, `b` if either is NaN (`minsd`; `f64::min`
+/// returns the other one, with three more instructions).
 #[inline(always)]
 fn min(a: f64, b: f64) -> f64 {
     if a < b { a } else { b }
 }
 
-/// The larger of two numbers, neither NaN.
+/// The larger of two numbers, `b` if either is NaN.
 #[inline(always)]
 fn max(a: f64, b: f64) -> f64 {
     if a > b { a } else { b }
 }
 
+/// `a >= b`, also true when either is NaN.
+#[inline(always)]
+#[allow(
+    clippy::neg_cmp_op_on_partial_ord,
+    reason = "a NaN crossing must pass the test"
+)]
+fn at_least(a: f64, b: f64) -> bool {
+    !(a < b)
+}
+
 /// The children of the interior node `entry` that the ray meets, in the
 /// order it meets them, each with its parameter range (never NaN: the
-/// root's range comes from a box test, and a crossing that is NaN is
-/// replaced by infinities). `[below, above]` are the children's indices,
+/// root's range comes from a box test, and a crossing that is NaN keeps
+/// the node's range). `[below, above]` are the children's indices,
 /// 0 for one that is not stored (and so never met).
 #[inline]
 fn children(
@@ -269,15 +335,13 @@ fn children(
 ) -> [Option<Entry>; 2] {
     let inv_dir = ray.inv_dir[axis];
     let t_plane = (f64::from(split) - ray.origin[axis]) * inv_dir;
-    // The crossing's rounding error is below γ(3) relative; NaN means the
-    // ray lies in the plane (0 · ∞), so it is in both children throughout.
-    let (t_low, t_high) = if t_plane.is_nan() {
-        (f64::NEG_INFINITY, f64::INFINITY)
-    } else {
-        let a = t_plane * (1.0 - 2.0 * gamma(3));
-        let b = t_plane * (1.0 + 2.0 * gamma(3));
-        (min(a, b), max(a, b))
-    };
+    // The crossing's rounding error is below γ(3) relative. A NaN crossing
+    // means the ray lies in the plane (0 · ∞), so it is in both children
+    // throughout: every test below is written so that NaN passes it and
+    // every bound so that NaN leaves the node's own.
+    let a = t_plane * (1.0 - 2.0 * gamma(3));
+    let b = t_plane * (1.0 + 2.0 * gamma(3));
+    let (t_low, t_high) = (min(a, b), max(a, b));
     // A ray going up (or along the plane with a +0 direction, whose
     // crossing is ±∞) meets the below child first.
     let (first, second) = if inv_dir.is_sign_negative() {
@@ -285,14 +349,14 @@ fn children(
     } else {
         (below, above)
     };
-    let near = (first != 0 && entry.t_min <= t_high).then_some(Entry {
+    let near = (first != 0 && at_least(t_high, entry.t_min)).then_some(Entry {
         node: first,
         t_min: entry.t_min,
-        t_max: min(entry.t_max, t_high),
+        t_max: min(t_high, entry.t_max),
     });
-    let far = (second != 0 && t_low <= entry.t_max).then_some(Entry {
+    let far = (second != 0 && at_least(entry.t_max, t_low)).then_some(Entry {
         node: second,
-        t_min: max(entry.t_min, t_low),
+        t_min: max(t_low, entry.t_min),
         t_max: entry.t_max,
     });
     [near, far]
@@ -313,6 +377,13 @@ mod tests {
 
     fn nodes(children: [Option<Entry>; 2]) -> Vec<u32> {
         children.iter().flatten().map(|e| e.node).collect()
+    }
+
+    #[test]
+    fn at_least_passes_nan_and_equal_values() {
+        assert!(at_least(2.0, 1.0) && at_least(1.0, 1.0) && !at_least(0.5, 1.0));
+        assert!(at_least(f64::NAN, 1.0) && at_least(1.0, f64::NAN));
+        assert_eq!((min(f64::NAN, 3.0), max(f64::NAN, 3.0)), (3.0, 3.0));
     }
 
     #[test]
