@@ -27,6 +27,7 @@ pub mod grid;
 pub mod kdtree;
 pub mod linear;
 mod mailbox;
+mod stack;
 
 #[cfg(test)]
 pub(crate) mod conformance;

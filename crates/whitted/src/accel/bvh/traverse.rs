@@ -100,7 +100,6 @@
 //! closures, compiled without AVX, were calls (6% of the instructions)
 //! until written out.
 
-use std::mem::MaybeUninit;
 use std::ops::Range;
 
 use super::node::{BvhNode, WIDTH, round_up};
@@ -109,6 +108,7 @@ use super::slabs::{Halves, Planes, SlabTest};
 use super::slabs_avx::Avx;
 use super::{Bvh, MAX_DEPTH};
 use crate::accel::TraversalCounters;
+use crate::accel::stack::Stack;
 use crate::math::Ray;
 
 /// Entries the stack needs for a tree whose leaves lie at most `depth` deep:
@@ -145,57 +145,21 @@ fn child_entry(node: &BvhNode, slot: usize, near: &[f32; WIDTH]) -> Entry {
     }
 }
 
-/// A traversal stack of `N` entries, its slots written before they are
-/// read: clearing it for every ray took 4% of the instructions on the
-/// bunny's rays.
-struct Stack<const N: usize> {
-    entries: [MaybeUninit<Entry>; N],
-    len: usize,
-}
-
-impl<const N: usize> Stack<N> {
-    #[inline(always)]
-    fn new() -> Self {
-        Self {
-            entries: [const { MaybeUninit::uninit() }; N],
-            len: 0,
-        }
-    }
-
-    #[inline(always)]
-    fn push(&mut self, entry: Entry) {
-        self.entries[self.len].write(entry);
-        self.len += 1;
-    }
-
-    #[inline(always)]
-    fn pop(&mut self) -> Option<Entry> {
-        self.len = self.len.checked_sub(1)?;
-        // SAFETY: slots below `len` have been written (by `push` or
-        // `push_sorted`), and entries are `Copy`.
-        Some(unsafe { self.entries[self.len].assume_init() })
-    }
-
-    /// Pushes the children in `mask` so that the nearest ends on top;
-    /// sorting them in place: building them in a separate array and
-    /// copying it over stalled on store forwarding (16% of the walk's
-    /// samples on the bunny).
-    #[inline(always)]
-    fn push_sorted(&mut self, node: &BvhNode, mask: u32, near: &[f32; WIDTH]) {
-        let base = self.len;
-        let mut bits = mask;
-        while bits != 0 {
-            let entry = child_entry(node, bits.trailing_zeros() as usize, near);
-            bits &= bits - 1;
-            let mut j = self.len;
-            // SAFETY: `base <= j - 1 < len`, written above in this call.
-            while j > base && unsafe { self.entries[j - 1].assume_init() }.t < entry.t {
-                self.entries[j] = self.entries[j - 1];
-                j -= 1;
-            }
-            self.entries[j].write(entry);
-            self.len += 1;
-        }
+/// Pushes the children of `node` in `mask` on `stack` so that the nearest
+/// ends on top.
+#[inline(always)]
+fn push_sorted<const N: usize>(
+    stack: &mut Stack<Entry, N>,
+    node: &BvhNode,
+    mask: u32,
+    near: &[f32; WIDTH],
+) {
+    let floor = stack.len();
+    let mut bits = mask;
+    while bits != 0 {
+        let entry = child_entry(node, bits.trailing_zeros() as usize, near);
+        bits &= bits - 1;
+        stack.insert_above(floor, entry, |new, other| other.t < new.t);
     }
 }
 
@@ -285,7 +249,7 @@ impl Bvh {
         let mut far = round_up(closest);
         let mut found = None;
         let mut work = TraversalCounters::default();
-        let mut stack = Stack::<N>::new();
+        let mut stack = Stack::<Entry, N>::new();
         let mut current = Entry::default();
         loop {
             work.nodes += 1;
@@ -316,7 +280,7 @@ impl Bvh {
                 }
                 if mask != 0 {
                     // All but the nearest stay on the stack.
-                    stack.push_sorted(node, mask, &near);
+                    push_sorted(&mut stack, node, mask, &near);
                     current = stack.pop().unwrap_or_default();
                     continue;
                 }
@@ -412,7 +376,7 @@ impl Bvh {
         let slabs = S::new(&Planes::new(ray));
         let far = round_up(ray.t_max);
         let mut work = TraversalCounters::default();
-        let mut stack = Stack::<N>::new();
+        let mut stack = Stack::<Entry, N>::new();
         let mut current = Entry::default();
         let occluded = loop {
             work.nodes += 1;

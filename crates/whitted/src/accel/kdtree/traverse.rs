@@ -23,8 +23,8 @@ use super::KdTree;
 use super::node::NodeKind;
 use crate::accel::TraversalCounters;
 use crate::accel::mailbox::Mailbox;
+use crate::accel::stack::Stack;
 use crate::math::{Ray, gamma};
-use std::mem::MaybeUninit;
 use std::ops::Range;
 
 /// Entries of the largest to-do stack: one per level at most, so this
@@ -191,7 +191,7 @@ impl KdTree {
         let mut horizon = ray.t_max;
         let axes = Axes::new(ray);
         let mut work = TraversalCounters::default();
-        let mut stack = Stack::<N>::new();
+        let mut stack = Stack::<Entry, N>::new();
         let mut entry = Entry {
             node: 0,
             t_min,
@@ -229,54 +229,12 @@ impl KdTree {
                 }
             }
             // The next pending cell that starts before the closest hit.
-            let Some(next) = stack.pop_until(|e| e.t_min <= horizon) else {
+            let Some(next) = std::iter::from_fn(|| stack.pop()).find(|e| e.t_min <= horizon) else {
                 break;
             };
             entry = next;
         }
         *counters += work;
-    }
-}
-
-/// The to-do stack of `N` entries, its slots written before they are read:
-/// clearing all [`STACK_CAPACITY`] entries (1.5 kB) for every ray cost
-/// more than the walk of a short ray.
-struct Stack<const N: usize> {
-    entries: [MaybeUninit<Entry>; N],
-    len: usize,
-}
-
-impl<const N: usize> Stack<N> {
-    #[inline(always)]
-    fn new() -> Self {
-        Self {
-            entries: [const { MaybeUninit::uninit() }; N],
-            len: 0,
-        }
-    }
-
-    /// Adds an entry on top; the walk pushes at most one per level, so
-    /// never more than the tree's depth.
-    #[inline(always)]
-    fn push(&mut self, entry: Entry) {
-        self.entries[self.len].write(entry);
-        self.len += 1;
-    }
-
-    /// Removes entries from the top until one satisfies `keep`, and returns
-    /// it; `None` once the stack is empty.
-    #[inline(always)]
-    fn pop_until(&mut self, keep: impl Fn(&Entry) -> bool) -> Option<Entry> {
-        while self.len > 0 {
-            self.len -= 1;
-            // SAFETY: the slots below the old `len` were written by `push`,
-            // and entries are `Copy`.
-            let entry = unsafe { self.entries[self.len].assume_init() };
-            if keep(&entry) {
-                return Some(entry);
-            }
-        }
-        None
     }
 }
 
