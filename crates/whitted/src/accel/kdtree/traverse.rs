@@ -354,31 +354,25 @@ mod tests {
         }
     }
 
+    /// The children, below 11 and above 20 of the plane x = 2, that `ray`
+    /// visits over `(t_min, t_max)`, in order.
+    fn visited(ray: &Ray, t_min: f64, t_max: f64) -> Vec<u32> {
+        nodes(children(
+            &entry(t_min, t_max),
+            0,
+            2.0,
+            [11, 20],
+            &Axes::new(ray),
+        ))
+    }
+
     #[test]
     fn a_ray_parallel_to_the_plane_visits_only_its_side() {
         for dir in [Vec3::Y, Vec3::new(-0.0, 1.0, 0.0)] {
             let below = Ray::new(Vec3::new(1.5, 0.0, 0.0), dir);
-            assert_eq!(
-                nodes(children(
-                    &entry(1.0, 5.0),
-                    0,
-                    2.0,
-                    [11, 20],
-                    &Axes::new(&below)
-                )),
-                [11]
-            );
+            assert_eq!(visited(&below, 1.0, 5.0), [11]);
             let above = Ray::new(Vec3::new(2.5, 0.0, 0.0), dir);
-            assert_eq!(
-                nodes(children(
-                    &entry(1.0, 5.0),
-                    0,
-                    2.0,
-                    [11, 20],
-                    &Axes::new(&above)
-                )),
-                [20]
-            );
+            assert_eq!(visited(&above, 1.0, 5.0), [20]);
         }
     }
 
@@ -386,57 +380,12 @@ mod tests {
     fn crossings_at_the_range_ends_visit_both_children() {
         // The ray crosses x = 2 at t = 2.
         let up = Ray::new(Vec3::ZERO, Vec3::X);
-        assert_eq!(
-            nodes(children(
-                &entry(2.0, 5.0),
-                0,
-                2.0,
-                [11, 20],
-                &Axes::new(&up)
-            )),
-            [11, 20]
-        );
-        assert_eq!(
-            nodes(children(
-                &entry(0.0, 2.0),
-                0,
-                2.0,
-                [11, 20],
-                &Axes::new(&up)
-            )),
-            [11, 20]
-        );
-        assert_eq!(
-            nodes(children(
-                &entry(0.0, 1.5),
-                0,
-                2.0,
-                [11, 20],
-                &Axes::new(&up)
-            )),
-            [11]
-        );
-        assert_eq!(
-            nodes(children(
-                &entry(2.5, 5.0),
-                0,
-                2.0,
-                [11, 20],
-                &Axes::new(&up)
-            )),
-            [20]
-        );
+        assert_eq!(visited(&up, 2.0, 5.0), [11, 20]);
+        assert_eq!(visited(&up, 0.0, 2.0), [11, 20]);
+        assert_eq!(visited(&up, 0.0, 1.5), [11]);
+        assert_eq!(visited(&up, 2.5, 5.0), [20]);
         let down = Ray::new(Vec3::new(4.0, 0.0, 0.0), -Vec3::X);
-        assert_eq!(
-            nodes(children(
-                &entry(0.0, 2.0),
-                0,
-                2.0,
-                [11, 20],
-                &Axes::new(&down)
-            )),
-            [20, 11]
-        );
+        assert_eq!(visited(&down, 0.0, 2.0), [20, 11]);
     }
 
     #[test]
