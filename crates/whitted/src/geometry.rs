@@ -139,7 +139,6 @@ impl<'a> Geometry<'a> {
                 .sum::<usize>();
         let mut refs = Vec::with_capacity(n);
         let mut bounded = Vec::with_capacity(n);
-        let mut slot_triangles = Vec::with_capacity(n);
         let mut unbounded = Vec::new();
         let mut boxes = Vec::with_capacity(n);
         let to_world = |transform: Option<TransformId>, local: Aabb| match transform {
@@ -151,12 +150,6 @@ impl<'a> Geometry<'a> {
             if local.is_finite() {
                 boxes.push(to_world(p.transform, local));
                 bounded.push(refs.len() as u32);
-                // An untransformed triangle shape takes the mesh triangles'
-                // path: the same watertight test on the same corners.
-                slot_triangles.push(match (&p.shape, p.transform) {
-                    (Shape::Triangle(t), None) => Some(t.vertices()),
-                    _ => None,
-                });
             } else {
                 unbounded.push(refs.len() as u32);
             }
@@ -174,8 +167,6 @@ impl<'a> Geometry<'a> {
             };
             let first = refs.len() as u32;
             boxes.par_extend(triangles().map(|t| to_world(m.transform, mesh.triangle_bounds(t))));
-            slot_triangles
-                .par_extend(triangles().map(|t| m.transform.is_none().then(|| mesh.corners(t))));
             bounded.extend(first..first + mesh.len() as u32);
             refs.extend(
                 (0..mesh.len() as u32).map(|triangle| PrimitiveRef::Triangle {
@@ -190,24 +181,49 @@ impl<'a> Geometry<'a> {
             .collect::<Vec<Aabb>>()
             .iter()
             .fold(Aabb::EMPTY, |a, b| a.union(b));
+        // The corners of the primitive in structure slot `slot` if it is an
+        // untransformed triangle. A triangle shape then takes the mesh
+        // triangles' path: the same watertight test on the same corners.
+        let slot_corners = |slot: u32| match refs[bounded[slot as usize] as usize] {
+            PrimitiveRef::Shape(i) => match &scene.primitives[i as usize] {
+                Primitive {
+                    shape: Shape::Triangle(t),
+                    transform: None,
+                    ..
+                } => Some(t.vertices()),
+                _ => None,
+            },
+            PrimitiveRef::Triangle { instance, triangle } => {
+                let m = &scene.mesh_instances[instance as usize];
+                let mesh = &scene.meshes[m.mesh.0 as usize];
+                m.transform.is_none().then(|| mesh.corners(triangle))
+            }
+        };
         // Perfect splits for the kd-tree: an untransformed triangle's
         // bounds in a cell are those of its part inside the cell; other
         // primitives keep their box ∩ the cell.
-        let clip = |slot: u32, cell: &Aabb| match slot_triangles[slot as usize] {
+        let clip = |slot: u32, cell: &Aabb| match slot_corners(slot) {
             Some(c) => clipped_triangle_bounds(c, cell),
             None => boxes[slot as usize].intersection(cell),
         };
         let accel = Accelerator::build_clipped(kind, &boxes, &clip);
-        let has_triangles = slot_triangles.iter().any(Option::is_some);
-        let in_order = |indices: &[u32]| {
-            let corners = indices.iter().map(|&slot| slot_triangles[slot as usize]);
-            corners.collect()
+        // Gathered straight from the scene, in parallel, in the order the
+        // queries name them: per entry of a BVH's or kd-tree's index
+        // array, per slot for the other structures. Copying them in slot
+        // order first, then to this order, made the dragon's BVH build 5%
+        // slower (324 against 307 ms, best of 15).
+        let order = match &accel {
+            Accelerator::Bvh(bvh) => Some(bvh.indices()),
+            Accelerator::KdTree(kd) => Some(kd.indices()),
+            _ => None,
         };
-        let corners = match &accel {
-            Accelerator::Bvh(bvh) => in_order(bvh.indices()),
-            Accelerator::KdTree(kd) => in_order(kd.indices()),
-            _ => slot_triangles,
-        };
+        let entries = order.map_or(bounded.len(), <[u32]>::len);
+        let corners: Vec<_> = (0..entries)
+            .into_par_iter()
+            .with_min_len(PARALLEL_CHUNK)
+            .map(|entry| slot_corners(order.map_or(entry as u32, |o| o[entry])))
+            .collect();
+        let has_triangles = corners.par_iter().any(Option::is_some);
         Self {
             primitives: &scene.primitives,
             instances: &scene.mesh_instances,
