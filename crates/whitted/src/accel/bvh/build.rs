@@ -104,7 +104,7 @@ pub(super) fn build(boxes: &[Aabb], params: &BvhBuildParams) -> (Vec<BvhNode>, V
         .map(FBox::outward)
         .collect();
     let mut indices: Vec<u32> = (0..n as u32).collect();
-    let mut scratch = vec![BinaryNode::default(); 2 * n - 1];
+    let mut scratch = BinaryNode::zeroed_vec(2 * n - 1);
     let (root, below) = scratch.split_at_mut(1);
     let (bounds, centroid_bounds) = bounds_of(&boxes);
     let task = Subtree {

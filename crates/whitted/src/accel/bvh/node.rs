@@ -6,6 +6,7 @@
 //! the exact boxes below it and culling against it stays conservative.
 
 use crate::math::{Aabb, Vec3};
+use std::alloc::{Layout, alloc_zeroed, handle_alloc_error};
 
 /// Children per node of a [`super::Bvh`].
 pub const WIDTH: usize = 8;
@@ -102,6 +103,30 @@ impl BinaryNode {
         }
     }
 
+    /// `len` nodes, each the default (all bits zero), in memory the
+    /// allocator hands out zeroed: the system maps its pages in as the
+    /// build first writes them, on the threads that write them, and never
+    /// those of slots no subtree uses. Filling the dragon's 1.7M slots
+    /// with `vec!` took 35 ms on one thread before the build started.
+    pub fn zeroed_vec(len: usize) -> Vec<Self> {
+        let Ok(layout) = Layout::array::<Self>(len) else {
+            panic!("{len} BVH build nodes do not fit in memory");
+        };
+        if layout.size() == 0 {
+            return Vec::new();
+        }
+        // SAFETY: the layout's size is not zero.
+        let ptr = unsafe { alloc_zeroed(layout) }.cast::<Self>();
+        if ptr.is_null() {
+            handle_alloc_error(layout);
+        }
+        // SAFETY: `ptr` was allocated by the global allocator with the
+        // layout of `len` nodes, and all-zero bits are a valid node (its
+        // fields are `f32`s and `u32`s, for which they mean 0, and it has
+        // no padding), so the `len` elements are initialised.
+        unsafe { Vec::from_raw_parts(ptr, len, len) }
+    }
+
     /// True for a leaf.
     pub fn is_leaf(&self) -> bool {
         self.count != 0
@@ -136,6 +161,15 @@ mod tests {
     fn a_node_is_256_bytes_on_a_cache_line_boundary() {
         assert_eq!(size_of::<BvhNode>(), 256);
         assert_eq!(align_of::<BvhNode>(), 64);
+    }
+
+    #[test]
+    fn zeroed_nodes_are_default_nodes() {
+        assert_eq!(
+            BinaryNode::zeroed_vec(1000),
+            vec![BinaryNode::default(); 1000]
+        );
+        assert!(BinaryNode::zeroed_vec(0).is_empty());
     }
 
     #[test]
