@@ -99,6 +99,17 @@
 //! compiler mixed scalar and vector code; and the ray setup's `array::map`
 //! closures, compiled without AVX, were calls (6% of the instructions)
 //! until written out.
+//!
+//! Also tried on the eight-wide tree and not kept (bunny, 1 thread, best of
+//! interleaved runs): an SAH that prices leaves by blocks of four
+//! triangles (for a four-at-once test) made a third of the leaves and
+//! nodes, but 11.5 instead of 3.8 triangles per diffuse ray, and diffuse
+//! rays ran at 2.6 to 3.2 instead of 3.5 Mrays/s with or without testing
+//! closest hits four at a time; collapsing subtrees of up to four
+//! triangles into one leaf halved the nodes (12,373 to 6,008) but took
+//! nodes per diffuse ray only from 10.0 to 9.4 and triangles from 3.8 to
+//! 4.8, at the same speed: half-full nodes lie near the leaves, where few
+//! rays go.
 
 use std::ops::Range;
 
