@@ -51,7 +51,7 @@ pub fn trace_all(geometry: &Geometry, set: &RaySet) -> (TraceResults, TraversalC
 /// The best time in seconds of `runs` passes (after one warm-up pass) over
 /// the ray set on a pool of `threads` threads.
 ///
-/// Each thread takes the next [`CHUNK`] rays from a shared counter until
+/// Each thread takes the next 256 rays from a shared counter until
 /// none are left, as the anchor harness hands out its tiles. Rayon's
 /// `par_chunks` (halving the set and stealing) made the bunny's diffuse rays
 /// scale 1.84x on two threads against 1.98x this way (median of eight
