@@ -77,15 +77,39 @@
 //! from 0.73 to 0.84 Mrays/s and gave nothing measurable on the bunny.
 //!
 //! Where the time goes (perf, bunny): the walk is about four fifths of the
-//! trace time and waits on the node loads (a step is about 3 ns for the
-//! coherent primary rays, about 11 ns for diffuse ones). 92% of the
-//! bunny's diffuse rays leave it without a hit, and one of them takes 42
-//! steps: 3.8 nodes where it meets both children, 33.6 where it meets
-//! one (13.8 of them nodes with one stored child), 2.8 where it meets
-//! none, 1.8 leaves. Its 6.3 primitive tests are a tenth of its time: the
-//! walk alone, every test skipped, runs at 1.9 Mrays/s against 1.74 with
-//! them (counted and timed with throwaway instrumentation). Tried and
-//! not kept:
+//! trace time (a step is about 3 ns for the coherent primary rays, about
+//! 11 ns for diffuse ones). 92% of the bunny's diffuse rays leave it
+//! without a hit, and one of them takes 42 steps: 16.6 at nodes with one
+//! stored child (13.8 meeting it, 2.8 dead ends; only 2.6 of them right
+//! after another such node, so merging runs of empty-space cuts into one
+//! node would save few steps), 23.6 at nodes with two
+//! (7.5 meeting only the near one, 12.3 only the far one, 3.8 both), 1.8
+//! leaves. Its 6.3 primitive tests are a tenth of its time: the walk
+//! alone, every test skipped, runs at 1.9 Mrays/s against 1.74 with them
+//! (counted and timed with throwaway instrumentation).
+//!
+//! The steps do not wait on memory: replaying the nodes a diffuse ray
+//! reads (the first 203k anchor rays) through a simulated cache, a ray
+//! touches 20.4 lines of nodes, of which 1.7 miss a 32 kB 8-way L1 and
+//! 0.08 a 1 MB L2. What a step waits on can be learnt: the first 256
+//! diffuse rays traced 792 times over run at 6.0 to 8.0 Mrays/s against
+//! 1.6 for the 203k different ones (the BVH: 6.5 to 7.9 against 3.5;
+//! one run of each, both ray slots of the bench), and with the nodes
+//! in L1 that leaves the branch predictor. Which child a diffuse ray goes
+//! to is close to a coin flip (near only 7.5, far only 12.3 a ray), and
+//! the walk needs that choice to be a branch (below). Tried and not kept:
+//! - One decision per node: whether the ray meets the below and the above
+//!   child computed without branches, the ray's direction on the axis
+//!   read from a per-ray mask instead of branched on, then one branch on
+//!   the pair: bunny diffuse 1.65 against 1.70 Mrays/s (medians of 12
+//!   interleaved runs); with the direction still a branch, 1.63 against
+//!   1.62.
+//! - The near child picked by a conditional move on that per-ray mask
+//!   (the met/not-met tests still branches): 1.60 against 1.70 (16 runs).
+//! - The met/not-met tests on the crossing itself, against the node's
+//!   range widened by 4γ(3), which takes two multiplications and a
+//!   min/max off the path from the node load to the branch: 1.64 against
+//!   1.65 (28 runs).
 //! - Choosing the next node without a branch (the far child written to
 //!   the stack every step, the next entry picked by a select): primary
 //!   rays 8.2 → 5.6 Mrays/s, kitchen shadow 9.3 → 4.0. The select makes
