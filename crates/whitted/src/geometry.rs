@@ -86,18 +86,16 @@ pub struct Geometry<'a> {
     refs: Vec<PrimitiveRef>,
     accel: Accelerator,
     bounds: Aabb,
-    bounded: Vec<u32>,
-    /// The corners of each untransformed triangle, of a mesh or a triangle
-    /// shape (`None` for other primitives), in the order the structure's queries name them: per
+    /// Each primitive the structure's queries name, in their order: per
     /// structure slot, or for a BVH or a kd-tree per entry of its index
-    /// array, so that a leaf's triangles lie together. The hot case reaches its vertices
-    /// without going through `refs`, the instance and the mesh's index
-    /// array (same test, same result). Tried and not kept before this:
-    /// renumbering the BVH's primitives to leaf order in its build, no
-    /// measurable change on the bunny (10.5/3.4/2.65 Mrays/s either way),
-    /// a slower build.
-    corners: Vec<Option<[Vec3; 3]>>,
-    /// Whether some entry of `corners` is a triangle, so queries compute
+    /// array, so that a leaf's triangles lie together. The hot case reaches
+    /// its vertices without going through `refs`, the instance and the
+    /// mesh's index array (same test, same result). Tried and not kept
+    /// before this: renumbering the BVH's primitives to leaf order in its
+    /// build, no measurable change on the bunny (10.5/3.4/2.65 Mrays/s
+    /// either way), a slower build.
+    entries: Vec<EntryPrimitive>,
+    /// Whether some entry of `entries` is a triangle, so queries compute
     /// the ray's shear up front.
     has_triangles: bool,
     /// Whether the processor has AVX, so the BVH's leaves test runs of
@@ -105,6 +103,47 @@ pub struct Geometry<'a> {
     #[cfg(target_arch = "x86_64")]
     wide_triangles: bool,
     unbounded: Vec<u32>,
+}
+
+/// The primitive of one entry of [`Geometry::entries`]: its number, and
+/// its corners when it is an untransformed triangle (of a mesh or a
+/// triangle shape, which then takes the mesh triangles' path: the same
+/// watertight test on the same corners). The number shares the corners'
+/// 80 bytes, so a hit reads it from the line its test read. Looking it up
+/// through the structure's index array and the slots' numbers, two random
+/// reads, took a fifth of the dragon's triangle-test time on diffuse rays
+/// (perf); without them its diffuse rays run at 1.79 against 1.67 Mrays/s
+/// with the BVH and 0.94 against 0.89 with the kd-tree (1 thread, medians
+/// of 10 and 8 interleaved runs; the bunny's, whose data stay in cache,
+/// within noise).
+#[derive(Clone, Copy, Debug)]
+struct EntryPrimitive {
+    /// The primitive's number (its index in `Geometry::refs`).
+    number: u32,
+    /// Whether `corners` holds a triangle's.
+    triangle: bool,
+    /// The triangle's corners, zero for other primitives.
+    corners: [Vec3; 3],
+}
+
+const _: () = assert!(size_of::<EntryPrimitive>() == 80);
+
+impl EntryPrimitive {
+    /// The entry of primitive `number`, with the corners if it is an
+    /// untransformed triangle.
+    fn new(number: u32, corners: Option<[Vec3; 3]>) -> Self {
+        Self {
+            number,
+            triangle: corners.is_some(),
+            corners: corners.unwrap_or([Vec3::ZERO; 3]),
+        }
+    }
+
+    /// The corners, if the primitive is an untransformed triangle.
+    #[inline(always)]
+    fn corners(&self) -> Option<&[Vec3; 3]> {
+        self.triangle.then_some(&self.corners)
+    }
 }
 
 /// A world-space ray with what the triangle test needs of it, computed once
@@ -230,13 +269,16 @@ impl<'a> Geometry<'a> {
             Accelerator::KdTree(kd) => Some(kd.indices()),
             _ => None,
         };
-        let entries = order.map_or(bounded.len(), <[u32]>::len);
-        let corners: Vec<_> = (0..entries)
+        let count = order.map_or(bounded.len(), <[u32]>::len);
+        let entries: Vec<_> = (0..count)
             .into_par_iter()
             .with_min_len(PARALLEL_CHUNK)
-            .map(|entry| slot_corners(order.map_or(entry as u32, |o| o[entry])))
+            .map(|entry| {
+                let slot = order.map_or(entry as u32, |o| o[entry]);
+                EntryPrimitive::new(bounded[slot as usize], slot_corners(slot))
+            })
             .collect();
-        let has_triangles = corners.par_iter().any(Option::is_some);
+        let has_triangles = entries.par_iter().any(|e| e.triangle);
         Self {
             primitives: &scene.primitives,
             instances: &scene.mesh_instances,
@@ -245,8 +287,7 @@ impl<'a> Geometry<'a> {
             refs,
             accel,
             bounds,
-            bounded,
-            corners,
+            entries,
             has_triangles,
             #[cfg(target_arch = "x86_64")]
             wide_triangles: is_x86_feature_detected!("avx"),
@@ -294,36 +335,31 @@ impl<'a> Geometry<'a> {
         }
     }
 
-    /// The primitive of entry `entry` of `corners` hit by the query's ray,
-    /// closer than `t_max`, recorded in `best`; returns its `t`. `slot`
-    /// gives an entry's structure slot. The primitive's number is looked up
-    /// only for a hit or a primitive that is not a plain mesh triangle:
-    /// that load, for every triangle tested, was a random access into
-    /// `bounded`.
+    /// The primitive of entry `entry` of `entries` hit by the query's ray,
+    /// closer than `t_max`, recorded in `best`; returns its `t`.
     #[inline(always)]
     fn hit_entry(
         &self,
         entry: u32,
-        slot: impl Fn(u32) -> u32,
         query: &Query,
         t_max: f64,
         best: &mut Option<Hit>,
     ) -> Option<f64> {
-        let number = |entry| self.bounded[slot(entry) as usize];
-        let h = match &self.corners[entry as usize] {
+        let e = &self.entries[entry as usize];
+        let h = match e.corners() {
             Some(corners) => intersect_triangle(corners, query, t_max),
-            None => self.intersect_primitive(number(entry), query, t_max),
+            None => self.intersect_primitive(e.number, query, t_max),
         }?;
         *best = Some(Hit {
-            primitive: number(entry),
+            primitive: e.number,
             shape_hit: h,
         });
         Some(h.t)
     }
 
-    /// The closest of the primitives of entries `entries` of `corners` hit
-    /// by the query's ray, closer than `t_max`, recorded in `best`; returns
-    /// its `t` (`slot` as for [`Self::hit_entry`]). One by one: testing runs
+    /// The closest of the primitives of entries `entries` of
+    /// [`Self::entries`] hit by the query's ray, closer than `t_max`,
+    /// recorded in `best`; returns its `t`. One by one: testing runs
     /// of triangles four at a time as [`Self::leaf_occludes`] does made
     /// the bunny's primary and diffuse rays 10% and 6% slower (1 thread,
     /// best of four interleaved runs), with 5% more instructions.
@@ -331,14 +367,13 @@ impl<'a> Geometry<'a> {
     fn hit_leaf(
         &self,
         entries: Range<u32>,
-        slot: impl Fn(u32) -> u32 + Copy,
         query: &Query,
         mut t_max: f64,
         best: &mut Option<Hit>,
     ) -> Option<f64> {
         let mut found = None;
         for entry in entries {
-            if let Some(t) = self.hit_entry(entry, slot, query, t_max, best) {
+            if let Some(t) = self.hit_entry(entry, query, t_max, best) {
                 t_max = t;
                 found = Some(t);
             }
@@ -346,20 +381,15 @@ impl<'a> Geometry<'a> {
         found
     }
 
-    /// True when a primitive of entries `entries` of `corners` lies in the
-    /// query's ray interval (`slot` as for [`Self::hit_entry`]). Where the
+    /// True when a primitive of entries `entries` of [`Self::entries`] lies
+    /// in the query's ray interval. Where the
     /// processor has AVX, runs of two to four triangles are tested at once,
     /// with the same answers as one by one (see [`Self::triangle_run`]):
     /// the same instructions on the bunny's shadow rays (callgrind), 18%
     /// faster (5.74 against 4.84 Mrays/s, 1 thread, best of four
     /// interleaved runs), having fewer branches on the edge tests' signs.
     #[inline(always)]
-    fn leaf_occludes(
-        &self,
-        entries: Range<u32>,
-        slot: impl Fn(u32) -> u32 + Copy,
-        query: &Query,
-    ) -> bool {
+    fn leaf_occludes(&self, entries: Range<u32>, query: &Query) -> bool {
         let mut entry = entries.start;
         while entry < entries.end {
             #[cfg(target_arch = "x86_64")]
@@ -370,7 +400,7 @@ impl<'a> Geometry<'a> {
                 entry += run;
                 continue;
             }
-            if self.entry_occludes(entry, slot, query) {
+            if self.entry_occludes(entry, query) {
                 return true;
             }
             entry += 1;
@@ -379,7 +409,7 @@ impl<'a> Geometry<'a> {
     }
 
     /// With AVX, the run of two to [`LANES`] triangles that starts at entry
-    /// `entry` of `corners` (and ends before `end`), tested at once against
+    /// `entry` of [`Self::entries`] (and ends before `end`), tested at once against
     /// the query's ray: its length and the hits, lane `i` for entry
     /// `entry + i`. `None` without AVX or such a run.
     #[cfg(target_arch = "x86_64")]
@@ -389,20 +419,14 @@ impl<'a> Geometry<'a> {
             return None;
         }
         let available = (end - entry).min(LANES as u32) as usize;
-        let corners = &self.corners[entry as usize..entry as usize + available];
-        let run = corners.iter().take_while(|c| c.is_some()).count();
+        let entries = &self.entries[entry as usize..entry as usize + available];
+        let run = entries.iter().take_while(|e| e.triangle).count();
         if run < 2 {
             return None;
         }
-        let first = corners[0].as_ref()?;
         // Lanes past the run repeat the first triangle; their answers are
         // masked out.
-        let lane = |i: usize| {
-            corners[..run]
-                .get(i)
-                .and_then(Option::as_ref)
-                .unwrap_or(first)
-        };
+        let lane = |i: usize| &entries[if i < run { i } else { 0 }].corners;
         // SAFETY: `wide_triangles` is set only where the processor has AVX.
         let hits = unsafe {
             watertight4(
@@ -416,13 +440,14 @@ impl<'a> Geometry<'a> {
         Some((run as u32, Hits4 { mask, ..hits }))
     }
 
-    /// True when the primitive of entry `entry` of `corners` lies in the
-    /// query's ray interval (`slot` as for [`Self::hit_entry`]).
+    /// True when the primitive of entry `entry` of [`Self::entries`] lies
+    /// in the query's ray interval.
     #[inline(always)]
-    fn entry_occludes(&self, entry: u32, slot: impl Fn(u32) -> u32, query: &Query) -> bool {
-        match &self.corners[entry as usize] {
+    fn entry_occludes(&self, entry: u32, query: &Query) -> bool {
+        let e = &self.entries[entry as usize];
+        match e.corners() {
             Some(corners) => intersect_triangle(corners, query, query.ray.t_max).is_some(),
-            None => self.occluded_by(self.bounded[slot(entry) as usize], query),
+            None => self.occluded_by(e.number, query),
         }
     }
 
@@ -486,19 +511,17 @@ impl<'a> Geometry<'a> {
         clipped.t_max = t_max;
         match &self.accel {
             Accelerator::Bvh(bvh) => {
-                let slot = |entry: u32| bvh.indices()[entry as usize];
                 bvh.intersect_in_leaf_order(&clipped, counters, |entries, t_max| {
-                    self.hit_leaf(entries, slot, &query, t_max, &mut best)
+                    self.hit_leaf(entries, &query, t_max, &mut best)
                 })
             }
             Accelerator::KdTree(kd) => {
-                let slot = |entry: u32| kd.indices()[entry as usize];
                 kd.intersect_in_leaf_order(&clipped, counters, |entry, t_max| {
-                    self.hit_entry(entry, slot, &query, t_max, &mut best)
+                    self.hit_entry(entry, &query, t_max, &mut best)
                 })
             }
             accel => accel.intersect(&clipped, counters, |slot, t_max| {
-                self.hit_entry(slot, |slot| slot, &query, t_max, &mut best)
+                self.hit_entry(slot, &query, t_max, &mut best)
             }),
         };
         best
@@ -514,21 +537,13 @@ impl<'a> Geometry<'a> {
         let query = self.query(ray);
         self.unbounded.iter().any(|&i| self.occluded_by(i, &query))
             || match &self.accel {
-                Accelerator::Bvh(bvh) => {
-                    let slot = |entry: u32| bvh.indices()[entry as usize];
-                    bvh.occluded_in_leaf_order(ray, counters, |entries| {
-                        self.leaf_occludes(entries, slot, &query)
-                    })
-                }
-                Accelerator::KdTree(kd) => {
-                    let slot = |entry: u32| kd.indices()[entry as usize];
-                    kd.occluded_in_leaf_order(ray, counters, |entry| {
-                        self.entry_occludes(entry, slot, &query)
-                    })
-                }
-                accel => accel.occluded(ray, counters, |slot| {
-                    self.entry_occludes(slot, |slot| slot, &query)
+                Accelerator::Bvh(bvh) => bvh.occluded_in_leaf_order(ray, counters, |entries| {
+                    self.leaf_occludes(entries, &query)
                 }),
+                Accelerator::KdTree(kd) => kd.occluded_in_leaf_order(ray, counters, |entry| {
+                    self.entry_occludes(entry, &query)
+                }),
+                accel => accel.occluded(ray, counters, |slot| self.entry_occludes(slot, &query)),
             }
     }
 
