@@ -382,9 +382,9 @@ impl<'a> Geometry<'a> {
     }
 
     /// True when a primitive of entries `entries` of [`Self::entries`] lies
-    /// in the query's ray interval. Where the
-    /// processor has AVX, runs of two to four triangles are tested at once,
-    /// with the same answers as one by one (see [`Self::triangle_run`]):
+    /// in the query's ray interval. Where the processor has AVX, runs of
+    /// two to four triangles are tested at once, with the same answers as
+    /// one by one (see [`Self::triangle_run`]):
     /// the same instructions on the bunny's shadow rays (callgrind), 18%
     /// faster (5.74 against 4.84 Mrays/s, 1 thread, best of four
     /// interleaved runs), having fewer branches on the edge tests' signs.
@@ -409,9 +409,9 @@ impl<'a> Geometry<'a> {
     }
 
     /// With AVX, the run of two to [`LANES`] triangles that starts at entry
-    /// `entry` of [`Self::entries`] (and ends before `end`), tested at once against
-    /// the query's ray: its length and the hits, lane `i` for entry
-    /// `entry + i`. `None` without AVX or such a run.
+    /// `entry` of [`Self::entries`] (and ends before `end`), tested at once
+    /// against the query's ray: its length and the hits, lane `i` for
+    /// entry `entry + i`. `None` without AVX or such a run.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn triangle_run(&self, entry: u32, end: u32, query: &Query) -> Option<(u32, Hits4)> {
