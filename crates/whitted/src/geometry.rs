@@ -98,8 +98,8 @@ pub struct Geometry<'a> {
     /// Whether some entry of `entries` is a triangle, so queries compute
     /// the ray's shear up front.
     has_triangles: bool,
-    /// Whether the processor has AVX, so the BVH's leaves test runs of
-    /// triangles four at a time.
+    /// Whether the processor has AVX, so shadow rays test runs of a BVH's
+    /// or a kd-tree's leaf triangles four at a time.
     #[cfg(target_arch = "x86_64")]
     wide_triangles: bool,
     unbounded: Vec<u32>,
@@ -540,8 +540,8 @@ impl<'a> Geometry<'a> {
                 Accelerator::Bvh(bvh) => bvh.occluded_in_leaf_order(ray, counters, |entries| {
                     self.leaf_occludes(entries, &query)
                 }),
-                Accelerator::KdTree(kd) => kd.occluded_in_leaf_order(ray, counters, |entry| {
-                    self.entry_occludes(entry, &query)
+                Accelerator::KdTree(kd) => kd.occluded_in_leaf_order(ray, counters, |entries| {
+                    self.leaf_occludes(entries, &query)
                 }),
                 accel => accel.occluded(ray, counters, |slot| self.entry_occludes(slot, &query)),
             }

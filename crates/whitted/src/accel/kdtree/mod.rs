@@ -123,10 +123,18 @@
 //!   1.43 Mrays/s. No split of cells of 3 or fewer primitives: the same
 //!   speed (1.62 / 1.60). Cost constants: intersection 3 the same (1.58),
 //!   an empty factor of 0.6 slower (1.31), 1.0 the same.
-//! - Any-hit rays without the mailbox: 3% fewer instructions on the
-//!   kitchen, but more triangle tests (bunny 5.01 → 5.76, dragon 5.51 →
-//!   5.91 a shadow ray); kitchen shadow 11.1 → 12.2 Mrays/s, bunny 3.25 →
-//!   3.17, dragon 1.49 → 1.37 (one run of three rounds): no clear gain.
+//! - Any-hit rays without the mailbox, each primitive still tested alone:
+//!   3% fewer instructions on the kitchen, but more triangle tests (bunny
+//!   5.01 → 5.76, dragon 5.51 → 5.91 a shadow ray); kitchen shadow 11.1 →
+//!   12.2 Mrays/s, bunny 3.25 → 3.17, dragon 1.49 → 1.37 (one run of three
+//!   rounds): no clear gain. Kept since (session 6): shadow rays hand
+//!   `Geometry` whole leaves without the mailbox, so their triangles go
+//!   through the BVH's four-at-once AVX test and one call a leaf instead
+//!   of one a primitive. kd-tree shadow rays went from 3.31 to 3.99 Mrays/s
+//!   on the bunny, 11.7 to 12.3 on the kitchen and 1.57 to 1.77 on the
+//!   dragon, the kd/BVH ratios from 1.73 / 1.49 / 1.93 to 1.45 / 1.41 /
+//!   1.74 (1 thread, medians of 4, 4 and 3 interleaved rounds of
+//!   `--accel bvh,kdtree` on the anchor rays).
 //! - Prefetching an interior node's above child as the node is read:
 //!   bunny diffuse 1.53 → 1.59 Mrays/s (median of five), shadow 2.80 →
 //!   2.36. Taken with the prefetch the eight-wide BVH did not gain from
