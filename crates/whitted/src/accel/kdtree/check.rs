@@ -115,6 +115,11 @@ impl KdTree {
                     below,
                     above,
                 } => {
+                    if !below && above == 0 {
+                        // The walk would take it for a cut whose child is
+                        // the root.
+                        return Err(format!("interior node {index} stores no child"));
+                    }
                     let plane = f64::from(split);
                     if !(cell.min[axis] < plane && plane < cell.max[axis]) {
                         return Err(format!(
@@ -360,6 +365,12 @@ mod tests {
             tree.validate(&boxes())
                 .unwrap_err()
                 .contains("reached twice")
+        );
+        tree.nodes[0] = KdNode::interior(0, 1.0, false, 0);
+        assert!(
+            tree.validate(&boxes())
+                .unwrap_err()
+                .contains("stores no child")
         );
         tree.nodes[0] = KdNode::leaf(1, 5);
         assert!(

@@ -227,26 +227,33 @@ impl KdTree {
                     split,
                     below,
                     above,
-                } => {
-                    let below = if below {
-                        entry.node + 1
-                    } else {
-                        keep_as_branch();
-                        0
-                    };
-                    match children(&entry, axis, split, [below, above], &axes) {
-                        [Some(first), Some(second)] => {
-                            stack.push(second);
-                            entry = first;
-                            continue;
-                        }
-                        [Some(only), None] | [None, Some(only)] => {
-                            entry = only;
-                            continue;
-                        }
-                        [None, None] => {}
+                } if !below || above == 0 => {
+                    // An empty-space cut: the walk goes on into the one
+                    // stored child unless the ray misses it.
+                    let child = if below { entry.node + 1 } else { above };
+                    if let Some((t_min, t_max)) = stored_side(&entry, axis, split, below, &axes) {
+                        entry = Entry {
+                            node: child,
+                            t_min,
+                            t_max,
+                        };
+                        continue;
                     }
                 }
+                NodeKind::Interior {
+                    axis, split, above, ..
+                } => match children(&entry, axis, split, [entry.node + 1, above], &axes) {
+                    [Some(first), Some(second)] => {
+                        stack.push(second);
+                        entry = first;
+                        continue;
+                    }
+                    [Some(only), None] | [None, Some(only)] => {
+                        entry = only;
+                        continue;
+                    }
+                    [None, None] => {}
+                },
                 NodeKind::Leaf { offset, count } => {
                     let start = offset as usize;
                     match leaf(start..start + count as usize, &mut work) {
@@ -324,6 +331,25 @@ fn at_least(a: f64, b: f64) -> bool {
     !(a < b)
 }
 
+/// Where the ray crosses the plane at `split` on `axis`: the crossing's
+/// parameter widened by its rounding error, as `(t_low, t_high)`, and
+/// whether the ray goes down the axis, meeting the above side first.
+///
+/// The crossing's rounding error is below γ(3) relative. A NaN crossing
+/// means the ray lies in the plane (0 · ∞), so it is on both sides
+/// throughout: the callers' tests are written so that NaN passes them and
+/// their bounds so that NaN leaves the node's own. A ray going up (or along
+/// the plane with a +0 direction, whose crossing is ±∞) meets the below
+/// side first.
+#[inline(always)]
+fn crossing(axis: usize, split: f32, ray: &Axes) -> (f64, f64, bool) {
+    let inv_dir = ray.inv_dir[axis];
+    let t_plane = (f64::from(split) - ray.origin[axis]) * inv_dir;
+    let a = t_plane * (1.0 - 2.0 * gamma(3));
+    let b = t_plane * (1.0 + 2.0 * gamma(3));
+    (min(a, b), max(a, b), inv_dir.is_sign_negative())
+}
+
 /// The children of the interior node `entry` that the ray meets, in the
 /// order it meets them, each with its parameter range (never NaN: the
 /// root's range comes from a box test, and a crossing that is NaN keeps
@@ -337,18 +363,8 @@ fn children(
     [below, above]: [u32; 2],
     ray: &Axes,
 ) -> [Option<Entry>; 2] {
-    let inv_dir = ray.inv_dir[axis];
-    let t_plane = (f64::from(split) - ray.origin[axis]) * inv_dir;
-    // The crossing's rounding error is below γ(3) relative. A NaN crossing
-    // means the ray lies in the plane (0 · ∞), so it is in both children
-    // throughout: every test below is written so that NaN passes it and
-    // every bound so that NaN leaves the node's own.
-    let a = t_plane * (1.0 - 2.0 * gamma(3));
-    let b = t_plane * (1.0 + 2.0 * gamma(3));
-    let (t_low, t_high) = (min(a, b), max(a, b));
-    // A ray going up (or along the plane with a +0 direction, whose
-    // crossing is ±∞) meets the below child first.
-    let (first, second) = if inv_dir.is_sign_negative() {
+    let (t_low, t_high, down) = crossing(axis, split, ray);
+    let (first, second) = if down {
         keep_as_branch();
         (above, below)
     } else {
@@ -365,6 +381,55 @@ fn children(
         t_max: entry.t_max,
     });
     [near, far]
+}
+
+/// The part `(t_min, t_max)` of the range of `entry`, an interior node with
+/// one stored child, in which the ray is on that child's side of the plane
+/// (below it if `below`), or `None` when it is never there: the range
+/// [`children`] gives that child.
+///
+/// Which end of the range the crossing clips depends on the ray's
+/// direction, but here, unlike at a node with two children, the direction
+/// does not choose the next node, so the end is picked by a select: as a
+/// branch it was mispredicted (see `mod.rs` for the figures).
+#[inline(always)]
+fn stored_side(
+    entry: &Entry,
+    axis: usize,
+    split: f32,
+    below: bool,
+    ray: &Axes,
+) -> Option<(f64, f64)> {
+    let (t_low, t_high, down) = crossing(axis, split, ray);
+    // The stored side is met first when the ray goes towards the other.
+    let first = opaque(u64::from(below != down).wrapping_neg());
+    let t_min = select(first, entry.t_min, max(t_low, entry.t_min));
+    let t_max = select(first, min(t_high, entry.t_max), entry.t_max);
+    at_least(t_max, t_min).then_some((t_min, t_max))
+}
+
+/// `mask`, passed through an empty assembly statement: the compiler can no
+/// longer see that it is all zeros or all ones, so a [`select`] made with
+/// it stays a select instead of being compiled back into a branch.
+#[inline(always)]
+fn opaque(mut mask: u64) -> u64 {
+    #[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
+    // SAFETY: an empty statement (a comment naming the register) that
+    // leaves the register as it is.
+    unsafe {
+        std::arch::asm!(
+            "/* {0} */",
+            inout(reg) mask,
+            options(pure, nomem, nostack, preserves_flags)
+        );
+    }
+    mask
+}
+
+/// `a` where `mask` is all ones, `b` where it is all zeros.
+#[inline(always)]
+fn select(mask: u64, a: f64, b: f64) -> f64 {
+    f64::from_bits((a.to_bits() & mask) | (b.to_bits() & !mask))
 }
 
 #[cfg(test)]
@@ -411,6 +476,52 @@ mod tests {
             [11, 20],
             &Axes::new(ray),
         ))
+    }
+
+    #[test]
+    fn the_stored_side_of_a_cut_gets_the_range_children_gives_it() {
+        let mut rng = crate::random::Rng::new(11);
+        // Random rays, then rays along the plane (NaN crossings), rays
+        // starting on it and crossings at the range's ends.
+        let mut cases: Vec<(Ray, f64, f64)> = (0..2000)
+            .map(|_| {
+                let origin = rng.point_in(Vec3::splat(-4.0), Vec3::splat(4.0));
+                let t_min = rng.range(0.0, 3.0);
+                (
+                    Ray::new(origin, rng.unit_vector()),
+                    t_min,
+                    t_min + rng.range(0.0, 3.0),
+                )
+            })
+            .collect();
+        for dir in [
+            Vec3::Y,
+            -Vec3::Y,
+            Vec3::new(-0.0, 1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+        ] {
+            for x in [1.5, 2.0, 2.5] {
+                cases.push((Ray::new(Vec3::new(x, 0.0, 0.0), dir), 0.0, 5.0));
+            }
+        }
+        let up = Ray::new(Vec3::ZERO, Vec3::X);
+        cases.extend([(up, 2.0, 5.0), (up, 0.0, 2.0)]);
+        for (ray, t_min, t_max) in cases {
+            let axes = Axes::new(&ray);
+            let e = entry(t_min, t_max);
+            for (below, indices) in [(true, [11, 0]), (false, [0, 20])] {
+                let expected = children(&e, 0, 2.0, indices, &axes)
+                    .into_iter()
+                    .flatten()
+                    .map(|c| (c.t_min, c.t_max))
+                    .next();
+                assert_eq!(
+                    stored_side(&e, 0, 2.0, below, &axes),
+                    expected,
+                    "{ray:?} over ({t_min}, {t_max}), below stored: {below}"
+                );
+            }
+        }
     }
 
     #[test]
