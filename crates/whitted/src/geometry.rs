@@ -516,8 +516,8 @@ impl<'a> Geometry<'a> {
                 })
             }
             Accelerator::KdTree(kd) => {
-                kd.intersect_in_leaf_order(&clipped, counters, |entry, t_max| {
-                    self.hit_entry(entry, &query, t_max, &mut best)
+                kd.intersect_in_leaf_order(&clipped, counters, |entries, t_max| {
+                    self.hit_leaf(entries, &query, t_max, &mut best)
                 })
             }
             accel => accel.intersect(&clipped, counters, |slot, t_max| {

@@ -49,12 +49,19 @@ fn assert_matches_brute_force(boxes: &[Aabb], rays: &[Ray], what: &str) -> KdTre
     for ray in rays {
         let expected = trace(&oracle, boxes, ray);
         assert_eq!(trace(&accel, boxes, ray), expected, "{what}: {ray:?}");
-        // Whole leaves, as `Geometry` asks for shadow rays.
-        let by_leaves = tree.occluded_in_leaf_order(ray, &mut TraversalCounters::default(), |r| {
+        // Whole leaves, as `Geometry` asks for them.
+        let closest =
+            tree.intersect_in_leaf_order(ray, &mut TraversalCounters::default(), |r, t_max| {
+                r.map(|e| tree.indices()[e as usize])
+                    .fold(None, |found, i| {
+                        box_hit(&boxes[i as usize], ray, found.unwrap_or(t_max)).or(found)
+                    })
+            });
+        let any = tree.occluded_in_leaf_order(ray, &mut TraversalCounters::default(), |r| {
             r.map(|e| tree.indices()[e as usize])
                 .any(|i| box_hit(&boxes[i as usize], ray, ray.t_max).is_some())
         });
-        assert_eq!(by_leaves, expected.1, "{what}, whole leaves: {ray:?}");
+        assert_eq!((closest, any), expected, "{what}, whole leaves: {ray:?}");
         hits += usize::from(expected.1);
     }
     assert!(hits > 0 || boxes.is_empty(), "{what}: no ray hits anything");

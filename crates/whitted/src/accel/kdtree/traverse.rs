@@ -18,9 +18,10 @@
 //! once per ray. With it, and the axis picked without a branch, a diffuse
 //! ray through the bunny's tree took 4201 instructions instead of 5430
 //! (callgrind, 20k anchor rays) and 5.6 primitive tests instead of 7.3.
-//! Any-hit queries in leaf order go without it and hand over whole leaves
-//! (see `mod.rs`): a repeated test gives the same answer, and the caller
-//! tests a leaf's triangles several at a time.
+//! The queries in leaf order (closest and any hit) go without it and hand
+//! over whole leaves (see `mod.rs`): a repeated test finds nothing new,
+//! and the caller takes a leaf in one call, testing an any-hit ray against
+//! its triangles several at a time.
 
 use super::KdTree;
 use super::node::NodeKind;
@@ -54,7 +55,8 @@ enum Flow {
 }
 
 impl KdTree {
-    /// The closest hit (see [`crate::accel`]).
+    /// The closest hit (see [`crate::accel`]). A primitive met again in a
+    /// later leaf is not tested again (the shared mailbox).
     #[inline]
     pub fn intersect(
         &self,
@@ -62,44 +64,72 @@ impl KdTree {
         counters: &mut TraversalCounters,
         mut hit: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<f64> {
-        self.intersect_in_leaf_order(ray, counters, |entry, t_max| {
-            hit(self.indices[entry as usize], t_max)
+        let mut mailbox = Mailbox::new();
+        self.closest_leaf(ray, counters, |entries, mut t_max, counters| {
+            let mut found = None;
+            for p in entries.map(|entry| self.indices[entry]) {
+                if !mailbox.first_visit(p) {
+                    continue;
+                }
+                counters.primitives += 1;
+                if let Some(t) = hit(p, t_max) {
+                    (t_max, found) = (t, Some(t));
+                }
+            }
+            found
         })
     }
 
-    /// [`Self::intersect`], with `hit` given each primitive's position in
-    /// [`Self::indices`] instead of its number: a caller that keeps what it
-    /// needs of the primitives in that order reads each leaf's together.
+    /// [`Self::intersect`], with `hit` given a whole leaf: the positions in
+    /// [`Self::indices`] of its primitives, and the closest hit so far; it
+    /// returns the closest hit among them nearer than that. A caller that
+    /// keeps what it needs of the primitives in that order reads each
+    /// leaf's together. Each primitive kept aside comes as a leaf of its
+    /// own. There is no mailbox, as for [`Self::occluded_in_leaf_order`]: a
+    /// primitive met again is tested again, and cannot be nearer than the
+    /// hit it gave before. The leaf counts as tested whole in
+    /// `counters.primitives`.
     #[inline]
     pub fn intersect_in_leaf_order(
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
-        mut hit: impl FnMut(u32, f64) -> Option<f64>,
+        mut hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
+    ) -> Option<f64> {
+        self.closest_leaf(ray, counters, |entries, t_max, counters| {
+            counters.primitives += entries.len() as u64;
+            hit(entries.start as u32..entries.end as u32, t_max)
+        })
+    }
+
+    /// The closest of the hits `leaf` returns for the positions in
+    /// [`Self::indices`] of every leaf the ray passes, near to far until no
+    /// nearer hit can follow, and of every primitive kept aside whose box
+    /// it meets (each one alone, tested first). `leaf` is given the closest
+    /// hit so far and returns a nearer one, if any.
+    #[inline(always)]
+    fn closest_leaf(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        mut leaf: impl FnMut(Range<usize>, f64, &mut TraversalCounters) -> Option<f64>,
     ) -> Option<f64> {
         let mut closest = None;
-        let mut t_max = ray.t_max;
         let mut clipped = *ray;
         let first_loose = self.indices.len() - self.loose.len();
         for (k, (_, b)) in self.loose.iter().enumerate() {
             counters.nodes += 1;
-            if b.intersect_ray(&clipped).is_some() {
-                counters.primitives += 1;
-                if let Some(t) = hit((first_loose + k) as u32, t_max) {
-                    (t_max, clipped.t_max, closest) = (t, t, Some(t));
-                }
+            let entry = first_loose + k;
+            if b.intersect_ray(&clipped).is_some()
+                && let Some(t) = leaf(entry..entry + 1, clipped.t_max, counters)
+            {
+                (clipped.t_max, closest) = (t, Some(t));
             }
         }
-        let mut mailbox = Mailbox::new();
+        let mut t_max = clipped.t_max;
         self.walk(&clipped, counters, |entries, counters| {
-            for entry in entries {
-                if !mailbox.first_visit(self.indices[entry]) {
-                    continue;
-                }
-                counters.primitives += 1;
-                if let Some(t) = hit(entry as u32, t_max) {
-                    (t_max, closest) = (t, Some(t));
-                }
+            if let Some(t) = leaf(entries, t_max, counters) {
+                (t_max, closest) = (t, Some(t));
             }
             Flow::Continue(t_max)
         });
