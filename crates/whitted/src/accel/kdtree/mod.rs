@@ -170,6 +170,13 @@
 //!   Once more after the two changes of session 7: intersection 1.2 and
 //!   2.0 gave 1.78 and 1.75 against 1.77 Mrays/s, empty factors 0.7 and
 //!   0.9 were slower (medians of the best of 8 to 10 runs in 4 rounds).
+//! - Loading both children of a node with two before the branches, so a
+//!   mispredicted step finds the next node already in a register (the
+//!   node's value carried in each to-do entry): bunny diffuse 1.70 →
+//!   1.85 Mrays/s on the diffuse rays alone (best of 8 runs, medians of
+//!   4 rounds), but the same on the anchor rays, all three kinds (1.79
+//!   and 1.84, ratios 1.97 and 1.99; medians of 6 rounds), and primary
+//!   and shadow rays slower in a first run.
 //! - Scaling the inverse direction by 1 ∓ 2γ(3) once per ray instead of
 //!   each crossing by it (one multiplication fewer before the branches):
 //!   the bounds still hold the exact crossing, but no longer match the box
