@@ -383,8 +383,8 @@ fn crossing(axis: usize, split: f32, ray: &Axes) -> (f64, f64, bool) {
 /// The children of the interior node `entry` that the ray meets, in the
 /// order it meets them, each with its parameter range (never NaN: the
 /// root's range comes from a box test, and a crossing that is NaN keeps
-/// the node's range). `[below, above]` are the children's indices,
-/// 0 for one that is not stored (and so never met).
+/// the node's range). `[below, above]` are the children's indices (a node
+/// with one stored child goes to [`stored_side`] instead).
 #[inline]
 fn children(
     entry: &Entry,
@@ -400,12 +400,12 @@ fn children(
     } else {
         (below, above)
     };
-    let near = (first != 0 && at_least(t_high, entry.t_min)).then_some(Entry {
+    let near = at_least(t_high, entry.t_min).then_some(Entry {
         node: first,
         t_min: entry.t_min,
         t_max: min(t_high, entry.t_max),
     });
-    let far = (second != 0 && at_least(entry.t_max, t_low)).then_some(Entry {
+    let far = at_least(entry.t_max, t_low).then_some(Entry {
         node: second,
         t_min: max(t_low, entry.t_min),
         t_max: entry.t_max,
@@ -539,12 +539,12 @@ mod tests {
         for (ray, t_min, t_max) in cases {
             let axes = Axes::new(&ray);
             let e = entry(t_min, t_max);
-            for (below, indices) in [(true, [11, 0]), (false, [0, 20])] {
-                let expected = children(&e, 0, 2.0, indices, &axes)
+            for (below, stored) in [(true, 11), (false, 20)] {
+                let expected = children(&e, 0, 2.0, [11, 20], &axes)
                     .into_iter()
                     .flatten()
-                    .map(|c| (c.t_min, c.t_max))
-                    .next();
+                    .find(|c| c.node == stored)
+                    .map(|c| (c.t_min, c.t_max));
                 assert_eq!(
                     stored_side(&e, 0, 2.0, below, &axes),
                     expected,
