@@ -38,6 +38,7 @@ pub use kdtree::{Clipper, KdTree, KdTreeBuildParams};
 pub use linear::Linear;
 
 use crate::math::{Aabb, Ray};
+use std::ops::Range;
 
 /// Work done for one or more rays: what the cost AOV and `whitted bench`
 /// report.
@@ -190,6 +191,58 @@ impl Accelerator {
             Accelerator::Linear(s) => s.occluded(ray, counters, occludes),
             Accelerator::Grid(s) => s.occluded(ray, counters, occludes),
             Accelerator::KdTree(s) => s.occluded(ray, counters, occludes),
+        }
+    }
+
+    /// The primitive numbers that the positions handed out by
+    /// [`Self::intersect_in_leaf_order`] and [`Self::occluded_in_leaf_order`]
+    /// stand for, each leaf's together, for the structures that list them
+    /// (BVH, kd-tree); `None` for the others, whose positions are the
+    /// primitive numbers themselves.
+    pub fn leaf_order(&self) -> Option<&[u32]> {
+        match self {
+            Accelerator::Bvh(s) => Some(s.indices()),
+            Accelerator::KdTree(s) => Some(s.indices()),
+            Accelerator::Linear(_) | Accelerator::Grid(_) => None,
+        }
+    }
+
+    /// The closest hit, with `hit` given a whole leaf at a time: a range of
+    /// positions (see [`Self::leaf_order`]) and the closest hit so far; it
+    /// returns the closest hit among them nearer than that. A grid or brute
+    /// force hands each primitive over as a leaf of its own.
+    #[inline]
+    pub fn intersect_in_leaf_order(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        mut hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
+    ) -> Option<f64> {
+        match self {
+            Accelerator::Bvh(s) => s.intersect_in_leaf_order(ray, counters, hit),
+            Accelerator::KdTree(s) => s.intersect_in_leaf_order(ray, counters, hit),
+            Accelerator::Linear(_) | Accelerator::Grid(_) => {
+                self.intersect(ray, counters, |p, t_max| hit(p..p + 1, t_max))
+            }
+        }
+    }
+
+    /// Any hit, with `occludes` given a whole leaf at a time as for
+    /// [`Self::intersect_in_leaf_order`]; it says whether any of them lies
+    /// in the ray's interval.
+    #[inline]
+    pub fn occluded_in_leaf_order(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        mut occludes: impl FnMut(Range<u32>) -> bool,
+    ) -> bool {
+        match self {
+            Accelerator::Bvh(s) => s.occluded_in_leaf_order(ray, counters, occludes),
+            Accelerator::KdTree(s) => s.occluded_in_leaf_order(ray, counters, occludes),
+            Accelerator::Linear(_) | Accelerator::Grid(_) => {
+                self.occluded(ray, counters, |p| occludes(p..p + 1))
+            }
         }
     }
 
