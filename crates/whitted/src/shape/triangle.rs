@@ -181,12 +181,17 @@ fn watertight_permuted<const KX: usize, const KY: usize, const KZ: usize>(
 
     // Edge functions: twice the signed areas opposite each vertex. An
     // edge shared with a neighbour gives the same value, negated, there.
+    // Their signs are combined with `|` and `&`, not `||` and `&&`: one
+    // branch per triangle, mostly a predictable miss, instead of one per
+    // sign. The bunny's diffuse rays went from 1.66 to 1.83 Mrays/s with
+    // the kd-tree and from 3.43 to 3.56 with the BVH (1 thread, medians of
+    // the best of 10 runs in each of 4 interleaved rounds).
     let e0 = b.x * c.y - b.y * c.x;
     let e1 = c.x * a.y - c.y * a.x;
     let e2 = a.x * b.y - a.y * b.x;
-    let negative = e0 < 0.0 || e1 < 0.0 || e2 < 0.0;
-    let positive = e0 > 0.0 || e1 > 0.0 || e2 > 0.0;
-    if negative && positive {
+    let negative = (e0 < 0.0) | (e1 < 0.0) | (e2 < 0.0);
+    let positive = (e0 > 0.0) | (e1 > 0.0) | (e2 > 0.0);
+    if negative & positive {
         return None;
     }
     let det = e0 + e1 + e2;
