@@ -185,6 +185,26 @@
 //!   Its speed, once kept to branches: bunny diffuse rays the same (1.55
 //!   against 1.59 Mrays/s, medians of 16 interleaved runs), kitchen +7%,
 //!   dragon +3%.
+//! - A descent to the origin's leaf before the walk (session 8). A ray
+//!   starting inside the root meets the child holding its origin first,
+//!   so down to the origin's leaf the next node needs only the origin's
+//!   side of each plane: an integer comparison (origin and split as
+//!   order-preserving integer keys) right after the node's load, the
+//!   other child pushed without a branch. The bunny's diffuse rays take
+//!   24.5 such steps of their 42, and 25.6 steps before their first leaf.
+//!   Bunny diffuse rays 1.87 → 2.19 Mrays/s (medians of the best of 6 to
+//!   8 runs in 4 to 6 interleaved rounds), but bunny shadow rays 3.26 →
+//!   2.81, the kitchen's primary rays (camera inside the root) 6.22 →
+//!   5.26 and shadow rays 12.4 → 10.1 (best of 24 runs), its diffuse rays
+//!   the same (2.42 and 2.39). A step of the descent is about 54
+//!   instructions: the crossing and both children's ranges are computed
+//!   every step, where the walk's branches, well predicted for rays that
+//!   go the same way, skip most of that. On the shadow rays alone, the
+//!   walk reached the first leaf at 8.7 Mrays/s, the descent at 5.0
+//!   (with its choice of child a branch; 4.2 and 4.6 on diffuse rays).
+//!   Pushing the other child whenever it is stored and dropping empty
+//!   ranges when popping was no better (bunny diffuse 1.98, kitchen
+//!   shadow 9.3).
 
 mod build;
 mod check;
