@@ -192,9 +192,9 @@
 //!   order-preserving integer keys) right after the node's load, the
 //!   other child pushed without a branch. The bunny's diffuse rays take
 //!   24.5 such steps of their 42, and 25.6 steps before their first leaf.
-//!   Bunny diffuse rays 1.87 → 2.19 Mrays/s (medians of the best of 6 to
-//!   8 runs in 4 to 6 interleaved rounds), but bunny shadow rays 3.26 →
-//!   2.81, the kitchen's primary rays (camera inside the root) 6.22 →
+//!   Bunny diffuse rays 1.86 → 2.19 Mrays/s (medians of the best of 6
+//!   runs in 4 interleaved rounds), but bunny shadow rays 3.26 → 2.81
+//!   (best of 10, 6 rounds), the kitchen's primary rays (camera inside the root) 6.22 →
 //!   5.26 and shadow rays 12.4 → 10.1 (best of 24 runs), its diffuse rays
 //!   the same (2.42 and 2.39). A step of the descent is about 54
 //!   instructions: the crossing and both children's ranges are computed
