@@ -35,6 +35,14 @@ impl<T: Copy, const N: usize> Stack<T, N> {
         self.len += 1;
     }
 
+    /// Adds `entry` on top if `keep`, without a branch: the slot above the
+    /// top is written either way, so the stack needs room for it.
+    #[inline(always)]
+    pub fn push_if(&mut self, entry: T, keep: bool) {
+        self.entries[self.len].write(entry);
+        self.len += usize::from(keep);
+    }
+
     /// Removes the top entry.
     #[inline(always)]
     pub fn pop(&mut self) -> Option<T> {
@@ -77,6 +85,16 @@ mod tests {
             (stack.len(), stack.pop(), stack.pop(), stack.pop()),
             (2, Some(2), Some(1), None)
         );
+    }
+
+    #[test]
+    fn pushing_if_keeps_only_the_entries_asked_for() {
+        let mut stack = Stack::<u32, 4>::new();
+        for (x, keep) in [(1, true), (2, false), (3, true), (4, false)] {
+            stack.push_if(x, keep);
+        }
+        let order: Vec<u32> = std::iter::from_fn(|| stack.pop()).collect();
+        assert_eq!(order, [3, 1]);
     }
 
     #[test]

@@ -6,6 +6,8 @@
 //! - `sah.rs`: the cost model and the sweep that picks a plane.
 //! - `build.rs`: the recursive build that splits the sorted events.
 //! - `traverse.rs`: closest-hit and any-hit queries.
+//! - `coherence.rs`: whether a thread's rays keep changing direction,
+//!   which picks how a walk starts.
 //! - `check.rs`: `validate` and `stats`.
 //!
 //! Split planes are `f32`. Boxes are widened outwards to the `f32` grid
@@ -185,7 +187,8 @@
 //!   Its speed, once kept to branches: bunny diffuse rays the same (1.55
 //!   against 1.59 Mrays/s, medians of 16 interleaved runs), kitchen +7%,
 //!   dragon +3%.
-//! - A descent to the origin's leaf before the walk (session 8). A ray
+//! - A descent to the origin's leaf before every walk (session 8; kept
+//!   since session 10 for rays that keep changing direction, below). A ray
 //!   starting inside the root meets the child holding its origin first,
 //!   so down to the origin's leaf the next node needs only the origin's
 //!   side of each plane: an integer comparison (origin and split as
@@ -220,9 +223,39 @@
 //!   - Closest hits testing runs of leaf triangles four at a time, as
 //!     shadow rays do: kd-tree diffuse 1.77 and 1.75, the BVH's 4.0 → 3.2
 //!     (the two binaries one after the other, not interleaved).
+//!
+//! Kept since session 10: the descent to the origin's leaf, for rays that
+//! keep changing direction. Before a walk, each thread notes whether its
+//! rays' direction octant keeps changing from one ray to the next
+//! (`coherence.rs`); when it does, and the ray starts inside the tree, the
+//! walk first goes down the cells holding the origin, choosing each child
+//! by the origin's side of the plane (a branch neighbouring origins take
+//! alike) and pushing the other without a branch on the direction
+//! (`traverse.rs`, `descend`). It also goes through empty-space cuts whose
+//! stored child holds the origin. Rays going one way (camera rays, shadow
+//! rays towards one light) walk from the root as before. Kd-tree, 1 thread,
+//! Mrays/s before → after, medians of the best of 4 runs in 4 interleaved
+//! rounds (bunny) and of 3 or 4 runs in 3 rounds (dragon, kitchen), with
+//! `python3 best2.py MODEL kdtree primary,shadow,diffuse ROUNDS RUNS
+//! /tmp/anchor_rays OLD NEW`, which alternates `whitted bench MODEL.obj
+//! --rays DIR --accel kdtree --runs RUNS --json` between two binaries:
+//!
+//! | model | primary | shadow | diffuse |
+//! |---|---|---|---|
+//! | bunny | 11.15 → 11.07 | 3.91 → 3.91 | 2.00 → 2.29 |
+//! | dragon | 8.39 → 8.56 | 1.73 → 1.75 | 1.03 → 1.22 |
+//! | kitchen | 6.05 → 6.22 | 12.39 → 12.22 | 2.43 → 2.51 |
+//!
+//! The descent taken by every ray starting inside the tree (an environment
+//! switch in a throwaway build) measured as in session 8: bunny diffuse
+//! 2.05 → 2.23, but bunny shadow 3.89 → 3.62, kitchen primary (the camera
+//! inside the tree) 6.24 → 5.50 and kitchen shadow 12.5 → 9.87. The
+//! origin's side compared as order-preserving integer keys instead of
+//! floats: bunny diffuse 2.22 → 2.17, primary 10.9 → 10.5.
 
 mod build;
 mod check;
+mod coherence;
 mod events;
 mod node;
 mod sah;

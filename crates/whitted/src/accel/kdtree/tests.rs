@@ -6,6 +6,7 @@
 //! the ray enters its box, so both structures see exactly the same hits.
 
 use super::build::default_max_depth;
+use super::coherence;
 use super::node::{KdNode, NodeKind};
 use super::traverse::{SHALLOW, STACK_CAPACITY};
 use super::{KdTree, KdTreeBuildParams};
@@ -46,7 +47,9 @@ fn assert_matches_brute_force(boxes: &[Aabb], rays: &[Ray], what: &str) -> KdTre
     let accel = Accelerator::KdTree(tree.clone());
     let oracle = Accelerator::build(AccelKind::Linear, boxes);
     let mut hits = 0;
-    for ray in rays {
+    for (ray, incoherent) in rays.iter().flat_map(|r| [(r, false), (r, true)]) {
+        coherence::pin(Some(incoherent));
+        let what = format!("{what}, {}", start_name(incoherent));
         let expected = trace(&oracle, boxes, ray);
         assert_eq!(trace(&accel, boxes, ray), expected, "{what}: {ray:?}");
         // Whole leaves, as `Geometry` asks for them.
@@ -64,6 +67,7 @@ fn assert_matches_brute_force(boxes: &[Aabb], rays: &[Ray], what: &str) -> KdTre
         assert_eq!((closest, any), expected, "{what}, whole leaves: {ray:?}");
         hits += usize::from(expected.1);
     }
+    coherence::pin(None);
     assert!(hits > 0 || boxes.is_empty(), "{what}: no ray hits anything");
     tree
 }
@@ -93,9 +97,31 @@ fn unit(v: usize) -> Vec3 {
     Vec3::AXES[v]
 }
 
+/// How a walk starts when rays count as `incoherent` or not.
+fn start_name(incoherent: bool) -> &'static str {
+    if incoherent {
+        "descent to the origin's leaf"
+    } else {
+        "walk from the root"
+    }
+}
+
+/// Runs `body` with the walk from the root, then with the descent to the
+/// origin's leaf, giving it the start's name.
+fn with_either_start(mut body: impl FnMut(&str)) {
+    for incoherent in [false, true] {
+        coherence::pin(Some(incoherent));
+        body(start_name(incoherent));
+    }
+    coherence::pin(None);
+}
+
 #[test]
-fn kdtree_conforms_to_brute_force() {
-    assert_conforms(AccelKind::KdTree);
+fn kdtree_conforms_to_brute_force_with_either_start() {
+    with_either_start(|start| {
+        println!("{start}");
+        assert_conforms(AccelKind::KdTree);
+    });
 }
 
 #[test]
@@ -375,16 +401,23 @@ fn unplaceable_boxes_are_tested_like_brute_force() {
     };
     let oracle = Accelerator::build(AccelKind::Linear, &boxes);
     let accel = Accelerator::KdTree(tree);
-    for ray in random_rays(&mut rng, 500, 5.0) {
-        let mut c = TraversalCounters::default();
-        let expected = oracle.intersect(&ray, &mut c, |i, t| hit(i, &ray, t));
-        let actual = accel.intersect(&ray, &mut c, |i, t| hit(i, &ray, t));
-        assert_eq!(actual, expected, "{ray:?}");
-        let any = |a: &Accelerator, c: &mut TraversalCounters| {
-            a.occluded(&ray, c, |i| hit(i, &ray, ray.t_max).is_some())
-        };
-        assert_eq!(any(&accel, &mut c), any(&oracle, &mut c), "{ray:?}");
-    }
+    let rays = random_rays(&mut rng, 500, 5.0);
+    with_either_start(|start| {
+        for ray in &rays {
+            let mut c = TraversalCounters::default();
+            let expected = oracle.intersect(ray, &mut c, |i, t| hit(i, ray, t));
+            let actual = accel.intersect(ray, &mut c, |i, t| hit(i, ray, t));
+            assert_eq!(actual, expected, "{start}: {ray:?}");
+            let any = |a: &Accelerator, c: &mut TraversalCounters| {
+                a.occluded(ray, c, |i| hit(i, ray, ray.t_max).is_some())
+            };
+            assert_eq!(
+                any(&accel, &mut c),
+                any(&oracle, &mut c),
+                "{start}: {ray:?}"
+            );
+        }
+    });
 }
 
 #[test]
@@ -451,21 +484,26 @@ fn trees_deeper_than_the_short_stack_are_walked_like_brute_force() {
     let accel = Accelerator::KdTree(tree);
     let oracle = Accelerator::build(AccelKind::Linear, &boxes);
     let mut rng = Rng::new(23);
-    for i in 0..2_000 {
-        // From far away towards the cubes, and out from among them.
-        let origin = rng.point_in(Vec3::splat(-4.0), Vec3::splat(4.0));
-        let target = Vec3::splat(1.25 * 0.5f64.powi(i % 60));
-        for ray in [
-            Ray::new(origin, target - origin),
-            Ray::new(target * 0.9, origin - target),
-        ] {
+    let rays: Vec<Ray> = (0..2_000)
+        .flat_map(|i| {
+            // From far away towards the cubes, and out from among them.
+            let origin = rng.point_in(Vec3::splat(-4.0), Vec3::splat(4.0));
+            let target = Vec3::splat(1.25 * 0.5f64.powi(i % 60));
+            [
+                Ray::new(origin, target - origin),
+                Ray::new(target * 0.9, origin - target),
+            ]
+        })
+        .collect();
+    with_either_start(|start| {
+        for ray in &rays {
             assert_eq!(
-                trace(&accel, &boxes, &ray),
-                trace(&oracle, &boxes, &ray),
-                "{ray:?}"
+                trace(&accel, &boxes, ray),
+                trace(&oracle, &boxes, ray),
+                "{start}: {ray:?}"
             );
         }
-    }
+    });
 }
 
 #[test]
@@ -556,17 +594,20 @@ fn perfect_splits_keep_every_triangle_where_it_meets_a_cell_and_match_brute_forc
     let oracle = Accelerator::build(AccelKind::Linear, &boxes);
     let accel = Accelerator::KdTree(tree);
     let mut hits = 0;
-    for ray in &rays {
-        let mut c = TraversalCounters::default();
-        let expected = oracle.intersect(ray, &mut c, |i, t| hit(i, ray, t));
-        let actual = accel.intersect(ray, &mut c, |i, t| hit(i, ray, t));
-        assert_eq!(actual, expected, "{ray:?}");
-        let any = |a: &Accelerator, c: &mut TraversalCounters| {
-            a.occluded(ray, c, |i| hit(i, ray, ray.t_max).is_some())
-        };
-        assert_eq!(any(&accel, &mut c), expected.is_some(), "{ray:?}");
-        hits += usize::from(expected.is_some());
-    }
+    with_either_start(|start| {
+        hits = 0;
+        for ray in &rays {
+            let mut c = TraversalCounters::default();
+            let expected = oracle.intersect(ray, &mut c, |i, t| hit(i, ray, t));
+            let actual = accel.intersect(ray, &mut c, |i, t| hit(i, ray, t));
+            assert_eq!(actual, expected, "{start}: {ray:?}");
+            let any = |a: &Accelerator, c: &mut TraversalCounters| {
+                a.occluded(ray, c, |i| hit(i, ray, ray.t_max).is_some())
+            };
+            assert_eq!(any(&accel, &mut c), expected.is_some(), "{start}: {ray:?}");
+            hits += usize::from(expected.is_some());
+        }
+    });
     assert!(
         hits > rays.len() / 4,
         "only {hits} of {} rays hit",

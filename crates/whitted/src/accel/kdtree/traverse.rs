@@ -1,6 +1,9 @@
 //! Ray traversal: the ray is clipped to the root box, then walks the leaves
 //! it passes from near to far with a fixed-size to-do stack of
-//! `(node, t_min, t_max)` (pbrt-v4 `KdTreeAggregate::Intersect`).
+//! `(node, t_min, t_max)` (pbrt-v4 `KdTreeAggregate::Intersect`). Among
+//! rays that keep changing direction (`coherence.rs`), one starting inside
+//! the tree first goes straight down to its origin's leaf, pushing the
+//! cells it passes by on the same stack ([`KdTree::descend`]).
 //!
 //! Every choice is conservative. The parameter where the ray crosses a
 //! split plane is widened by its rounding error, and both children are
@@ -24,6 +27,7 @@
 //! its triangles several at a time.
 
 use super::KdTree;
+use super::coherence;
 use super::node::NodeKind;
 use crate::accel::TraversalCounters;
 use crate::accel::mailbox::Mailbox;
@@ -249,6 +253,18 @@ impl KdTree {
             t_min,
             t_max,
         };
+        // A ray starting inside the tree, among rays that keep changing
+        // direction, first goes down to its origin's leaf.
+        if coherence::incoherent(axes.octant()) && t_min <= ray.t_min {
+            let Some(start) = self
+                .descend(entry, &axes, &mut stack, &mut work)
+                .or_else(|| stack.pop())
+            else {
+                *counters += work;
+                return;
+            };
+            entry = start;
+        }
         loop {
             work.nodes += 1;
             match self.nodes[entry.node as usize].kind() {
@@ -302,6 +318,89 @@ impl KdTree {
     }
 }
 
+impl KdTree {
+    /// The start of a walk for a ray whose origin lies in `root`'s cell:
+    /// down the nodes whose cells hold the origin, each step choosing the
+    /// child on the origin's side of the plane and pushing the other one
+    /// if the ray meets it, without a branch on the ray's direction (see
+    /// `coherence.rs`). Stops at the origin's leaf, or at the stored child
+    /// of an empty-space cut when the origin lies in the empty part. Returns
+    /// where the walk goes on, `None` when the ray misses that node's cell
+    /// (the walk then takes the next cell from the stack).
+    ///
+    /// Every range is the one [`children`] or [`stored_side`] gives, so the
+    /// walk visits the same cells, pushed in another order only when the
+    /// ray crosses a plane before its range starts.
+    #[inline(always)]
+    fn descend<const N: usize>(
+        &self,
+        root: Entry,
+        axes: &Axes,
+        stack: &mut Stack<Entry, N>,
+        work: &mut TraversalCounters,
+    ) -> Option<Entry> {
+        let mut entry = root;
+        while let NodeKind::Interior {
+            axis,
+            split,
+            below,
+            above,
+        } = self.nodes[entry.node as usize].kind()
+        {
+            work.nodes += 1;
+            let origin_above = axes.origin[axis] >= f64::from(split);
+            if !below || above == 0 {
+                let (t_min, t_max) = stored_side(&entry, axis, split, below, axes)?;
+                entry = Entry {
+                    node: if below { entry.node + 1 } else { above },
+                    t_min,
+                    t_max,
+                };
+                if origin_above == below {
+                    break;
+                }
+                continue;
+            }
+            // The ranges of the child the ray meets first and second.
+            let (t_low, t_high, down) = crossing(axis, split, axes);
+            let first = (entry.t_min, min(t_high, entry.t_max));
+            let second = (max(t_low, entry.t_min), entry.t_max);
+            let down = opaque(u64::from(down).wrapping_neg());
+            let below_range = (
+                select(down, second.0, first.0),
+                select(down, second.1, first.1),
+            );
+            let above_range = (
+                select(down, first.0, second.0),
+                select(down, first.1, second.1),
+            );
+            let ((go, go_range), (other, other_range)) = if origin_above {
+                keep_as_branch();
+                ((above, above_range), (entry.node + 1, below_range))
+            } else {
+                ((entry.node + 1, below_range), (above, above_range))
+            };
+            stack.push_if(
+                Entry {
+                    node: other,
+                    t_min: other_range.0,
+                    t_max: other_range.1,
+                },
+                at_least(other_range.1, other_range.0),
+            );
+            if !at_least(go_range.1, go_range.0) {
+                return None;
+            }
+            entry = Entry {
+                node: go,
+                t_min: go_range.0,
+                t_max: go_range.1,
+            };
+        }
+        Some(entry)
+    }
+}
+
 /// The ray's origin and inverse direction as arrays, so a node's axis picks
 /// them by an indexed load: indexing the vectors compiled to a branch on
 /// the axis, which changes from node to node and was mispredicted.
@@ -316,6 +415,13 @@ impl Axes {
             origin: ray.origin.to_array(),
             inv_dir: ray.inv_dir.to_array(),
         }
+    }
+
+    /// The direction's octant: bit `axis` set where it goes down that axis.
+    #[inline(always)]
+    fn octant(&self) -> u32 {
+        let down = |axis: usize| u32::from(self.inv_dir[axis].is_sign_negative()) << axis;
+        down(0) | down(1) | down(2)
     }
 }
 
@@ -465,7 +571,7 @@ fn select(mask: u64, a: f64, b: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::Vec3;
+    use crate::math::{Aabb, Vec3};
 
     fn entry(t_min: f64, t_max: f64) -> Entry {
         Entry {
@@ -574,6 +680,69 @@ mod tests {
         assert_eq!(visited(&up, 2.5, 5.0), [20]);
         let down = Ray::new(Vec3::new(4.0, 0.0, 0.0), -Vec3::X);
         assert_eq!(visited(&down, 0.0, 2.0), [20, 11]);
+    }
+
+    /// The cells of the tree's stored leaves, by node index.
+    fn leaf_cells(tree: &KdTree) -> Vec<(u32, Aabb)> {
+        let mut cells = Vec::new();
+        let mut pending = vec![(0, tree.bounds)];
+        while let Some((node, cell)) = pending.pop() {
+            match tree.nodes[node as usize].kind() {
+                NodeKind::Leaf { .. } => cells.push((node, cell)),
+                NodeKind::Interior {
+                    axis,
+                    split,
+                    below,
+                    above,
+                } => {
+                    let [low, high] = super::super::split_cell(&cell, axis, f64::from(split));
+                    if below {
+                        pending.push((node + 1, low));
+                    }
+                    if above != 0 {
+                        pending.push((above, high));
+                    }
+                }
+            }
+        }
+        cells
+    }
+
+    #[test]
+    fn the_descent_ends_in_the_leaf_holding_the_origin() {
+        let mut rng = crate::random::Rng::new(12);
+        let boxes = crate::accel::conformance::random_boxes(&mut rng, 3_000, 10.0, 1.0);
+        let tree = KdTree::build(&boxes);
+        let cells = leaf_cells(&tree);
+        let mut in_leaves = 0;
+        for _ in 0..3_000 {
+            let origin = rng.point_in(tree.bounds.min, tree.bounds.max);
+            let ray = Ray::new(origin, rng.unit_vector());
+            let (t_min, t_max) = tree.bounds.intersect_ray(&ray).unwrap();
+            let root = Entry {
+                node: 0,
+                t_min,
+                t_max,
+            };
+            let mut stack = Stack::<Entry, STACK_CAPACITY>::new();
+            let mut work = TraversalCounters::default();
+            let end = tree.descend(root, &Axes::new(&ray), &mut stack, &mut work);
+            let holding: Vec<u32> = cells
+                .iter()
+                .filter(|(_, c)| (0..3).all(|a| c.min[a] <= origin[a] && origin[a] <= c.max[a]))
+                .map(|&(node, _)| node)
+                .collect();
+            if !holding.is_empty() {
+                in_leaves += 1;
+                let end = end.expect("the ray meets the origin's leaf");
+                assert!(holding.contains(&end.node), "{ray:?} ended in {end:?}");
+                assert_eq!(end.t_min, 0.0);
+            }
+            assert!(work.nodes > 0);
+        }
+        // Most of the volume is in stored leaves (cut-off empty space
+        // aside), so most origins are.
+        assert!(in_leaves > 1_500, "{in_leaves} origins in leaves");
     }
 
     #[test]
