@@ -15,6 +15,10 @@
 //! - `occluded(ray, counters, occludes)`: any hit; stops at the first
 //!   primitive for which `occludes(i)` holds.
 //! - `validate(boxes)`: checks the built structure's invariants.
+//!
+//! A caller may say how the rays it traces on a thread relate
+//! ([`with_ray_coherence`]); a structure may pick how it walks by it, never
+//! what it returns.
 //! - `stats()`: its size and quality.
 //!
 //! Culling must be conservative: a structure may skip a primitive only when
@@ -23,6 +27,7 @@
 //! returns (ties at equal `t` may pick either primitive).
 
 pub mod bvh;
+mod coherence;
 pub mod grid;
 pub mod kdtree;
 pub mod linear;
@@ -33,6 +38,7 @@ mod stack;
 pub(crate) mod conformance;
 
 pub use bvh::{Bvh, BvhBuildParams};
+pub use coherence::{RayCoherence, current_ray_coherence, with_ray_coherence};
 pub use grid::{Grid, GridBuildParams};
 pub use kdtree::{Clipper, KdTree, KdTreeBuildParams};
 pub use linear::Linear;

@@ -14,6 +14,7 @@ mod timing;
 pub use scene_rays::scene_ray_sets;
 pub use timing::{TraceResults, time_set, trace_all};
 
+use crate::accel::RayCoherence;
 use crate::math::Ray;
 
 /// The kinds of rays measured.
@@ -43,6 +44,16 @@ impl RayKind {
     /// True for kinds that ask for any hit rather than the closest.
     pub fn is_any_hit(&self) -> bool {
         matches!(self, RayKind::Shadow)
+    }
+
+    /// How the directions of one ray and the next relate: camera rays
+    /// through neighbouring pixels and shadow rays from neighbouring hits
+    /// towards one light go about the same way, diffuse bounces every way.
+    pub fn coherence(&self) -> RayCoherence {
+        match self {
+            RayKind::Primary | RayKind::Shadow => RayCoherence::Coherent,
+            RayKind::Diffuse => RayCoherence::Incoherent,
+        }
     }
 }
 

@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use super::RaySet;
-use crate::accel::TraversalCounters;
+use crate::accel::{TraversalCounters, with_ray_coherence};
 use crate::geometry::Geometry;
 use crate::math::Ray;
 
@@ -23,8 +23,14 @@ pub enum TraceResults {
 }
 
 /// Traces every ray once on this thread, keeping each result, and counts the
-/// traversal work of all of them.
+/// traversal work of all of them. Here and in [`time_set`] the queries are
+/// told how the set's rays relate ([`super::RayKind::coherence`]).
 pub fn trace_all(geometry: &Geometry, set: &RaySet) -> (TraceResults, TraversalCounters) {
+    with_ray_coherence(set.kind.coherence(), || trace_all_here(geometry, set))
+}
+
+/// [`trace_all`], with the hint already in place.
+fn trace_all_here(geometry: &Geometry, set: &RaySet) -> (TraceResults, TraversalCounters) {
     let mut counters = TraversalCounters::default();
     let results = if set.kind.is_any_hit() {
         TraceResults::Occluded(
@@ -81,12 +87,14 @@ pub fn time_set(
     let pass = || {
         next.store(0, Ordering::Relaxed);
         let per_thread = pool.broadcast(|_| {
-            let mut counters = TraversalCounters::default();
-            let mut found = 0;
-            while let Some(chunk) = chunks.get(next.fetch_add(1, Ordering::Relaxed)) {
-                found += trace(chunk, &mut counters);
-            }
-            found
+            with_ray_coherence(set.kind.coherence(), || {
+                let mut counters = TraversalCounters::default();
+                let mut found = 0;
+                while let Some(chunk) = chunks.get(next.fetch_add(1, Ordering::Relaxed)) {
+                    found += trace(chunk, &mut counters);
+                }
+                found
+            })
         });
         per_thread.into_iter().sum::<usize>()
     };

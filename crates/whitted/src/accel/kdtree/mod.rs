@@ -6,8 +6,6 @@
 //! - `sah.rs`: the cost model and the sweep that picks a plane.
 //! - `build.rs`: the recursive build that splits the sorted events.
 //! - `traverse.rs`: closest-hit and any-hit queries.
-//! - `coherence.rs`: whether a thread's rays keep changing direction,
-//!   which picks how a walk starts.
 //! - `check.rs`: `validate` and `stats`.
 //!
 //! Split planes are `f32`. Boxes are widened outwards to the `f32` grid
@@ -224,21 +222,21 @@
 //!     shadow rays do: kd-tree diffuse 1.77 and 1.75, the BVH's 4.0 → 3.2
 //!     (the two binaries one after the other, not interleaved).
 //!
-//! Kept since session 10: the descent to the origin's leaf, for rays that
-//! keep changing direction. Before a walk, each thread notes whether its
-//! rays' direction octant keeps changing from one ray to the next
-//! (`coherence.rs`); when it does, and the ray starts inside the tree, the
-//! walk first goes down the cells holding the origin, choosing each child
-//! by the origin's side of the plane (a branch neighbouring origins take
-//! alike) and pushing the other without a branch on the direction
-//! (`traverse.rs`, `descend`). It also goes through empty-space cuts whose
-//! stored child holds the origin. Rays going one way (camera rays, shadow
-//! rays towards one light) walk from the root as before. Kd-tree, 1 thread,
-//! Mrays/s before → after, medians of the best of 4 runs in 4 interleaved
-//! rounds (bunny) and of 3 or 4 runs in 3 rounds (dragon, kitchen), with
-//! `python3 best2.py MODEL kdtree primary,shadow,diffuse ROUNDS RUNS
-//! /tmp/anchor_rays OLD NEW`, which alternates `whitted bench MODEL.obj
-//! --rays DIR --accel kdtree --runs RUNS --json` between two binaries:
+//! Kept since session 10: the descent to the origin's leaf, for rays the
+//! caller says are incoherent ([`crate::accel::with_ray_coherence`];
+//! `whitted bench` says so of its diffuse rays). A ray starting inside the
+//! tree then first goes down the cells holding its origin, choosing each
+//! child by the origin's side of the plane (a branch neighbouring origins
+//! take alike) and pushing the other without a branch on the direction
+//! (`traverse.rs`, `descend`); it also goes through empty-space cuts whose
+//! stored child holds the origin. Other rays walk from the root as before.
+//! Kd-tree, 1 thread, Mrays/s before → after, medians of the best of 4
+//! runs in 4 interleaved rounds (bunny) and of 3 or 4 runs in 3 rounds
+//! (dragon, kitchen), with `python3 best2.py MODEL kdtree
+//! primary,shadow,diffuse ROUNDS RUNS /tmp/anchor_rays OLD NEW`, which
+//! alternates `whitted bench MODEL.obj --rays DIR --accel kdtree --runs
+//! RUNS --json` between two binaries (measured with the choice made as
+//! below, which took the descent for exactly the diffuse rays):
 //!
 //! | model | primary | shadow | diffuse |
 //! |---|---|---|---|
@@ -246,16 +244,28 @@
 //! | dragon | 8.39 → 8.56 | 1.73 → 1.75 | 1.03 → 1.22 |
 //! | kitchen | 6.05 → 6.22 | 12.39 → 12.22 | 2.43 → 2.51 |
 //!
-//! The descent taken by every ray starting inside the tree (an environment
-//! switch in a throwaway build) measured as in session 8: bunny diffuse
-//! 2.05 → 2.23, but bunny shadow 3.89 → 3.62, kitchen primary (the camera
-//! inside the tree) 6.24 → 5.50 and kitchen shadow 12.5 → 9.87. The
-//! origin's side compared as order-preserving integer keys instead of
-//! floats: bunny diffuse 2.22 → 2.17, primary 10.9 → 10.5.
+//! Tried on the way and not kept:
+//! - The descent for every ray starting inside the tree (an environment
+//!   switch in a throwaway build), measured as in session 8: bunny diffuse
+//!   2.05 → 2.23, but bunny shadow 3.89 → 3.62, kitchen primary (the
+//!   camera inside the tree) 6.24 → 5.50 and kitchen shadow 12.5 → 9.87.
+//!   With the children's ranges clipped by bounds chosen off the chain
+//!   from one node's range to the next (one `min` and one `max` a step on
+//!   it), the bunny's shadow rays still went from 3.86 to 2.99 (bests of
+//!   4 rounds of 4 runs).
+//! - The choice made without the caller: each thread kept a running share
+//!   of its queries whose direction octant differed from the query
+//!   before's, and took the descent above a third. It chose right for the
+//!   ray files, but a render's rays change octant from one shadow ray to
+//!   the next when there are several lights, while the branch predictor
+//!   still learns the pattern each pixel repeats: rendering `gears.nff`
+//!   (five lights) at 800 × 800 on 1 thread went from 1.96 to 2.19 s
+//!   (best of 5 interleaved runs).
+//! - The origin's side compared as order-preserving integer keys instead
+//!   of floats: bunny diffuse 2.22 → 2.17, primary 10.9 → 10.5.
 
 mod build;
 mod check;
-mod coherence;
 mod events;
 mod node;
 mod sah;
@@ -295,10 +305,10 @@ impl Default for KdTreeBuildParams {
 
 /// A kd-tree over primitive boxes.
 ///
-/// Its queries keep, per thread, a running note of how often the ray's
-/// direction octant changes from one query to the next, and start the walk
-/// of a ray among ever-changing ones at its origin's leaf. Only their speed
-/// depends on it: both starts return the same hits.
+/// Its queries start the walk of a ray at its origin's leaf when the
+/// caller says the rays are incoherent ([`crate::accel::with_ray_coherence`]),
+/// at the root otherwise. Only their speed depends on it: both starts
+/// return the same hits.
 #[derive(Clone, Debug)]
 pub struct KdTree {
     /// The nodes, root first, each below child right after its parent.

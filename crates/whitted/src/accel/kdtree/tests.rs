@@ -6,12 +6,11 @@
 //! the ray enters its box, so both structures see exactly the same hits.
 
 use super::build::default_max_depth;
-use super::coherence;
 use super::node::{KdNode, NodeKind};
 use super::traverse::{SHALLOW, STACK_CAPACITY};
 use super::{KdTree, KdTreeBuildParams};
 use crate::accel::conformance::{assert_conforms, random_boxes};
-use crate::accel::{AccelKind, Accelerator, TraversalCounters};
+use crate::accel::{AccelKind, Accelerator, RayCoherence, TraversalCounters, with_ray_coherence};
 use crate::math::{Aabb, Ray, Vec3};
 use crate::random::Rng;
 use crate::shape::Triangle;
@@ -47,27 +46,35 @@ fn assert_matches_brute_force(boxes: &[Aabb], rays: &[Ray], what: &str) -> KdTre
     let accel = Accelerator::KdTree(tree.clone());
     let oracle = Accelerator::build(AccelKind::Linear, boxes);
     let mut hits = 0;
-    for (ray, incoherent) in rays.iter().flat_map(|r| [(r, false), (r, true)]) {
-        coherence::pin(Some(incoherent));
-        let what = format!("{what}, {}", start_name(incoherent));
-        let expected = trace(&oracle, boxes, ray);
-        assert_eq!(trace(&accel, boxes, ray), expected, "{what}: {ray:?}");
-        // Whole leaves, as `Geometry` asks for them.
-        let closest =
-            tree.intersect_in_leaf_order(ray, &mut TraversalCounters::default(), |r, t_max| {
+    with_either_start(|start| {
+        hits = 0;
+        for ray in rays {
+            let expected = trace(&oracle, boxes, ray);
+            assert_eq!(
+                trace(&accel, boxes, ray),
+                expected,
+                "{what}, {start}: {ray:?}"
+            );
+            // Whole leaves, as `Geometry` asks for them.
+            let closest =
+                tree.intersect_in_leaf_order(ray, &mut TraversalCounters::default(), |r, t_max| {
+                    r.map(|e| tree.indices()[e as usize])
+                        .fold(None, |found, i| {
+                            box_hit(&boxes[i as usize], ray, found.unwrap_or(t_max)).or(found)
+                        })
+                });
+            let any = tree.occluded_in_leaf_order(ray, &mut TraversalCounters::default(), |r| {
                 r.map(|e| tree.indices()[e as usize])
-                    .fold(None, |found, i| {
-                        box_hit(&boxes[i as usize], ray, found.unwrap_or(t_max)).or(found)
-                    })
+                    .any(|i| box_hit(&boxes[i as usize], ray, ray.t_max).is_some())
             });
-        let any = tree.occluded_in_leaf_order(ray, &mut TraversalCounters::default(), |r| {
-            r.map(|e| tree.indices()[e as usize])
-                .any(|i| box_hit(&boxes[i as usize], ray, ray.t_max).is_some())
-        });
-        assert_eq!((closest, any), expected, "{what}, whole leaves: {ray:?}");
-        hits += usize::from(expected.1);
-    }
-    coherence::pin(None);
+            assert_eq!(
+                (closest, any),
+                expected,
+                "{what}, {start}, whole leaves: {ray:?}"
+            );
+            hits += usize::from(expected.1);
+        }
+    });
     assert!(hits > 0 || boxes.is_empty(), "{what}: no ray hits anything");
     tree
 }
@@ -97,23 +104,14 @@ fn unit(v: usize) -> Vec3 {
     Vec3::AXES[v]
 }
 
-/// How a walk starts when rays count as `incoherent` or not.
-fn start_name(incoherent: bool) -> &'static str {
-    if incoherent {
-        "descent to the origin's leaf"
-    } else {
-        "walk from the root"
-    }
-}
-
-/// Runs `body` with the walk from the root, then with the descent to the
-/// origin's leaf, giving it the start's name.
+/// Runs `body` with rays said to be coherent (the walk from the root),
+/// then incoherent (the descent to the origin's leaf first), giving it the
+/// start's name.
 fn with_either_start(mut body: impl FnMut(&str)) {
-    for incoherent in [false, true] {
-        coherence::pin(Some(incoherent));
-        body(start_name(incoherent));
-    }
-    coherence::pin(None);
+    with_ray_coherence(RayCoherence::Coherent, || body("walk from the root"));
+    with_ray_coherence(RayCoherence::Incoherent, || {
+        body("descent to the origin's leaf")
+    });
 }
 
 #[test]

@@ -1,9 +1,10 @@
 //! Ray traversal: the ray is clipped to the root box, then walks the leaves
 //! it passes from near to far with a fixed-size to-do stack of
 //! `(node, t_min, t_max)` (pbrt-v4 `KdTreeAggregate::Intersect`). Among
-//! rays that keep changing direction (`coherence.rs`), one starting inside
-//! the tree first goes straight down to its origin's leaf, pushing the
-//! cells it passes by on the same stack ([`KdTree::descend`]).
+//! rays the caller says are incoherent ([`crate::accel::RayCoherence`]),
+//! one starting inside the tree first goes straight down to its origin's
+//! leaf, pushing the cells it passes by on the same stack
+//! ([`KdTree::descend`]).
 //!
 //! Every choice is conservative. The parameter where the ray crosses a
 //! split plane is widened by its rounding error, and both children are
@@ -27,11 +28,10 @@
 //! its triangles several at a time.
 
 use super::KdTree;
-use super::coherence;
 use super::node::NodeKind;
-use crate::accel::TraversalCounters;
 use crate::accel::mailbox::Mailbox;
 use crate::accel::stack::Stack;
+use crate::accel::{RayCoherence, TraversalCounters, current_ray_coherence};
 use crate::math::{Ray, gamma};
 use std::ops::Range;
 
@@ -253,9 +253,9 @@ impl KdTree {
             t_min,
             t_max,
         };
-        // A ray starting inside the tree, among rays that keep changing
-        // direction, first goes down to its origin's leaf.
-        if coherence::incoherent(axes.octant()) && t_min <= ray.t_min {
+        // A ray starting inside the tree, among rays said to go every way,
+        // first goes down to its origin's leaf.
+        if current_ray_coherence() == RayCoherence::Incoherent && t_min <= ray.t_min {
             let Some(start) = self
                 .descend(entry, &axes, &mut stack, &mut work)
                 .or_else(|| stack.pop())
@@ -323,7 +323,7 @@ impl KdTree {
     /// down the nodes whose cells hold the origin, each step choosing the
     /// child on the origin's side of the plane and pushing the other one
     /// if the ray meets it, without a branch on the ray's direction (see
-    /// `coherence.rs`). Stops at the origin's leaf, or at the stored child
+    /// [`crate::accel::RayCoherence`]). Stops at the origin's leaf, or at the stored child
     /// of an empty-space cut when the origin lies in the empty part. Returns
     /// where the walk goes on, `None` when the ray misses that node's cell
     /// (the walk then takes the next cell from the stack).
@@ -415,13 +415,6 @@ impl Axes {
             origin: ray.origin.to_array(),
             inv_dir: ray.inv_dir.to_array(),
         }
-    }
-
-    /// The direction's octant: bit `axis` set where it goes down that axis.
-    #[inline(always)]
-    fn octant(&self) -> u32 {
-        let down = |axis: usize| u32::from(self.inv_dir[axis].is_sign_negative()) << axis;
-        down(0) | down(1) | down(2)
     }
 }
 
