@@ -117,6 +117,7 @@ fn with_either_start(mut body: impl FnMut(&str)) {
 #[test]
 fn kdtree_conforms_to_brute_force_with_either_start() {
     with_either_start(|start| {
+        // Printed with a failure's output: which start failed.
         println!("{start}");
         assert_conforms(AccelKind::KdTree);
     });

@@ -323,10 +323,11 @@ impl KdTree {
     /// down the nodes whose cells hold the origin, each step choosing the
     /// child on the origin's side of the plane and pushing the other one
     /// if the ray meets it, without a branch on the ray's direction (see
-    /// [`crate::accel::RayCoherence`]). Stops at the origin's leaf, or at the stored child
-    /// of an empty-space cut when the origin lies in the empty part. Returns
-    /// where the walk goes on, `None` when the ray misses that node's cell
-    /// (the walk then takes the next cell from the stack).
+    /// [`crate::accel::RayCoherence`]). Stops at the origin's leaf, or at
+    /// the stored child of an empty-space cut when the origin lies in the
+    /// empty part. Returns where the walk goes on, `None` when the ray
+    /// misses that node's cell (the walk then takes the next cell from the
+    /// stack).
     ///
     /// Every range is the one [`children`] or [`stored_side`] gives, so the
     /// walk visits the same cells, pushed in another order only when the
