@@ -114,6 +114,34 @@ fn with_either_start(mut body: impl FnMut(&str)) {
     });
 }
 
+/// Checks that `accel` and `oracle` give every ray the same closest hit
+/// and any-hit answer with either start, primitives hit by `hit(i, ray,
+/// t_max)`. Returns how many rays hit something.
+fn assert_agrees_with(
+    accel: &Accelerator,
+    oracle: &Accelerator,
+    rays: &[Ray],
+    hit: impl Fn(u32, &Ray, f64) -> Option<f64>,
+) -> usize {
+    let mut hits = 0;
+    with_either_start(|start| {
+        hits = 0;
+        for ray in rays {
+            let mut c = TraversalCounters::default();
+            let expected = oracle.intersect(ray, &mut c, |i, t| hit(i, ray, t));
+            let actual = accel.intersect(ray, &mut c, |i, t| hit(i, ray, t));
+            assert_eq!(actual, expected, "{start}: {ray:?}");
+            let any = |a: &Accelerator, c: &mut TraversalCounters| {
+                a.occluded(ray, c, |i| hit(i, ray, ray.t_max).is_some())
+            };
+            let expected_any = any(oracle, &mut c);
+            assert_eq!(any(accel, &mut c), expected_any, "{start}: {ray:?}");
+            hits += usize::from(expected_any);
+        }
+    });
+    hits
+}
+
 #[test]
 fn kdtree_conforms_to_brute_force_with_either_start() {
     with_either_start(|start| {
@@ -401,22 +429,7 @@ fn unplaceable_boxes_are_tested_like_brute_force() {
     let oracle = Accelerator::build(AccelKind::Linear, &boxes);
     let accel = Accelerator::KdTree(tree);
     let rays = random_rays(&mut rng, 500, 5.0);
-    with_either_start(|start| {
-        for ray in &rays {
-            let mut c = TraversalCounters::default();
-            let expected = oracle.intersect(ray, &mut c, |i, t| hit(i, ray, t));
-            let actual = accel.intersect(ray, &mut c, |i, t| hit(i, ray, t));
-            assert_eq!(actual, expected, "{start}: {ray:?}");
-            let any = |a: &Accelerator, c: &mut TraversalCounters| {
-                a.occluded(ray, c, |i| hit(i, ray, ray.t_max).is_some())
-            };
-            assert_eq!(
-                any(&accel, &mut c),
-                any(&oracle, &mut c),
-                "{start}: {ray:?}"
-            );
-        }
-    });
+    assert_agrees_with(&accel, &oracle, &rays, hit);
 }
 
 #[test]
@@ -592,21 +605,7 @@ fn perfect_splits_keep_every_triangle_where_it_meets_a_cell_and_match_brute_forc
     };
     let oracle = Accelerator::build(AccelKind::Linear, &boxes);
     let accel = Accelerator::KdTree(tree);
-    let mut hits = 0;
-    with_either_start(|start| {
-        hits = 0;
-        for ray in &rays {
-            let mut c = TraversalCounters::default();
-            let expected = oracle.intersect(ray, &mut c, |i, t| hit(i, ray, t));
-            let actual = accel.intersect(ray, &mut c, |i, t| hit(i, ray, t));
-            assert_eq!(actual, expected, "{start}: {ray:?}");
-            let any = |a: &Accelerator, c: &mut TraversalCounters| {
-                a.occluded(ray, c, |i| hit(i, ray, ray.t_max).is_some())
-            };
-            assert_eq!(any(&accel, &mut c), expected.is_some(), "{start}: {ray:?}");
-            hits += usize::from(expected.is_some());
-        }
-    });
+    let hits = assert_agrees_with(&accel, &oracle, &rays, hit);
     assert!(
         hits > rays.len() / 4,
         "only {hits} of {} rays hit",
