@@ -1,6 +1,7 @@
 //! What a caller knows of the rays it traces on a thread: whether they
 //! go the same way one after the other. Only the speed of a query depends
-//! on it, never its answer.
+//! on it, never its answer (on an exact tie between primitives at the same
+//! `t`, the walk's order may pick the other one).
 //!
 //! The kd-tree's walk branches at every node on the ray's direction along
 //! the node's axis. Rays that go the same way one after the other (camera

@@ -15,11 +15,12 @@
 //! - `occluded(ray, counters, occludes)`: any hit; stops at the first
 //!   primitive for which `occludes(i)` holds.
 //! - `validate(boxes)`: checks the built structure's invariants.
+//! - `stats()`: its size and quality.
 //!
 //! A caller may say how the rays it traces on a thread relate
 //! ([`with_ray_coherence`]); a structure may pick how it walks by it, never
-//! what it returns.
-//! - `stats()`: its size and quality.
+//! the closest `t` it returns (on an exact tie, which primitive may
+//! change, as between structures).
 //!
 //! Culling must be conservative: a structure may skip a primitive only when
 //! the ray provably cannot meet its box within the interval, so every

@@ -47,8 +47,9 @@ impl<T: Copy, const N: usize> Stack<T, N> {
     #[inline(always)]
     pub fn pop(&mut self) -> Option<T> {
         self.len = self.len.checked_sub(1)?;
-        // SAFETY: every slot below `len` has been written (by `push` or
-        // `insert_above`), and entries are `Copy`.
+        // SAFETY: every slot below `len` has been written (by `push`,
+        // `push_if` or `insert_above`, each before raising `len`), and
+        // entries are `Copy`.
         Some(unsafe { self.entries[self.len].assume_init() })
     }
 

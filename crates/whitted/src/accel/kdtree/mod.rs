@@ -308,7 +308,8 @@ impl Default for KdTreeBuildParams {
 /// Its queries start the walk of a ray at its origin's leaf when the
 /// caller says the rays are incoherent ([`crate::accel::with_ray_coherence`]),
 /// at the root otherwise. Only their speed depends on it: both starts
-/// return the same hits.
+/// return the same closest `t` (on an exact tie, possibly another
+/// primitive).
 #[derive(Clone, Debug)]
 pub struct KdTree {
     /// The nodes, root first, each below child right after its parent.

@@ -319,7 +319,8 @@ impl KdTree {
 }
 
 impl KdTree {
-    /// The start of a walk for a ray whose origin lies in `root`'s cell:
+    /// The start of a walk for a ray whose origin lies in `root`'s cell
+    /// (one that starts at `t_min` = 0 inside the root's box):
     /// down the nodes whose cells hold the origin, each step choosing the
     /// child on the origin's side of the plane and pushing the other one
     /// if the ray meets it, without a branch on the ray's direction (see
@@ -330,8 +331,12 @@ impl KdTree {
     /// stack).
     ///
     /// Every range is the one [`children`] or [`stored_side`] gives, so the
-    /// walk visits the same cells, pushed in another order only when the
-    /// ray crosses a plane before its range starts.
+    /// walk visits the same cells. Their order differs from the walk's only
+    /// when the crossing lies at or behind the range's start (an origin on
+    /// a plane, a negative `t_min`, a ray in a plane): the closest `t` is
+    /// the same, and on an exact tie another primitive may be returned.
+    /// The side chosen only orders the cells, so the call's condition (the
+    /// point at `ray.t_min`, not the origin, inside the root) is for speed.
     #[inline(always)]
     fn descend<const N: usize>(
         &self,
