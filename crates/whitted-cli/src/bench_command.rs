@@ -10,12 +10,13 @@ use std::time::Instant;
 use clap::Args;
 use serde_json::{Value, json};
 use whitted::accel::{AccelKind, AccelStats};
+use whitted::bench::obj_positions::load_obj_positions;
 use whitted::bench::ray_files::{RayFile, agreement, read_ray_file};
 use whitted::bench::{RayKind, RaySet, TraceResults, scene_ray_sets, time_set, trace_all};
-use whitted::camera::Camera;
-use whitted::geometry::Geometry;
-use whitted::mesh::load_obj_positions;
-use whitted::scene::{Scene, load_any};
+use whitted::render::Camera;
+use whitted::render::Scene;
+use whitted::scene::load_any;
+use whitted::world::World;
 
 use crate::progress::Status;
 
@@ -159,14 +160,14 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         }
         None => {
             status.set("generating rays".to_string());
-            let geometry = Geometry::new(&scene);
+            let geometry = World::new(&scene.objects);
             let sets = scene_ray_sets(&scene, &geometry, args.width, args.height);
             let none = sets.iter().map(|_| None).collect();
             (sets, none)
         }
     };
     let total_rays: usize = sets.iter().map(|s| s.rays.len()).sum();
-    let primitives = scene.primitive_count();
+    let primitives = scene.objects.primitive_count();
 
     let mut reports = Vec::new();
     for &kind in &kinds {
@@ -235,10 +236,10 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
 /// and the best time: the first build alone also pays for starting the
 /// thread pool and for fresh memory, which the Embree harness's median of
 /// three builds does not.
-fn time_build(scene: &Scene, kind: AccelKind, runs: usize) -> (Geometry<'_>, f64) {
+fn time_build(scene: &Scene, kind: AccelKind, runs: usize) -> (World<'_>, f64) {
     let build = || {
         let start = Instant::now();
-        let geometry = Geometry::with_accel(scene, kind);
+        let geometry = World::build(&scene.objects, kind);
         (geometry, start.elapsed().as_secs_f64())
     };
     let (mut geometry, mut best) = build();

@@ -5,11 +5,11 @@ use std::time::Instant;
 
 use clap::Args;
 use whitted::accel::AccelKind;
-use whitted::heat_map::heat_map;
+use whitted::image::heat_map;
 use whitted::image::{ImageFormat, check_destination};
 use whitted::math::Vec3;
-use whitted::render::{Aov, RenderOptions, render};
-use whitted::scene::{CameraOverride, LoadOptions, Scene, load_any_with};
+use whitted::render::{Aov, render};
+use whitted::scene::{CameraOverride, LoadOptions, load_any_with};
 
 use crate::progress::ProgressReport;
 
@@ -184,13 +184,13 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
                     "{}: read in {:.3} s, {} primitives",
                     path.display(),
                     start.elapsed().as_secs_f64(),
-                    loaded.scene.primitive_count()
+                    loaded.scene.objects.primitive_count()
                 );
             }
             loaded.scene
         }
         None => {
-            let mut scene = Scene::default_scene();
+            let mut scene = whitted::scene::default_scene();
             scene.camera = options
                 .camera
                 .apply(&scene.camera)
@@ -208,14 +208,12 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         return Err("--threads must be at least 1".to_string());
     }
 
-    let options = RenderOptions {
-        threads: args.threads,
-        aovs: aov_outputs.iter().map(|(a, _)| *a).collect(),
-    };
+    scene.settings.threads = args.threads;
+    scene.settings.aovs = aov_outputs.iter().map(|(a, _)| *a).collect();
     let total = u64::from(scene.settings.width) * u64::from(scene.settings.height);
     let bar = ProgressReport::new(total, args.quiet);
     let start = Instant::now();
-    let output = render(&scene, &options, &|p| bar.update(p));
+    let output = render(&scene, &|p| bar.update(p));
     bar.finish();
     let output = output.map_err(|e| e.to_string())?;
     let elapsed = start.elapsed().as_secs_f64();
@@ -239,17 +237,19 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
 
     if !args.quiet {
         let rays = output.rays;
+        let by_kind = output
+            .ray_kinds
+            .iter()
+            .map(|&kind| format!("{} {}", rays[kind], kind.name()))
+            .collect::<Vec<_>>()
+            .join(", ");
         eprintln!(
-            "{}: {}x{}, {} spp in {:.3} s; rays: {} primary, {} shadow, {} reflected, {} refracted; {:.2} Mrays/s",
+            "{}: {}x{}, {} spp in {:.3} s; rays: {by_kind}; {:.2} Mrays/s",
             args.output.display(),
             scene.settings.width,
             scene.settings.height,
             scene.settings.samples_per_pixel,
             elapsed,
-            rays.primary,
-            rays.shadow,
-            rays.reflected,
-            rays.refracted,
             rays.total() as f64 / elapsed / 1e6,
         );
     }

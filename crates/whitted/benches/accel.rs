@@ -9,9 +9,9 @@ use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use whitted::accel::{AccelKind, Accelerator, TraversalCounters};
+use whitted::math::random::Rng;
 use whitted::math::{Aabb, Ray, Vec3};
 use whitted::mesh::TriangleMesh;
-use whitted::random::Rng;
 use whitted::shape::RayShear;
 
 /// A sphere of `rings × segments × 2` triangles with seeded radial bumps.

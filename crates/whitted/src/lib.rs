@@ -5,18 +5,33 @@
 //! intersected primitives, shades it with the Phong model, casts shadow rays
 //! and recurses for reflection and refraction.
 //!
-//! The data flow is parse → prepare → trace → write: a [`scene::Scene`] comes
-//! from a scene file (or is built in code), [`render::render`] turns it into
-//! an [`image::Film`] plus optional per-pixel data, and the writers in
+//! The library is built in layers, each importing only from the ones
+//! before it (ARCHITECTURE.md draws them; a test checks it):
+//!
+//! | layer | what it holds |
+//! |---|---|
+//! | [`math`] | vectors, rays, boxes, transforms, error bounds, random numbers, sample patterns |
+//! | [`shape`] | the primitives, each intersected exactly |
+//! | [`mesh`] | triangle meshes with shared vertices |
+//! | [`accel`] | acceleration structures over boxes (they know `math` only) |
+//! | [`world`] | what is traced: objects prepared once for ray queries |
+//! | [`shading`] | colours, materials, textures, bump maps, lights, optics |
+//! | [`integrator`] | the algorithms that turn rays into colours (Whitted) |
+//! | [`image`] | films and their writers (PNG, EXR, PFM), heat maps |
+//! | [`render`](mod@render) | the scene description, settings, camera, tiles over threads |
+//! | [`scene`] | readers: TOML, NFF, OBJ → one [`Scene`] |
+//! | [`bench`](mod@bench) | measuring the acceleration structures |
+//!
+//! The data flow is parse → prepare → trace → write: a [`Scene`] comes from
+//! a scene file (or is built in code), [`render::render`] turns it into an
+//! [`image::Film`] plus optional per-pixel data, and the writers in
 //! [`image`] save it as PNG, EXR or PFM.
 //!
 //! ```
-//! use whitted::camera::Camera;
-//! use whitted::light::{Attenuation, Light};
-//! use whitted::material::Material;
-//! use whitted::math::{Color, Transform, Vec3};
-//! use whitted::render::{RenderOptions, render};
-//! use whitted::scene::Scene;
+//! use whitted::math::{Transform, Vec3};
+//! use whitted::render::{Camera, Scene, render};
+//! use whitted::shading::{Attenuation, Color, Light, Material};
+//! use whitted::integrator::RayKind;
 //! use whitted::shape::{Shape, Sphere};
 //!
 //! let camera = Camera::new(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, Vec3::Y, 40.0)?;
@@ -34,32 +49,25 @@
 //!     attenuation: Attenuation::NONE,
 //! });
 //!
-//! let output = render(&scene, &RenderOptions::default(), &|_progress| {})?;
+//! let output = render(&scene, &|_progress| {})?;
 //! let centre = output.image.pixel(16, 12);
 //! assert!(centre[0] > centre[1]);
-//! assert_eq!(output.rays.primary, 32 * 24);
+//! assert_eq!(output.rays[RayKind::Primary], 32 * 24);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 #![deny(missing_docs)]
 
 pub mod accel;
 pub mod bench;
-pub mod bump;
-pub mod camera;
-pub mod color_space;
-pub mod geometry;
-pub mod heat_map;
 pub mod image;
-pub mod light;
-pub mod material;
+pub mod integrator;
 pub mod math;
 pub mod mesh;
-pub mod random;
 pub mod render;
-pub mod sampling;
 pub mod scene;
+pub mod shading;
 pub mod shape;
-pub mod tangent_frame;
-pub mod texture;
-pub mod trace;
-pub mod triangle_clip;
+pub mod world;
+
+pub use render::{RenderSettings, Scene, render};
+pub use scene::load_any;

@@ -4,12 +4,14 @@
 
 use std::sync::Arc;
 
-use whitted::light::{Attenuation, Light};
-use whitted::material::Material;
-use whitted::math::{Color, DVec2, Transform, Vec3};
-use whitted::scene::Scene;
+use whitted::math::{DVec2, Transform, Vec3};
+use whitted::render::Scene;
+use whitted::shading::Color;
+use whitted::shading::Material;
+use whitted::shading::Texture;
+use whitted::shading::texture::{DissolveMap, ImageData, ImageTexture, Wrap};
+use whitted::shading::{Attenuation, Light};
 use whitted::shape::{Parallelogram, Plane, Shape, Sphere};
-use whitted::texture::{DissolveMap, ImageData, ImageTexture, Texture, Wrap};
 
 mod common;
 use common::{black, pixel, rendered, scene_looking_down_z};

@@ -11,9 +11,9 @@
 
 use std::path::{Path, PathBuf};
 
-use whitted::color_space::encode_srgb8;
 use whitted::image::Film;
-use whitted::render::{RenderOptions, render};
+use whitted::image::encode_srgb8;
+use whitted::render::render;
 use whitted::scene::load_scene;
 
 const SIZE: u32 = 64;
@@ -108,9 +108,7 @@ fn example_scenes_match_their_golden_images() {
         let mut scene = load_scene(scene_path).unwrap();
         scene.settings.width = SIZE;
         scene.settings.height = SIZE;
-        let film = render(&scene, &RenderOptions::default(), &|_| {})
-            .unwrap()
-            .image;
+        let film = render(&scene, &|_| {}).unwrap().image;
         let actual = to_srgb8(&film);
         let golden_path = golden_folder().join(format!("{name}.png"));
         if update {

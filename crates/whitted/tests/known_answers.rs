@@ -1,10 +1,12 @@
 //! Renders of analytic scenes whose correct pixel values are known exactly.
 
-use whitted::light::{Attenuation, Light};
-use whitted::material::Material;
-use whitted::math::{Color, Transform, Vec3};
-use whitted::render::{RenderOptions, render};
-use whitted::scene::Scene;
+use whitted::integrator::RayKind;
+use whitted::math::{Transform, Vec3};
+use whitted::render::Scene;
+use whitted::render::render;
+use whitted::shading::Color;
+use whitted::shading::Material;
+use whitted::shading::{Attenuation, Light};
 use whitted::shape::{Plane, Shape, Sphere};
 
 mod common;
@@ -36,14 +38,10 @@ fn diffuse_plane_lit_head_on_is_kd_times_intensity_in_every_pixel() {
         intensity,
     });
     let film = rendered(&scene);
-    let expected = (kd * intensity).as_vec3();
+    let expected = (kd * intensity).to_f32();
     for y in 0..11 {
         for x in 0..17 {
-            assert_eq!(
-                film.pixel(x, y),
-                expected.to_array().as_slice(),
-                "({x}, {y})"
-            );
+            assert_eq!(film.pixel(x, y), expected.as_slice(), "({x}, {y})");
         }
     }
 }
@@ -235,26 +233,20 @@ fn phong_highlight_peaks_where_the_mirror_direction_meets_the_eye() {
     });
     let film = rendered(&scene);
     assert_close(pixel(&film, 1, 1), Color::ONE, 1e-12);
-    let corner = pixel(&film, 0, 0).x;
+    let corner = pixel(&film, 0, 0).r;
     assert!(corner < 1.0 && corner > 0.9, "{corner}");
 }
 
 #[test]
 fn picture_is_identical_whatever_the_thread_count() {
-    let mut scene = Scene::default_scene();
+    let mut scene = whitted::scene::default_scene();
     scene.settings.width = 48;
     scene.settings.height = 36;
     scene.settings.samples_per_pixel = 4;
     let with = |threads| {
-        render(
-            &scene,
-            &RenderOptions {
-                threads: Some(threads),
-                aovs: Vec::new(),
-            },
-            &|_| {},
-        )
-        .unwrap()
+        let mut scene = scene.clone();
+        scene.settings.threads = Some(threads);
+        render(&scene, &|_| {}).unwrap()
     };
     let one = with(1);
     let three = with(3);
@@ -279,11 +271,8 @@ fn aovs_give_depth_normal_and_primitive_of_the_centre_ray() {
         material,
         Transform::IDENTITY,
     );
-    let options = RenderOptions {
-        threads: None,
-        aovs: vec![Aov::Id, Aov::Depth, Aov::Normal],
-    };
-    let out = render(&scene, &options, &|_| {}).unwrap();
+    scene.settings.aovs = vec![Aov::Id, Aov::Depth, Aov::Normal];
+    let out = render(&scene, &|_| {}).unwrap();
     let film = |aov| &out.aovs.iter().find(|(a, _)| *a == aov).unwrap().1;
     assert_eq!(out.aovs[0].0, Aov::Id);
     assert_eq!(film(Aov::Depth).pixel(1, 1), &[5.0]);
@@ -295,8 +284,8 @@ fn aovs_give_depth_normal_and_primitive_of_the_centre_ray() {
     let s: f64 = 2.0 / 3.0;
     assert!((corner_depth - 5.0 * (1.0 + 2.0 * s * s).sqrt()).abs() < 1e-5);
 
-    scene.primitives.pop();
-    let out = render(&scene, &options, &|_| {}).unwrap();
+    scene.objects.primitives.pop();
+    let out = render(&scene, &|_| {}).unwrap();
     let film = |aov| &out.aovs.iter().find(|(a, _)| *a == aov).unwrap().1;
     assert_eq!(film(Aov::Depth).pixel(0, 0), &[f32::INFINITY]);
     assert_eq!(film(Aov::Normal).pixel(0, 0), &[0.0, 0.0, 0.0]);
@@ -323,19 +312,16 @@ fn facing_perfect_mirrors_recurse_to_the_deepest_allowed_depth_without_overflow(
         Transform::IDENTITY,
     );
     scene.settings.max_depth = MAX_DEPTH;
-    let options = RenderOptions {
-        threads: Some(1),
-        aovs: Vec::new(),
-    };
-    let out = render(&scene, &options, &|_| {}).unwrap();
+    scene.settings.threads = Some(1);
+    let out = render(&scene, &|_| {}).unwrap();
     // Every bounce adds the emission once: depth + 1 times in all.
     let expected = 0.001 * f64::from(MAX_DEPTH + 1);
     assert_close(pixel(&out.image, 0, 0), Color::splat(expected), 1e-6);
-    assert_eq!(out.rays.reflected, 4 * u64::from(MAX_DEPTH));
+    assert_eq!(out.rays[RayKind::Reflected], 4 * u64::from(MAX_DEPTH));
 
     scene.settings.max_depth = MAX_DEPTH + 1;
     assert!(matches!(
-        render(&scene, &options, &|_| {}),
+        render(&scene, &|_| {}),
         Err(RenderError::DepthTooLarge(_))
     ));
 }
@@ -381,8 +367,8 @@ fn a_mesh_renders_exactly_like_its_triangles_given_one_by_one() {
         }
         scene
     };
-    let mesh = render(&build(true), &RenderOptions::default(), &|_| {}).unwrap();
-    let single = render(&build(false), &RenderOptions::default(), &|_| {}).unwrap();
+    let mesh = render(&build(true), &|_| {}).unwrap();
+    let single = render(&build(false), &|_| {}).unwrap();
     assert_eq!(mesh.image, single.image);
     assert!(mesh.image.data().iter().any(|&v| v > 0.2));
 }
@@ -414,7 +400,7 @@ fn vertex_normals_shade_a_flat_mesh_as_if_it_were_curved() {
         }
         let id = scene.add_mesh(mesh);
         scene.add_mesh_instance(id, m, Transform::IDENTITY);
-        pixel(&rendered(&scene), 1, 1).x
+        pixel(&rendered(&scene), 1, 1).r
     };
     let flat = brightness(None);
     let curved = brightness(Some(vec![lean; 3]));

@@ -7,7 +7,7 @@
 
 use std::path::Path;
 
-use whitted::mesh::parse_obj_positions;
+use whitted::bench::obj_positions::parse_obj_positions;
 use whitted::scene::{MAX_DIAGNOSTICS, SceneError, parse_nff, parse_obj, parse_scene};
 
 /// The diagnostics' count and the whole message's length, and checks the

@@ -3,9 +3,10 @@
 
 use std::path::{Path, PathBuf};
 
-use whitted::light::Light;
-use whitted::math::{Color, Vec3};
+use whitted::math::Vec3;
 use whitted::scene::{load_any, load_nff};
+use whitted::shading::Color;
+use whitted::shading::Light;
 
 /// The SPD scenes, outside the repository: `shared/scenes/spd` beside it.
 fn spd_folder() -> PathBuf {
@@ -29,7 +30,7 @@ fn every_spd_scene_parses() {
     for file in &files {
         match load_nff(file) {
             Ok(scene) => assert!(
-                scene.primitive_count() > 0 && !scene.lights.is_empty(),
+                scene.objects.primitive_count() > 0 && !scene.lights.is_empty(),
                 "{} is empty",
                 file.display()
             ),
@@ -54,7 +55,7 @@ fn the_spd_primitive_counts_are_kept() {
             continue;
         }
         let scene = load_nff(&file).unwrap();
-        assert_eq!(scene.primitive_count(), total, "{name}");
+        assert_eq!(scene.objects.primitive_count(), total, "{name}");
     }
 }
 
@@ -65,18 +66,28 @@ fn the_spd_like_fixture_reads_every_entity() {
     assert_eq!((scene.settings.width, scene.settings.height), (64, 48));
     assert_eq!(scene.background, Color::new(0.078, 0.361, 0.753));
     assert_eq!(scene.camera.eye(), Vec3::new(0.0, -6.0, 2.5));
-    let kinds: Vec<&str> = scene.primitives.iter().map(|p| p.shape.kind()).collect();
+    let kinds: Vec<&str> = scene
+        .objects
+        .primitives
+        .iter()
+        .map(|p| p.shape.kind())
+        .collect();
     assert_eq!(
         kinds,
         ["polygon", "sphere", "cone", "cylinder", "sphere", "polygon"]
     );
     // The patch is a smooth mesh.
-    assert_eq!(scene.meshes.len(), 1);
-    assert_eq!(scene.primitive_count(), 7);
+    assert_eq!(scene.objects.meshes.len(), 1);
+    assert_eq!(scene.objects.primitive_count(), 7);
     // Four distinct `f` entities, in order of appearance.
-    let materials: Vec<u32> = scene.primitives.iter().map(|p| p.material.0).collect();
+    let materials: Vec<u32> = scene
+        .objects
+        .primitives
+        .iter()
+        .map(|p| p.material.0)
+        .collect();
     assert_eq!(materials, [0, 1, 1, 1, 2, 3]);
-    assert_eq!(scene.mesh_instances[0].material.0, 3);
+    assert_eq!(scene.objects.mesh_instances[0].material.0, 3);
     assert!(scene.materials[2].is_transmissive());
     let intensities: Vec<Color> = scene
         .lights
@@ -95,9 +106,7 @@ fn an_nff_background_is_written_to_png_as_pov_ray_writes_it() {
     let source = "b 0.078 0.361 0.753\nv\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 30\n\
                   hither 1\nresolution 2 2\n";
     let scene = whitted::scene::parse_nff(source, Path::new("sky.nff")).unwrap();
-    let film = whitted::render::render(&scene, &Default::default(), &|_| {})
-        .unwrap()
-        .image;
+    let film = whitted::render::render(&scene, &|_| {}).unwrap().image;
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("sky.png");
     film.write(&path).unwrap();

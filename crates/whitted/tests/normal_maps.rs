@@ -5,16 +5,19 @@
 use std::f64::consts::FRAC_1_SQRT_2;
 use std::sync::Arc;
 
-use whitted::bump::Bump;
-use whitted::camera::Camera;
-use whitted::light::Light;
-use whitted::material::{Material, MaterialId};
-use whitted::math::{Color, DVec2, Transform, Vec3};
+use whitted::math::{DVec2, Transform, Vec3};
 use whitted::mesh::TriangleMesh;
-use whitted::render::{RenderOptions, render};
-use whitted::scene::Scene;
+use whitted::render::Camera;
+use whitted::render::Scene;
+use whitted::render::render;
+use whitted::shading::Bump;
+use whitted::shading::Color;
+use whitted::shading::Light;
+use whitted::shading::Material;
+use whitted::shading::Texture;
+use whitted::shading::texture::{ImageData, ImageTexture, Wrap};
 use whitted::shape::{Parallelogram, Shape};
-use whitted::texture::{ImageData, ImageTexture, Texture, Wrap};
+use whitted::world::MaterialId;
 
 /// A 9×9 picture of the square [-2, 2]² in the plane z = 0, seen from
 /// z = 5, lit by one directional light towards `to_light` (unit).
@@ -67,9 +70,7 @@ fn add_square_mesh(scene: &mut Scene, uv: [DVec2; 4], material: MaterialId) {
 
 /// The centre pixel's red value.
 fn centre(scene: &Scene) -> f64 {
-    let film = render(scene, &RenderOptions::default(), &|_| {})
-        .unwrap()
-        .image;
+    let film = render(scene, &|_| {}).unwrap().image;
     f64::from(film.pixel(4, 4)[0])
 }
 
@@ -173,9 +174,7 @@ fn a_flat_normal_map_renders_exactly_like_no_map() {
             })
         });
         add_square_mesh(&mut scene, [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y], m);
-        render(&scene, &RenderOptions::default(), &|_| {})
-            .unwrap()
-            .image
+        render(&scene, &|_| {}).unwrap().image
     });
     assert_eq!(pictures[0], pictures[1]);
 }

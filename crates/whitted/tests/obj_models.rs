@@ -2,13 +2,15 @@
 
 use std::path::{Path, PathBuf};
 
-use whitted::camera::Camera;
-use whitted::math::{Color, Ray, Vec3};
-use whitted::render::{RenderOptions, render};
+use whitted::math::{Ray, Vec3};
+use whitted::render::Camera;
+use whitted::render::Scene;
+use whitted::render::render;
 use whitted::scene::obj::headlight;
-use whitted::scene::{LoadedScene, Scene, load_obj};
+use whitted::scene::{LoadedScene, load_obj};
+use whitted::shading::Color;
+use whitted::shading::Texture;
 use whitted::shape::RayShear;
-use whitted::texture::Texture;
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -25,6 +27,7 @@ fn hits(scene: &Scene, x: f64, y: f64) -> bool {
     let ray = Ray::new(Vec3::new(x, y, 5.0), -Vec3::Z);
     let shear = RayShear::new(&ray);
     scene
+        .objects
         .meshes
         .iter()
         .any(|m| (0..m.len() as u32).any(|i| m.intersect(i, &ray, &shear).is_some()))
@@ -36,22 +39,22 @@ fn every_face_form_and_relative_indices_are_read() {
     assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
     let scene = loaded.scene;
     // No material, "red paint" (twice), "blue": three meshes.
-    assert_eq!(scene.meshes.len(), 3);
-    assert_eq!(scene.primitive_count(), 8);
-    let red = &scene.materials[scene.mesh_instances[1].material.0 as usize];
-    assert_eq!(red.diffuse, Texture::Constant(Vec3::new(1.0, 0.0, 0.0)));
+    assert_eq!(scene.objects.meshes.len(), 3);
+    assert_eq!(scene.objects.primitive_count(), 8);
+    let red = &scene.materials[scene.objects.mesh_instances[1].material.0 as usize];
+    assert_eq!(red.diffuse, Texture::Constant(Color::RED));
     assert!(red.specular.is_black());
-    let blue = &scene.materials[scene.mesh_instances[2].material.0 as usize];
-    assert_eq!(blue.reflection, Texture::Constant(Vec3::splat(0.5)));
+    let blue = &scene.materials[scene.objects.mesh_instances[2].material.0 as usize];
+    assert_eq!(blue.reflection, Texture::Constant(Color::splat(0.5)));
     // `f 1/1 ...` and `f -4/-4/-1 ...` give different vertices (one has a normal).
-    assert_eq!(scene.meshes[1].positions().len(), 8);
-    assert_eq!(scene.meshes[2].positions().len(), 4);
+    assert_eq!(scene.objects.meshes[1].positions().len(), 8);
+    assert_eq!(scene.objects.meshes[2].positions().len(), 4);
 }
 
 #[test]
 fn a_concave_polygon_leaves_its_notch_empty() {
     let scene = load("concave.obj").scene;
-    assert_eq!(scene.primitive_count(), 4);
+    assert_eq!(scene.objects.primitive_count(), 4);
     assert!(!hits(&scene, 1.5, 1.5), "the notch of the L was hit");
     for (x, y) in [(0.5, 0.5), (1.5, 0.5), (0.5, 1.5)] {
         assert!(hits(&scene, x, y), "({x}, {y}) is inside the L");
@@ -61,7 +64,7 @@ fn a_concave_polygon_leaves_its_notch_empty() {
 #[test]
 fn smoothing_groups_share_vertices_and_s_off_is_flat() {
     let scene = load("smoothing.obj").scene;
-    let mesh = &scene.meshes[0];
+    let mesh = &scene.objects.meshes[0];
     // 6 shared vertices for the smoothed roof, 4 + 4 for the flat one.
     assert_eq!(mesh.positions().len(), 14);
     assert_eq!(mesh.len(), 8);
@@ -78,7 +81,7 @@ fn missing_libraries_and_materials_are_warnings_with_a_grey_fallback() {
     assert!(text[1].contains("missing_materials.obj:5:8: warning: no material `nowhere`"));
     assert_eq!(
         loaded.scene.materials,
-        vec![whitted::material::Material::default()]
+        vec![whitted::shading::Material::default()]
     );
 }
 
@@ -92,7 +95,7 @@ fn the_kitchen_loads_with_its_33_materials() {
     }
     let loaded = load_obj(&path).unwrap();
     assert_eq!(loaded.scene.materials.len(), 33);
-    assert_eq!(loaded.scene.meshes.len(), 33);
+    assert_eq!(loaded.scene.objects.meshes.len(), 33);
     assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
 }
 
@@ -122,15 +125,13 @@ fn map_kd_shows_its_texture_under_a_head_on_light() {
     scene.lights = vec![headlight(&scene.camera)];
     scene.settings.width = 4;
     scene.settings.height = 4;
-    let film = render(&scene, &RenderOptions::default(), &|_| {})
-        .unwrap()
-        .image;
+    let film = render(&scene, &|_| {}).unwrap().image;
     // A corner pixel sees (±0.75, ±0.75, 0): N·L = 5 / |(0.75, 0.75, 5)|.
     let cosine = 5.0 / (25.0f64 + 2.0 * 0.75 * 0.75).sqrt();
     for (x, y, texel) in [
-        (0, 0, Color::X),
-        (3, 0, Color::Y),
-        (0, 3, Color::Z),
+        (0, 0, Color::RED),
+        (3, 0, Color::GREEN),
+        (0, 3, Color::BLUE),
         (3, 3, Color::ONE),
     ] {
         let p = film.pixel(x, y);

@@ -2,16 +2,18 @@
 //! 1e-3, 1 and 1e4 renders the same picture. Self-intersection from a fixed
 //! epsilon would speckle the small scene or leak at the large one.
 
-use whitted::camera::Camera;
-use whitted::color_space::encode_srgb8;
 use whitted::image::Film;
-use whitted::light::{Attenuation, Light};
-use whitted::material::Material;
-use whitted::math::{Color, Transform, Vec3};
-use whitted::render::{RenderOptions, render};
-use whitted::scene::Scene;
+use whitted::image::encode_srgb8;
+use whitted::math::{Transform, Vec3};
+use whitted::render::Camera;
+use whitted::render::Scene;
+use whitted::render::render;
+use whitted::shading::Color;
+use whitted::shading::Material;
+use whitted::shading::Texture;
+use whitted::shading::texture::Checker;
+use whitted::shading::{Attenuation, Light};
 use whitted::shape::{AxisBox, Cylinder, Parallelogram, Shape, Sphere, Triangle};
-use whitted::texture::{Checker, Texture};
 
 fn scene_at_scale(s: f64) -> Scene {
     let v = |x: f64, y: f64, z: f64| Vec3::new(x, y, z) * s;
@@ -69,9 +71,7 @@ fn scene_at_scale(s: f64) -> Scene {
 }
 
 fn picture(s: f64) -> Vec<u8> {
-    let film: Film = render(&scene_at_scale(s), &RenderOptions::default(), &|_| {})
-        .unwrap()
-        .image;
+    let film: Film = render(&scene_at_scale(s), &|_| {}).unwrap().image;
     film.data().iter().map(|&v| encode_srgb8(v)).collect()
 }
 

@@ -8,8 +8,8 @@
 //! A structure's tests call [`assert_conforms`] with its [`AccelKind`].
 
 use super::{AccelKind, Accelerator, TraversalCounters};
+use crate::math::random::Rng;
 use crate::math::{Aabb, Ray, Vec3};
-use crate::random::Rng;
 use crate::shape::{AxisBox, Shape, Sphere, Triangle};
 
 /// A primitive of a test scene.

@@ -4,8 +4,8 @@
 //! world-space boxes, and its queries take a closure that intersects
 //! primitive `i`; the caller keeps whatever hit data it needs in the
 //! closure's state. Unbounded shapes (infinite planes) never enter a
-//! structure: [`crate::geometry::Geometry`] tests them in a short list beside
-//! it.
+//! structure: the world (the `world` module, a layer above) tests them in
+//! a short list beside it.
 //!
 //! Every structure offers the same inherent methods, dispatched by
 //! [`Accelerator`]:

@@ -7,6 +7,7 @@
 //! towards a light (any-hit), and one cosine-distributed diffuse bounce per
 //! primary hit (incoherent).
 
+pub mod obj_positions;
 pub mod ray_files;
 mod scene_rays;
 mod timing;

@@ -2,18 +2,18 @@
 //! structure.
 
 use super::{RayKind, RaySet};
-use crate::geometry::Geometry;
-use crate::light::Light;
+use crate::math::random::{Rng, hash64};
 use crate::math::{Aabb, Ray, Vec3, offset_ray_origin};
-use crate::random::{Rng, hash64};
-use crate::scene::Scene;
+use crate::render::Scene;
+use crate::shading::{Color, Light};
+use crate::world::World;
 
 /// Primary rays through the centre of every pixel of a `width` × `height`
 /// image, then one shadow ray and one diffuse ray per primary hit. Shadow
 /// rays go towards the scene's first light (or, without lights, a point
 /// above the scene's bounds) and are cast only where it is above the
 /// surface. Diffuse directions are seeded by the pixel index.
-pub fn scene_ray_sets(scene: &Scene, geometry: &Geometry, width: u32, height: u32) -> Vec<RaySet> {
+pub fn scene_ray_sets(scene: &Scene, geometry: &World, width: u32, height: u32) -> Vec<RaySet> {
     let mut primary = Vec::with_capacity(width as usize * height as usize);
     for y in 0..height {
         for x in 0..width {
@@ -79,8 +79,8 @@ fn default_light(bounds: Aabb) -> Light {
     };
     Light::Point {
         position: Vec3::new(c.x + 0.2 * d.x, c.y + d.y, c.z + 0.1 * d.z),
-        intensity: Vec3::ONE,
-        attenuation: crate::light::Attenuation::NONE,
+        intensity: Color::ONE,
+        attenuation: crate::shading::Attenuation::NONE,
     }
 }
 
@@ -116,8 +116,8 @@ mod tests {
 
     #[test]
     fn default_scene_gives_every_kind_of_ray() {
-        let scene = Scene::default_scene();
-        let geometry = Geometry::new(&scene);
+        let scene = crate::scene::default_scene();
+        let geometry = World::new(&scene.objects);
         let sets = scene_ray_sets(&scene, &geometry, 32, 24);
         assert_eq!(sets[0].rays.len(), 32 * 24);
         assert!(!sets[1].rays.is_empty() && !sets[2].rays.is_empty());

@@ -7,8 +7,8 @@ use std::time::Instant;
 
 use super::RaySet;
 use crate::accel::{TraversalCounters, with_ray_coherence};
-use crate::geometry::Geometry;
 use crate::math::Ray;
+use crate::world::World;
 
 /// Rays handed to a thread at a time (as the anchor's 16 × 16 tiles).
 const CHUNK: usize = 256;
@@ -25,12 +25,12 @@ pub enum TraceResults {
 /// Traces every ray once on this thread, keeping each result, and counts the
 /// traversal work of all of them. Here and in [`time_set`] the queries are
 /// told how the set's rays relate ([`super::RayKind::coherence`]).
-pub fn trace_all(geometry: &Geometry, set: &RaySet) -> (TraceResults, TraversalCounters) {
+pub fn trace_all(geometry: &World, set: &RaySet) -> (TraceResults, TraversalCounters) {
     with_ray_coherence(set.kind.coherence(), || trace_all_here(geometry, set))
 }
 
 /// [`trace_all`], with the hint already in place.
-fn trace_all_here(geometry: &Geometry, set: &RaySet) -> (TraceResults, TraversalCounters) {
+fn trace_all_here(geometry: &World, set: &RaySet) -> (TraceResults, TraversalCounters) {
     let mut counters = TraversalCounters::default();
     let results = if set.kind.is_any_hit() {
         TraceResults::Occluded(
@@ -63,7 +63,7 @@ fn trace_all_here(geometry: &Geometry, set: &RaySet) -> (TraceResults, Traversal
 /// scale 1.84x on two threads against 1.98x this way (median of eight
 /// interleaved runs; primary and shadow rays within noise).
 pub fn time_set(
-    geometry: &Geometry,
+    geometry: &World,
     set: &RaySet,
     threads: usize,
     runs: usize,

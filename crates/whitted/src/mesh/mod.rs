@@ -1,7 +1,5 @@
-//! Triangle meshes and their importers.
+//! Triangle meshes: vertices stored once and shared by their triangles.
 
-pub mod obj_positions;
 pub mod triangle_mesh;
 
-pub use obj_positions::{TriangleSoup, load_obj_positions, parse_obj_positions};
-pub use triangle_mesh::{MeshError, MeshId, MeshSurface, TriangleMesh};
+pub use triangle_mesh::{MeshError, MeshSurface, TriangleMesh};

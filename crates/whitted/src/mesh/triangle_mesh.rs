@@ -10,10 +10,6 @@
 use crate::math::{Aabb, DVec2, Ray, Vec3, gamma};
 use crate::shape::{LocalSurface, RayShear, ShapeHit, watertight};
 
-/// Index of a mesh in [`crate::scene::Scene::meshes`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct MeshId(pub u32);
-
 /// Why a mesh could not be built.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum MeshError {
@@ -259,7 +255,7 @@ mod tests {
     fn mesh_triangles_are_hit_exactly_like_single_triangles() {
         let mesh = quad();
         let single = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0)).unwrap();
-        let mut rng = crate::random::Rng::new(4);
+        let mut rng = crate::math::random::Rng::new(4);
         for _ in 0..500 {
             let origin = Vec3::new(rng.range(-0.5, 1.5), rng.range(-0.5, 1.5), 2.0);
             let ray = Ray::new(
@@ -337,7 +333,7 @@ mod tests {
 
     #[test]
     fn solved_tangents_map_uv_differences_onto_the_edges() {
-        let mut rng = crate::random::Rng::new(21);
+        let mut rng = crate::math::random::Rng::new(21);
         let mut solved = 0;
         for _ in 0..1000 {
             let p = [0; 3].map(|_| rng.point_in(Vec3::splat(-10.0), Vec3::splat(10.0)));

@@ -1,8 +1,8 @@
 //! Replacing parts of a scene's camera, whatever format the scene came
 //! from: any part given replaces the scene's, the others are kept.
 
-use crate::camera::{Camera, CameraError};
 use crate::math::Vec3;
+use crate::render::{Camera, CameraError};
 
 /// The parts of a camera to replace; `None` keeps the scene's.
 #[derive(Clone, Debug, Default, PartialEq)]

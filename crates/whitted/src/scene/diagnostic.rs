@@ -39,7 +39,7 @@ pub enum SceneError {
     },
     /// The camera asked for (by replacing parts of the scene's) is invalid.
     #[error("the camera asked for is invalid: {0}")]
-    Camera(#[from] crate::camera::CameraError),
+    Camera(#[from] crate::render::CameraError),
     /// The file was read but what it says is wrong: every problem found, in
     /// the order they appear in the file.
     #[error("{}", summary(diagnostics))]

@@ -134,7 +134,7 @@ impl AxisBox {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::random::Rng;
+    use crate::math::random::Rng;
     use crate::shape::testing::{
         assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
         assert_outward_rays_escape, assert_surface_is_sane, assert_tangents_follow_uv, rays_toward,

@@ -217,7 +217,7 @@ mod tests {
     use std::f64::consts::SQRT_2;
 
     use super::*;
-    use crate::random::Rng;
+    use crate::math::random::Rng;
     use crate::shape::testing::{
         assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
         assert_outward_rays_escape, assert_surface_is_sane, assert_tangents_follow_uv, rays_toward,

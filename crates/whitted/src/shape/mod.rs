@@ -31,6 +31,7 @@ mod polygon;
 mod quadratic;
 mod sphere;
 mod triangle;
+mod triangle_clip;
 #[cfg(target_arch = "x86_64")]
 mod watertight_avx;
 
@@ -43,8 +44,9 @@ pub use plane::Plane;
 pub use polygon::Polygon;
 pub use sphere::Sphere;
 pub use triangle::{RayShear, Triangle, watertight};
+pub(crate) use triangle_clip::clipped_triangle_bounds;
 #[cfg(target_arch = "x86_64")]
-pub use watertight_avx::{Hits4, LANES, watertight4};
+pub(crate) use watertight_avx::{Hits4, LANES, watertight4};
 
 use crate::math::{Aabb, DVec2, Ray, Vec3};
 

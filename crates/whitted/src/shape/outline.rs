@@ -210,7 +210,7 @@ mod tests {
     use std::f64::consts::TAU;
 
     use super::*;
-    use crate::random::Rng;
+    use crate::math::random::Rng;
 
     /// The outline of `points` (in the plane z = 0) without bands.
     fn unbanded(points: &[DVec2]) -> Outline {

@@ -192,7 +192,7 @@ mod tests {
     use std::f64::consts::TAU;
 
     use super::*;
-    use crate::random::Rng;
+    use crate::math::random::Rng;
     use crate::shape::testing::{
         assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
         assert_surface_is_sane, assert_tangents_follow_uv,

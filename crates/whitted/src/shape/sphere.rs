@@ -178,10 +178,10 @@ mod tests {
 
     #[test]
     fn culling_passed_spheres_never_changes_the_hit() {
-        let mut rng = crate::random::Rng::new(11);
+        let mut rng = crate::math::random::Rng::new(11);
         let mut culled = 0;
         for _ in 0..100_000 {
-            let point = |rng: &mut crate::random::Rng, scale: f64| {
+            let point = |rng: &mut crate::math::random::Rng, scale: f64| {
                 scale * Vec3::new(rng.uniform(), rng.uniform(), rng.uniform())
                     - Vec3::splat(scale / 2.0)
             };

@@ -2,8 +2,8 @@
 //! aimed at the shape, and the invariants each hit must keep.
 
 use super::Shape;
+use crate::math::random::Rng;
 use crate::math::{Aabb, DVec2, Ray, Vec3, offset_ray_origin};
-use crate::random::Rng;
 
 /// The region random rays aim at: the shape's bounds, or a box around the
 /// origin for unbounded shapes.

@@ -153,8 +153,8 @@ impl RayShear {
 #[inline]
 pub fn watertight(p0: Vec3, p1: Vec3, p2: Vec3, ray: &Ray, shear: &RayShear) -> Option<ShapeHit> {
     // One copy per permutation, so the axes are constants: indexing the
-    // vertices by a run-time axis made the bunny's shadow and diffuse rays
-    // take 15% more instructions (callgrind).
+    // vertices by a run-time axis took more instructions (figures in
+    // docs/performance.md, one-triangle test).
     match shear.kz {
         0 => watertight_permuted::<1, 2, 0>(p0, p1, p2, ray, shear),
         1 => watertight_permuted::<2, 0, 1>(p0, p1, p2, ray, shear),
@@ -183,9 +183,8 @@ fn watertight_permuted<const KX: usize, const KY: usize, const KZ: usize>(
     // edge shared with a neighbour gives the same value, negated, there.
     // Their signs are combined with `|` and `&`, not `||` and `&&`: one
     // branch per triangle, mostly a predictable miss, instead of one per
-    // sign. The bunny's diffuse rays went from 1.66 to 1.83 Mrays/s with
-    // the kd-tree and from 3.43 to 3.56 with the BVH (1 thread, medians of
-    // the best of 10 runs in each of 4 interleaved rounds).
+    // sign (faster with both structures: docs/performance.md, one-triangle
+    // test).
     let e0 = b.x * c.y - b.y * c.x;
     let e1 = c.x * a.y - c.y * a.x;
     let e2 = a.x * b.y - a.y * b.x;
@@ -235,7 +234,7 @@ fn watertight_permuted<const KX: usize, const KY: usize, const KZ: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::random::Rng;
+    use crate::math::random::Rng;
     use crate::shape::testing::{
         assert_convex_exits_cleanly, assert_no_nan_for_awkward_rays, assert_no_self_intersection,
         assert_surface_is_sane, assert_tangents_follow_uv,

@@ -39,21 +39,6 @@ pub struct Hits4 {
     pub v: [f64; LANES],
 }
 
-impl Hits4 {
-    /// The lane of the closest hit, the first of equally close ones: the
-    /// one a test of the lanes one by one, each against the closest found
-    /// so far, would keep.
-    pub fn closest(&self) -> Option<usize> {
-        let mut best: Option<usize> = None;
-        for lane in 0..LANES {
-            if self.mask & 1 << lane != 0 && best.is_none_or(|b| self.t[lane] < self.t[b]) {
-                best = Some(lane);
-            }
-        }
-        best
-    }
-}
-
 /// A corner of each lane's triangle in the ray's sheared space.
 #[derive(Clone, Copy)]
 struct Corner {
@@ -256,7 +241,7 @@ fn permuted<const KX: usize, const KY: usize, const KZ: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::random::Rng;
+    use crate::math::random::Rng;
     use crate::shape::{ShapeHit, watertight};
 
     /// The four lanes' answers against the one-triangle test's, bit for
@@ -355,17 +340,5 @@ mod tests {
             }
         }
         assert!(hits > 100, "{hits} hits");
-    }
-
-    #[test]
-    fn the_closest_lane_is_the_first_of_equally_close_ones() {
-        let hits = Hits4 {
-            mask: 0b1110,
-            t: [0.5, 2.0, 1.0, 1.0],
-            u: [0.0; LANES],
-            v: [0.0; LANES],
-        };
-        assert_eq!(hits.closest(), Some(2));
-        assert_eq!(Hits4 { mask: 0, ..hits }.closest(), None);
     }
 }

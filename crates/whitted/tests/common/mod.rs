@@ -1,12 +1,13 @@
 //! Helpers shared by the known-answer render tests.
 
-use whitted::camera::Camera;
 use whitted::image::Film;
-use whitted::material::Material;
-use whitted::math::{Color, Vec3};
-use whitted::render::{RenderOptions, render};
-use whitted::scene::Scene;
-use whitted::texture::Texture;
+use whitted::math::Vec3;
+use whitted::render::Camera;
+use whitted::render::Scene;
+use whitted::render::render;
+use whitted::shading::Color;
+use whitted::shading::Material;
+use whitted::shading::Texture;
 
 /// A material with no ambient and no diffuse colour.
 pub fn black() -> Material {
@@ -29,9 +30,7 @@ pub fn scene_looking_down_z(width: u32, height: u32, fov: f64) -> Scene {
 
 /// The scene's picture.
 pub fn rendered(scene: &Scene) -> Film {
-    render(scene, &RenderOptions::default(), &|_| {})
-        .unwrap()
-        .image
+    render(scene, &|_| {}).unwrap().image
 }
 
 /// Pixel (x, y) of `film` as a colour.

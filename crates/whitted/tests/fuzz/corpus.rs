@@ -6,7 +6,7 @@
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
-use whitted::random::Rng;
+use whitted::math::random::Rng;
 
 /// The repository's root.
 pub fn repository() -> PathBuf {

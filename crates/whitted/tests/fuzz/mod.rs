@@ -27,7 +27,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::time::{Duration, Instant};
 
 use whitted::accel::AccelKind;
-use whitted::random::{Rng, hash64};
+use whitted::math::random::{Rng, hash64};
 
 use self::mutate::Mutator;
 use self::targets::{Target, Workspace};

@@ -3,7 +3,7 @@
 //! replaced by extremes, words and lines dropped, duplicated, swapped, and
 //! words of the format inserted).
 
-use whitted::random::Rng;
+use whitted::math::random::Rng;
 
 /// Inputs are cut to this length, so every case stays fast; what only a
 /// large input can show (quadratic work) is tested apart.

@@ -7,20 +7,21 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use whitted::accel::AccelKind;
+use whitted::bench::obj_positions::parse_obj_positions;
 use whitted::bench::ray_files::read_ray_file;
 use whitted::bench::{RayKind, trace_all};
-use whitted::camera::Camera;
-use whitted::geometry::Geometry;
 use whitted::math::{DVec2, Vec3};
-use whitted::mesh::obj_positions::parse_obj_positions;
-use whitted::render::{Aov, RenderOptions, render};
+use whitted::render::Camera;
+use whitted::render::Scene;
+use whitted::render::{Aov, render};
 use whitted::scene::{
-    MAX_DIAGNOSTICS, MAX_SHOWN_CHARS, Scene, SceneError, parse_nff, parse_obj, parse_scene,
+    MAX_DIAGNOSTICS, MAX_SHOWN_CHARS, SceneError, parse_nff, parse_obj, parse_scene,
 };
-use whitted::texture::{Decoding, ImageTexture, Wrap, decode_image};
+use whitted::shading::texture::{Decoding, ImageTexture, Wrap, decode_image};
+use whitted::world::World;
 
 use super::corpus::{self, fixtures, read_all, repository};
-use whitted::random::Rng;
+use whitted::math::random::Rng;
 
 /// One reader and its inputs.
 pub struct Target {
@@ -85,15 +86,13 @@ fn exercise(mut scene: Scene, accel: AccelKind) {
     settings.samples_per_pixel = settings.samples_per_pixel.clamp(1, 2);
     settings.max_depth = settings.max_depth.min(4);
     settings.accel = accel;
-    let geometry = Geometry::with_accel(&scene, accel);
-    let _ = geometry.accelerator().validate(&[]);
-    let _ = scene.primitive_count();
-    drop(geometry);
-    let options = RenderOptions {
-        threads: Some(1),
-        aovs: Aov::ALL.to_vec(),
-    };
-    let _ = render(&scene, &options, &|_| {});
+    let world = World::build(&scene.objects, accel);
+    let _ = world.accelerator().validate(&[]);
+    let _ = scene.objects.primitive_count();
+    drop(world);
+    settings.threads = Some(1);
+    settings.aovs = Aov::ALL.to_vec();
+    let _ = render(&scene, &|_| {});
 }
 
 /// Renders the scene a reader accepted, or checks the size of its report:
@@ -218,7 +217,7 @@ fn run_ray_files(workspace: &Workspace, parts: &[Vec<u8>], accel: AccelKind) -> 
         static SCENE: Scene = ray_target_scene();
     }
     SCENE.with(|scene| {
-        let geometry = Geometry::with_accel(scene, accel);
+        let geometry = World::build(&scene.objects, accel);
         let _ = trace_all(&geometry, &file.set);
     });
     true

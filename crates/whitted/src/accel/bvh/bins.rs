@@ -119,9 +119,9 @@ impl Bins {
         boxes: &[FBox],
         centroid_bounds: &FBox,
     ) -> Option<Plane> {
-        // Small nodes need fewer bins to find their planes: on 100k random
-        // boxes this saves a quarter of the build's instructions and changes
-        // the SAH cost by 5e-6.
+        // Small nodes need fewer bins to find their planes: fewer bins
+        // save build time and barely change the SAH cost (figures in
+        // docs/performance.md, BVH build).
         let bins = bins.min(2 * boxes.len());
         let binning = Binning::new(centroid_bounds, bins);
         self.fill(boxes, &binning);
@@ -170,11 +170,10 @@ impl Bins {
     }
 
     /// Puts every primitive in its bin along each axis, in one pass (one
-    /// pass per axis made the whole build run 12% more instructions).
-    /// Binning nodes of 16k primitives or more in parallel chunks of 8k,
-    /// merging the chunks' bins (exactly, so still deterministic), was not
-    /// faster: bunny 37.0 against 35.7 ms (best of 10, back to back, two
-    /// shared cores), the dragon within noise.
+    /// pass per axis took more instructions).
+    ///
+    /// Tried binning large nodes in parallel chunks: no faster, see
+    /// docs/performance.md (BVH build).
     fn fill(&mut self, boxes: &[FBox], binning: &Binning) {
         let bins = binning.bins;
         for axis in 0..3 {
@@ -221,7 +220,7 @@ impl Plane {
 mod tests {
     use super::*;
     use crate::accel::conformance::random_boxes;
-    use crate::random::Rng;
+    use crate::math::random::Rng;
 
     fn fboxes(seed: u64, n: usize) -> Vec<FBox> {
         random_boxes(&mut Rng::new(seed), n, 100.0, 2.0)

@@ -6,6 +6,9 @@
 //! most steps). Leaves stay in their parent's slots; the wide tree is never
 //! deeper than the binary one. Nodes are numbered depth first, each one when
 //! its parent is filled, so a subtree's nodes lie close together.
+//!
+//! Tried collapsing subtrees of up to four triangles into one leaf: no
+//! faster, see docs/performance.md (eight-wide BVH).
 
 use super::node::{BinaryNode, BvhNode, WIDTH};
 

@@ -119,7 +119,7 @@ mod tests {
     use crate::accel::conformance::assert_conforms;
     use crate::accel::conformance::random_boxes;
     use crate::math::Vec3;
-    use crate::random::Rng;
+    use crate::math::random::Rng;
 
     fn assert_valid(name: &str, boxes: &[Aabb], params: &BvhBuildParams) -> Bvh {
         let bvh = Bvh::build_with(boxes, params);

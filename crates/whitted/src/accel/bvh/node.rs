@@ -106,8 +106,8 @@ impl BinaryNode {
     /// `len` nodes, each the default (all bits zero), in memory the
     /// allocator hands out zeroed: the system maps its pages in as the
     /// build first writes them, on the threads that write them, and never
-    /// those of slots no subtree uses. Filling the dragon's 1.7M slots
-    /// with `vec!` took 35 ms on one thread before the build started.
+    /// those of slots no subtree uses. `vec!` would fill every slot on one
+    /// thread before the build started (see docs/performance.md, BVH build).
     pub fn zeroed_vec(len: usize) -> Vec<Self> {
         let Ok(layout) = Layout::array::<Self>(len) else {
             panic!("{len} BVH build nodes do not fit in memory");

@@ -159,8 +159,8 @@ const _: () = assert!(WIDTH == 8, "the tests are written for eight lanes");
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
+    use crate::math::random::Rng;
     use crate::math::{Aabb, Vec3};
-    use crate::random::Rng;
 
     /// A node of eight random boxes (some empty), and rays from all around
     /// it, some starting inside boxes or with zero direction components.

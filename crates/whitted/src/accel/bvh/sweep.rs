@@ -3,12 +3,11 @@
 //! is priced.
 //!
 //! Binning a node costs the same number of bins to clear and sweep however
-//! few primitives it holds, and most nodes of a tree are small: on the
-//! Stanford bunny, sweeping nodes of up to [`SWEEP_MAX`] primitives exactly
-//! instead of binning them took the build from 306 to 257 million
-//! instructions (callgrind; 6 or 20 as the limit did a little worse than
-//! 12). The exact sweep also prices every plane the bins would, so its
-//! choice is never worse.
+//! few primitives it holds, and most nodes of a tree are small, so nodes of
+//! up to [`SWEEP_MAX`] primitives are swept exactly instead, which takes
+//! fewer instructions (figures, and other limits tried, in
+//! docs/performance.md, BVH build). The exact sweep also prices every
+//! plane the bins would, so its choice is never worse.
 
 use super::build::Halves;
 use super::fbox::FBox;
@@ -81,9 +80,8 @@ pub(super) fn best_split(prims: &mut Prims) -> Option<(f32, Halves)> {
 }
 
 /// `order` becomes `0..order.len()` sorted by centre along `axis`, stably,
-/// by insertion (the lists are short). Placing each by its rank, counted
-/// without branches over a fixed-length array, was slower: 37 against
-/// 26.5 ms of CPU per bunny build.
+/// by insertion (the lists are short). Tried placing each by its rank,
+/// counted without branches: slower, see docs/performance.md (BVH build).
 fn sort_by_centre(order: &mut [usize], centres: &[Vec3A], axis: usize) {
     for i in 0..order.len() {
         let key = centres[i][axis];
@@ -100,8 +98,8 @@ fn sort_by_centre(order: &mut [usize], centres: &[Vec3A], axis: usize) {
 mod tests {
     use super::*;
     use crate::accel::conformance::random_boxes;
+    use crate::math::random::Rng;
     use crate::math::{Aabb, Vec3};
-    use crate::random::Rng;
 
     /// The cheapest cost over every axis and every prefix of the primitives
     /// sorted by centre along it, in `f64`.

@@ -57,59 +57,28 @@
 //!
 //! `counters.nodes` counts the wide nodes and the leaves the walk enters.
 //!
-//! Measured on the Stanford bunny (69k triangles) with the Embree harness's
-//! rays, 1 thread, interleaved runs: the binary BVH with a scalar `f64`
-//! slab test this replaced ran primary/shadow/diffuse rays at 7.1/2.1/1.6
-//! Mrays/s, this walk (with the triangle corners kept per slot in
-//! `Geometry`) at 10.8/3.85/2.6. Tried and not kept: on the binary tree,
-//! testing both children at once in `f64` or `f32` SIMD (0.88 to 0.93
-//! times the scalar loop); here, sorting the hit children in a separate
-//! array and copying them to the stack (store-forwarding stalls; removing
-//! them, with `maxps` and an inlined ray setup, took primary rays from 7.7
-//! to 9.3 Mrays/s); a stack sized for [`MAX_DEPTH`] for every tree
-//! (8% of the time went to clearing it); an SAH traversal cost of 0.5
-//! instead of 1 for smaller leaves (3.4 instead of 3.9 triangles per shadow
-//! ray, no faster).
+//! # The walk, and why it is written so
 //!
 //! A node where the ray meets one child goes straight on to it, and one
 //! where it meets two pushes only the farther, so the stack is written only
-//! for what waits on it: on the bunny's rays (callgrind, a quarter of the
-//! shadow and diffuse rays, a sixteenth of the primary ones) that took the
-//! instructions from 59.7/96.6/120.6 to 57.3/90.2/108.5 million for
-//! primary/shadow/diffuse. The kitchen's tree (depth 16) took the stack
-//! for [`MAX_DEPTH`] and cleared 2.3 kB a ray; the middle-sized stack took
-//! its shadow rays from 9.6 to 12.1 Mrays/s (1 thread, interleaved runs).
-//! The any-hit walk goes on to the last child it meets and pushes only the
-//! others, in the order it visited them before (3% and 6% fewer
-//! instructions on the bunny's and the kitchen's shadow rays, the same
-//! nodes visited). With four-wide nodes, reading each axis's entry and
-//! exit planes through rows chosen once per ray instead of a branch per
-//! axis and node took 1 to 5% fewer instructions (callgrind) but was no
-//! faster; the eight-wide walk below reads them so.
+//! for what waits on it. The any-hit walk goes on to the last child it
+//! meets and pushes the others in slot order. The stack is never cleared
+//! (`accel/stack.rs`), and its size, short, middle-sized or for
+//! [`MAX_DEPTH`], follows the tree's depth.
 //!
-//! Eight children a node, tested in one AVX register, with the stack left
-//! uncleared: on the bunny's rays (1 thread, interleaved runs, best of
-//! two) primary/shadow/diffuse rays went from 12.3/4.3/3.0 to 13.4/4.9/3.5
-//! Mrays/s, nodes visited per ray from 4.2/14.7/14.0 to 3.1/10.3/10.0, and
-//! the shadow rays' instructions fell 13% (callgrind). The same tree
-//! walked with two SSE halves (processors without AVX) ran at
-//! 9.0/4.1/2.9: eight-wide nodes pay only with eight-wide registers. Built
-//! the first time with the slab test written lane by lane for the compiler
-//! to vectorise, it was slower than the four-wide walk (10.2/3.7/2.7): the
-//! compiler mixed scalar and vector code; and the ray setup's `array::map`
-//! closures, compiled without AVX, were calls (6% of the instructions)
-//! until written out.
+//! Eight children a node are tested in one AVX register: eight-wide nodes
+//! pay only with eight-wide registers, and a processor without AVX walks
+//! them as two SSE halves. The slab test is written with explicit SIMD
+//! operations rather than lane by lane for the compiler to vectorise (it
+//! mixed scalar and vector code), and each axis's entry and exit planes are
+//! read through rows chosen once per ray, not by a branch per axis and
+//! node.
 //!
-//! Also tried on the eight-wide tree and not kept (bunny, 1 thread, best of
-//! interleaved runs): an SAH that prices leaves by blocks of four
-//! triangles (for a four-at-once test) made a third of the leaves and
-//! nodes, but 11.5 instead of 3.8 triangles per diffuse ray, and diffuse
-//! rays ran at 2.6 to 3.2 instead of 3.5 Mrays/s with or without testing
-//! closest hits four at a time; collapsing subtrees of up to four
-//! triangles into one leaf halved the nodes (12,373 to 6,008) but took
-//! nodes per diffuse ray only from 10.0 to 9.4 and triangles from 3.8 to
-//! 4.8, at the same speed: half-full nodes lie near the leaves, where few
-//! rays go.
+//! The figures behind these choices are in docs/performance.md (eight-wide
+//! BVH). Not kept, with their figures there too:
+//! - Tried testing a binary node's two children at once in SIMD: slower.
+//! - Tried sorting the hit children in an array, then copying: slower.
+//! - Tried clearing a stack for [`MAX_DEPTH`] for every ray: slower.
 
 use std::ops::Range;
 
@@ -401,10 +370,8 @@ impl Bvh {
                 let (mask, near) = slabs.test(node, far);
                 if mask != 0 {
                     // The last slot hit goes on, the others wait on the
-                    // stack in slot order, unsorted: any hit will do, and on
-                    // the bunny's shadow rays nearest first visited more
-                    // nodes (14.9 against 14.7 a ray) and ran about 10%
-                    // slower.
+                    // stack in slot order, unsorted: any hit will do. Tried
+                    // nearest first: slower, see docs/performance.md.
                     let last = 31 - mask.leading_zeros();
                     let mut bits = mask & !(1 << last);
                     while bits != 0 {
@@ -429,8 +396,8 @@ impl Bvh {
 mod tests {
     use super::{Halves, MAX_DEPTH, stack_size};
     use crate::accel::{Bvh, Linear, TraversalCounters};
+    use crate::math::random::Rng;
     use crate::math::{Aabb, Ray, Vec3};
-    use crate::random::Rng;
 
     /// Unit cubes at x = 0, 2, 4, ...
     fn row(n: u32) -> Vec<Aabb> {

@@ -130,7 +130,7 @@ impl Iterator for DdaCells<'_> {
 mod tests {
     use super::*;
     use crate::math::Aabb;
-    use crate::random::Rng;
+    use crate::math::random::Rng;
 
     /// Cells one unit wide over [0, 4] x [0, 4] x [0, 4].
     fn cubes() -> Lattice {

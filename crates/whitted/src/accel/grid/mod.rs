@@ -70,7 +70,7 @@ mod tests {
     use super::*;
     use crate::accel::AccelKind;
     use crate::math::Vec3;
-    use crate::random::Rng;
+    use crate::math::random::Rng;
 
     #[test]
     fn grid_conforms_to_brute_force() {

@@ -81,8 +81,8 @@ impl Grid {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::random::Rng;
     use crate::math::{Aabb, Vec3};
-    use crate::random::Rng;
 
     /// Ten slabs crossing the whole scene along x, among small boxes.
     fn slabs_among_small_boxes() -> Vec<Aabb> {

@@ -102,7 +102,7 @@ mod tests {
     use super::*;
     use crate::accel::conformance::random_boxes;
     use crate::math::Vec3;
-    use crate::random::Rng;
+    use crate::math::random::Rng;
 
     fn degenerate_inputs() -> Vec<(&'static str, Vec<Aabb>)> {
         let unit = Aabb::new(Vec3::ZERO, Vec3::ONE);

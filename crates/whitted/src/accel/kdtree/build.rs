@@ -271,7 +271,7 @@ mod tests {
     use super::*;
     use crate::accel::conformance::random_boxes;
     use crate::math::Vec3;
-    use crate::random::Rng;
+    use crate::math::random::Rng;
 
     #[test]
     fn work_grows_like_n_log_n_and_events_are_sorted_about_once() {

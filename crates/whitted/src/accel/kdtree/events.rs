@@ -111,7 +111,7 @@ pub(super) fn merge(a: Vec<Event>, b: Vec<Event>) -> Vec<Event> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::random::Rng;
+    use crate::math::random::Rng;
 
     #[test]
     fn snapping_widens_to_f32_and_keeps_exact_values() {

@@ -11,10 +11,10 @@ use super::traverse::{SHALLOW, STACK_CAPACITY};
 use super::{KdTree, KdTreeBuildParams};
 use crate::accel::conformance::{assert_conforms, random_boxes};
 use crate::accel::{AccelKind, Accelerator, RayCoherence, TraversalCounters, with_ray_coherence};
+use crate::math::random::Rng;
 use crate::math::{Aabb, Ray, Vec3};
-use crate::random::Rng;
 use crate::shape::Triangle;
-use crate::triangle_clip::clipped_triangle_bounds;
+use crate::shape::clipped_triangle_bounds;
 
 /// Where `ray` enters `b` within `(ray.t_min, t_max)`.
 fn box_hit(b: &Aabb, ray: &Ray, t_max: f64) -> Option<f64> {

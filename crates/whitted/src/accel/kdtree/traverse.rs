@@ -19,13 +19,11 @@
 //!
 //! A primitive lies in every leaf its box overlaps, so a ray meets it
 //! again leaf after leaf: the shared mailbox (`accel/mailbox.rs`) tests it
-//! once per ray. With it, and the axis picked without a branch, a diffuse
-//! ray through the bunny's tree took 4201 instructions instead of 5430
-//! (callgrind, 20k anchor rays) and 5.6 primitive tests instead of 7.3.
-//! The queries in leaf order (closest and any hit) go without it and hand
-//! over whole leaves (see `mod.rs`): a repeated test finds nothing new,
-//! and the caller takes a leaf in one call, testing an any-hit ray against
-//! its triangles several at a time.
+//! once per ray, which saves primitive tests and instructions (figures in
+//! docs/performance.md, kd-tree walk). The queries in leaf order (closest
+//! and any hit) go without it and hand over whole leaves (see `mod.rs`): a
+//! repeated test finds nothing new, and the caller takes a leaf in one
+//! call, testing an any-hit ray against its triangles several at a time.
 
 use super::KdTree;
 use super::node::NodeKind;
@@ -231,6 +229,10 @@ impl KdTree {
 
     /// [`Self::walk`] with a stack of `N` entries, at least the tree's
     /// depth.
+    ///
+    /// Not kept (figures in docs/performance.md, kd-tree walk):
+    /// - Tried prefetching a node's above child, or the far child: slower.
+    /// - Tried loading both children before the branches: no faster.
     #[inline(always)]
     fn walk_with<const N: usize>(
         &self,
@@ -337,6 +339,11 @@ impl KdTree {
     /// the same, and on an exact tie another primitive may be returned.
     /// The side chosen only orders the cells, so the call's condition (the
     /// point at `ray.t_min`, not the origin, inside the root) is for speed.
+    ///
+    /// Not kept (figures in docs/performance.md, kd-tree descent to the
+    /// origin's leaf):
+    /// - Tried pushing the other child whenever it is stored: no faster.
+    /// - Tried comparing the origin's side as integer keys: slower.
     #[inline(always)]
     fn descend<const N: usize>(
         &self,
@@ -431,9 +438,9 @@ impl Axes {
 /// walk compiles to branches without it today, but small changes to
 /// [`children`] made the compiler pick the below child and the near side
 /// with conditional moves, so every node's load waited for the previous
-/// node's: with the inverse direction scaled once per ray (see
-/// `mod.rs`), the bunny's shadow rays ran at 2.5 Mrays/s against 3.2, and
-/// at 3.0 to 3.1 with this guard (1 thread, medians of interleaved runs).
+/// node's: slower, see docs/performance.md (kd-tree walk).
+///
+/// Tried choosing the next node by selects on purpose: slower too.
 #[inline(always)]
 fn keep_as_branch() {
     #[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
@@ -476,6 +483,9 @@ fn at_least(a: f64, b: f64) -> bool {
 /// their bounds so that NaN leaves the node's own. A ray going up (or along
 /// the plane with a +0 direction, whose crossing is ±∞) meets the below
 /// side first.
+///
+/// Tried scaling the inverse direction once per ray: missed a box (see
+/// docs/performance.md, kd-tree walk).
 #[inline(always)]
 fn crossing(axis: usize, split: f32, ray: &Axes) -> (f64, f64, bool) {
     let inv_dir = ray.inv_dir[axis];
@@ -490,6 +500,11 @@ fn crossing(axis: usize, split: f32, ray: &Axes) -> (f64, f64, bool) {
 /// root's range comes from a box test, and a crossing that is NaN keeps
 /// the node's range). `[below, above]` are the children's indices (a node
 /// with one stored child goes to [`stored_side`] instead).
+///
+/// Not kept (figures in docs/performance.md, kd-tree walk):
+/// - Tried one branch per node on both met/not-met tests: slower.
+/// - Tried picking the near child by a select on a per-ray mask: slower.
+/// - Tried the met tests against a range widened by 4γ(3): no faster.
 #[inline]
 fn children(
     entry: &Entry,
@@ -526,7 +541,8 @@ fn children(
 /// Which end of the range the crossing clips depends on the ray's
 /// direction, but here, unlike at a node with two children, the direction
 /// does not choose the next node, so the end is picked by a select: as a
-/// branch it was mispredicted (see `mod.rs` for the figures).
+/// branch it was mispredicted (figures in docs/performance.md, kd-tree
+/// walk). At nodes with two children the same selects were slower.
 #[inline(always)]
 fn stored_side(
     entry: &Entry,
@@ -615,7 +631,7 @@ mod tests {
 
     #[test]
     fn the_stored_side_of_a_cut_gets_the_range_children_gives_it() {
-        let mut rng = crate::random::Rng::new(11);
+        let mut rng = crate::math::random::Rng::new(11);
         // Random rays, then rays along the plane (NaN crossings), rays
         // starting on it and crossings at the range's ends.
         let mut cases: Vec<(Ray, f64, f64)> = (0..2000)
@@ -709,7 +725,7 @@ mod tests {
 
     #[test]
     fn the_descent_ends_in_the_leaf_holding_the_origin() {
-        let mut rng = crate::random::Rng::new(12);
+        let mut rng = crate::math::random::Rng::new(12);
         let boxes = crate::accel::conformance::random_boxes(&mut rng, 3_000, 10.0, 1.0);
         let tree = KdTree::build(&boxes);
         let cells = leaf_cells(&tree);

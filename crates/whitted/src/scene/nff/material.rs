@@ -16,8 +16,8 @@
 //! | ior | `ior` when `T > 0`; 1 otherwise (opaque files may put 0 there) |
 
 use super::reader::{Parsed, Reader};
-use crate::material::Material;
-use crate::math::Color;
+use crate::shading::Color;
+use crate::shading::Material;
 
 /// The global ambient light `Ia`, white: small, but present on every
 /// surface, as the SPD asks (NFF itself has no ambient term).

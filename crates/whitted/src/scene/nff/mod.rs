@@ -45,11 +45,14 @@ use self::patches::{PatchSet, patches_to_meshes, read_patch};
 use self::reader::{Parsed, Reader};
 use self::shapes::{Placed, flat_shape, read_cone, read_polygon, read_sphere};
 use self::view::{View, read_view};
-use crate::color_space::ColorSpace;
-use crate::light::{Attenuation, Light};
-use crate::material::{Material, MaterialId};
-use crate::math::{Color, Transform, Vec3};
-use crate::scene::{RenderSettings, Scene, SceneError};
+use crate::image::ColorSpace;
+use crate::math::{Transform, Vec3};
+use crate::render::{RenderSettings, Scene};
+use crate::scene::SceneError;
+use crate::shading::Color;
+use crate::shading::Material;
+use crate::shading::{Attenuation, Light};
+use crate::world::MaterialId;
 
 /// Reads a scene from the text of an NFF file; `path` is only used in
 /// messages.
@@ -134,9 +137,9 @@ impl Document {
 
     fn set_fill(&mut self, fill: Fill) {
         let key = [
-            fill.color.x,
-            fill.color.y,
-            fill.color.z,
+            fill.color.r,
+            fill.color.g,
+            fill.color.b,
             fill.kd,
             fill.ks,
             fill.shine,

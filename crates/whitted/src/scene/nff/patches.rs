@@ -19,9 +19,9 @@ use std::ops::Range;
 
 use super::reader::{Parsed, Reader};
 use super::shapes::vertex_count;
-use crate::material::MaterialId;
 use crate::math::Vec3;
 use crate::mesh::TriangleMesh;
+use crate::world::MaterialId;
 
 /// One `pp` entity.
 #[derive(Clone, Debug, PartialEq)]

@@ -14,6 +14,7 @@ use std::path::Path;
 use super::lexer::{Lexer, Token, is_entity_keyword};
 use crate::math::Vec3;
 use crate::scene::{Diagnostic, Severity, push_limited};
+use crate::shading::Color;
 
 /// A problem that has been recorded; the entity being read is abandoned.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -144,9 +145,9 @@ impl<'a> Reader<'a> {
     }
 
     /// Three numbers that are not negative, for the colour `what`.
-    pub(super) fn color(&mut self, what: &str) -> Parsed<Vec3> {
+    pub(super) fn color(&mut self, what: &str) -> Parsed<Color> {
         let start = self.next_start();
-        let color = self.vec3(what)?;
+        let color = Color::from(self.vec3(what)?.to_array());
         if color.min_element() < 0.0 {
             let span = self.since(start);
             return Err(self.error(span, format!("{what} must not be negative, got {color}")));

@@ -36,7 +36,7 @@ fn the_view_sets_camera_size_and_the_spd_tracing_rules() {
     assert_eq!((s.settings.max_depth, s.settings.min_weight), (4, 0.0));
     assert_eq!(s.background, Color::ZERO);
     assert_eq!(s.ambient, Color::splat(AMBIENT));
-    assert!(s.primitives.is_empty() && s.lights.is_empty());
+    assert!(s.objects.primitives.is_empty() && s.lights.is_empty());
 }
 
 #[test]
@@ -79,7 +79,7 @@ fn each_object_takes_the_material_of_the_last_fill_and_repeats_share_one() {
         "{VIEW}s 0 0 0 1\nf 1 0 0 1 0 0 0 0\ns 0 0 0 1\nf 0 1 0 1 0 0 0 0\n\
          c 0 0 0 1 0 0 1 1\nf 1 0 0 1 0 0 0 0\np 3 0 0 0 1 0 0 0 1 0\n"
     ));
-    let materials: Vec<u32> = s.primitives.iter().map(|p| p.material.0).collect();
+    let materials: Vec<u32> = s.objects.primitives.iter().map(|p| p.material.0).collect();
     // The first sphere, before any `f`, gets the default grey.
     assert_eq!(materials, [0, 1, 2, 1]);
     assert_eq!(s.materials.len(), 3);
@@ -94,15 +94,20 @@ fn every_entity_is_read_and_patches_follow_the_other_shapes() {
          s 0 0 0 1 # a comment\nc\n0 0 0 1\n0 0 1 0.5\n\
          p 5 0 0 0 2 0 0 2 2 0 1 1 0 0 2 0\n"
     ));
-    let kinds: Vec<&str> = s.primitives.iter().map(|p| p.shape.kind()).collect();
+    let kinds: Vec<&str> = s
+        .objects
+        .primitives
+        .iter()
+        .map(|p| p.shape.kind())
+        .collect();
     assert_eq!(kinds, ["sphere", "cone", "polygon"]);
-    assert_eq!(s.meshes.len(), 1);
-    assert_eq!(s.meshes[0].len(), 1);
-    assert_eq!(s.primitive_count(), 4);
-    let cone = &s.primitives[1];
-    let placement = cone
-        .transform
-        .map_or(Transform::IDENTITY, |id| s.transforms[id.0 as usize]);
+    assert_eq!(s.objects.meshes.len(), 1);
+    assert_eq!(s.objects.meshes[0].len(), 1);
+    assert_eq!(s.objects.primitive_count(), 4);
+    let cone = &s.objects.primitives[1];
+    let placement = cone.transform.map_or(Transform::IDENTITY, |id| {
+        s.objects.transforms[id.0 as usize]
+    });
     let apex = placement.point_to_world(Vec3::new(0.0, 0.0, 1.0));
     assert!(apex.abs_diff_eq(Vec3::Z, 1e-15));
     assert!(matches!(cone.shape, Shape::Cone(c) if !c.caps()));
@@ -206,7 +211,7 @@ fn truncated_and_mangled_files_give_errors_never_panics() {
         "é",
     ];
     let tokens: Vec<&str> = source.split_ascii_whitespace().collect();
-    let mut rng = crate::random::Rng::new(7);
+    let mut rng = crate::math::random::Rng::new(7);
     for _ in 0..2000 {
         let mut mangled = tokens.clone();
         let at = rng.below(mangled.len() as u32) as usize;

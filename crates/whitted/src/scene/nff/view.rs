@@ -19,9 +19,9 @@
 use std::ops::Range;
 
 use super::reader::{Parsed, Reader};
-use crate::camera::{Camera, CameraError};
 use crate::math::Vec3;
 use crate::render::MAX_SIDE;
+use crate::render::{Camera, CameraError};
 
 /// What the `v` block says.
 #[derive(Clone, Debug, PartialEq)]

@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 
 use super::text::Line;
 use crate::math::DVec2;
-use crate::texture::Wrap;
+use crate::shading::texture::Wrap;
 
 /// What a map applies to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -30,12 +30,15 @@ use std::path::Path;
 use self::build::build_meshes;
 use self::mtl::read_library;
 use self::reader::{NONE, ObjData, read_obj};
-use crate::camera::Camera;
-use crate::light::{Attenuation, Light};
-use crate::material::{Material, MaterialId};
-use crate::math::{Aabb, Color, Transform};
-use crate::scene::{Diagnostic, LoadedScene, RenderSettings, Scene, SceneError, Severity};
-use crate::texture::ImageCache;
+use crate::math::{Aabb, Transform};
+use crate::render::Camera;
+use crate::render::{RenderSettings, Scene};
+use crate::scene::{Diagnostic, LoadedScene, SceneError, Severity};
+use crate::shading::Color;
+use crate::shading::Material;
+use crate::shading::texture::ImageCache;
+use crate::shading::{Attenuation, Light};
+use crate::world::MaterialId;
 
 /// The vertical field of view of the camera framing a bare model, degrees.
 pub const DEFAULT_FOV_DEGREES: f64 = 50.0;

@@ -9,11 +9,12 @@ use std::path::Path;
 
 use super::maps::{Channel, MapSlot, MapStatement, read_map};
 use super::text::lines;
-use crate::bump::Bump;
-use crate::material::Material;
-use crate::math::Color;
 use crate::scene::{Diagnostic, Severity, push_limited};
-use crate::texture::{Decoding, DissolveMap, ImageCache, ImageData, ImageTexture, Texture};
+use crate::shading::Bump;
+use crate::shading::Color;
+use crate::shading::Material;
+use crate::shading::Texture;
+use crate::shading::texture::{Decoding, DissolveMap, ImageCache, ImageData, ImageTexture};
 
 /// The materials of one library by name, or its errors; with its warnings.
 pub(super) struct Library {
@@ -196,7 +197,7 @@ fn decoding(statement: &MapStatement) -> Decoding {
 /// them) write normal maps as `map_Bump`.
 fn looks_like_normal_map(data: &ImageData) -> bool {
     let mean = data.mean();
-    (mean.x - 0.5).abs() < 0.1 && (mean.y - 0.5).abs() < 0.1 && mean.z > 0.75
+    (mean.r - 0.5).abs() < 0.1 && (mean.g - 0.5).abs() < 0.1 && mean.b > 0.75
 }
 
 /// Decodes each map; a file that cannot be read is a warning and the
@@ -350,7 +351,7 @@ fn whitted_material(m: &tobj::Material, extra: &Extra, maps: &Maps) -> Material 
 mod tests {
     use super::*;
     use crate::math::DVec2;
-    use crate::texture::Texture;
+    use crate::shading::Texture;
 
     fn read(source: &str) -> Library {
         read_library(source, Path::new("m.mtl"), &mut ImageCache::default())
@@ -422,7 +423,7 @@ mod tests {
     #[test]
     fn maps_fill_their_slots_and_one_file_is_shared() {
         let dir = tempfile::tempdir().unwrap();
-        let png = crate::texture::png_bytes(1, 1, &[255, 0, 0]);
+        let png = crate::shading::texture::png_bytes(1, 1, &[255, 0, 0]);
         std::fs::write(dir.path().join("red.png"), png).unwrap();
         let source = "newmtl shiny\nKs 0.5 0.5 0.5\nillum 3\nmap_Ks -o 0.5 0.25 red.png\n\
                       map_Ka red.png\nnewmtl lamp\nillum 0\nmap_Kd .\\red.png\n";
@@ -450,17 +451,17 @@ mod tests {
         // Left texel clear (alpha 0), right texel opaque.
         write(
             "leaf.png",
-            crate::texture::rgba_png_bytes(2, 1, &[0, 255, 0, 0, 0, 255, 0, 255]),
+            crate::shading::texture::rgba_png_bytes(2, 1, &[0, 255, 0, 0, 0, 255, 0, 255]),
         )
         .unwrap();
         write(
             "height.png",
-            crate::texture::png_bytes(2, 1, &[0, 0, 0, 255, 255, 255]),
+            crate::shading::texture::png_bytes(2, 1, &[0, 0, 0, 255, 255, 255]),
         )
         .unwrap();
         write(
             "normal.png",
-            crate::texture::png_bytes(1, 1, &[128, 128, 255]),
+            crate::shading::texture::png_bytes(1, 1, &[128, 128, 255]),
         )
         .unwrap();
         let source = "newmtl leaf\nKd 0 1 0\nmap_d -s 2 1 leaf.png\nbump -bm 0.05 height.png\n\
@@ -497,7 +498,7 @@ mod tests {
         else {
             panic!("{:?}", m["wall"].bump);
         };
-        assert_eq!(wall.wrap, crate::texture::Wrap::Clamp);
+        assert_eq!(wall.wrap, crate::shading::texture::Wrap::Clamp);
         let glass = &m["glass"].transmission;
         let (clear, opaque) = (
             glass.at(crate::math::DVec2::new(0.25, 0.5)),
@@ -505,7 +506,7 @@ mod tests {
         );
         assert_eq!(clear, Color::new(1.0, 0.5, 0.5));
         assert!(
-            (opaque - Color::new(0.5, 0.25, 0.25)).length() < 1e-12,
+            (opaque - Color::new(0.5, 0.25, 0.25)).abs().max_element() < 1e-12,
             "{opaque}"
         );
     }

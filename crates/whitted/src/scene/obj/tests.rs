@@ -11,9 +11,9 @@ fn parse(source: &str) -> LoadedScene {
 fn vertices_are_shared_and_one_mesh_is_made_per_material() {
     let loaded = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n");
     let scene = loaded.scene;
-    assert_eq!(scene.meshes.len(), 1);
-    assert_eq!(scene.meshes[0].positions().len(), 4);
-    assert_eq!(scene.meshes[0].len(), 2);
+    assert_eq!(scene.objects.meshes.len(), 1);
+    assert_eq!(scene.objects.meshes[0].positions().len(), 4);
+    assert_eq!(scene.objects.meshes[0].len(), 2);
     assert_eq!(scene.materials, vec![Material::default()]);
     assert!(loaded.warnings.is_empty());
 }
@@ -40,12 +40,12 @@ fn unknown_statements_and_lines_are_warned_about_once() {
 fn a_file_without_s_is_smoothed_and_given_normals_are_kept() {
     let roof = "v -1 0 0\nv 0 1 0\nv 1 0 0\nv -1 0 1\nv 0 1 1\nv 1 0 1\nf 1 4 5 2\nf 2 5 6 3\n";
     let scene = parse(roof).scene;
-    assert_eq!(scene.meshes[0].positions().len(), 6);
+    assert_eq!(scene.objects.meshes[0].positions().len(), 6);
     let normals = parse(&format!("{roof}vn 0 0 1\nf 1//1 2//1 3//1\n")).scene;
-    assert_eq!(normals.meshes[0].positions().len(), 9);
+    assert_eq!(normals.objects.meshes[0].positions().len(), 9);
     let ridge = Vec3::new(0.0, 1.0, 0.5);
     let ray = crate::math::Ray::new(Vec3::new(0.0, 5.0, 0.5), -Vec3::Y);
-    let mesh = &scene.meshes[0];
+    let mesh = &scene.objects.meshes[0];
     let shear = crate::shape::RayShear::new(&ray);
     let (i, hit) = (0..mesh.len() as u32)
         .find_map(|i| mesh.intersect(i, &ray, &shear).map(|h| (i, h)))

@@ -26,8 +26,8 @@ use toml_span::Span;
 use toml_span::value::Value;
 
 use super::reader::{Parsed, Reader, all, list};
-use crate::light::{Attenuation, Light};
-use crate::math::Color;
+use crate::shading::Color;
+use crate::shading::{Attenuation, Light};
 
 /// The kinds of light, as written in `type`, each with its keys.
 const KINDS: &[(&str, &[&str])] = &[

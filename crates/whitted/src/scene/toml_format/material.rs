@@ -40,10 +40,12 @@
 use toml_span::value::Value;
 
 use super::reader::{Fields, Parsed, Reader, all};
-use crate::bump::Bump;
-use crate::material::Material;
-use crate::math::{Color, DVec2};
-use crate::texture::{Checker, Decoding, ImageTexture, Texture, Wrap};
+use crate::math::DVec2;
+use crate::shading::Bump;
+use crate::shading::Color;
+use crate::shading::Material;
+use crate::shading::Texture;
+use crate::shading::texture::{Checker, Decoding, ImageTexture, Wrap};
 
 /// The keys of a material.
 const KEYS: &[&str] = &[
@@ -296,7 +298,7 @@ mod tests {
         let s = scene(&format!("{CAMERA}[materials.plain]\n"));
         assert_eq!(s.materials, [Material::default()]);
         let s = scene(&format!("{CAMERA}[materials.red]\ndiffuse = [1, 0, 0]\n"));
-        assert_eq!(s.materials[0].ambient, Texture::Constant(Color::X));
+        assert_eq!(s.materials[0].ambient, Texture::Constant(Color::RED));
     }
 
     #[test]
@@ -335,7 +337,7 @@ mod tests {
         assert_eq!(
             m.diffuse,
             Texture::Checker(Checker {
-                even: Color::X,
+                even: Color::RED,
                 odd: Color::ONE,
                 size: 1.0,
             })
@@ -355,7 +357,7 @@ mod tests {
     fn image_slots_are_read_relative_to_the_scene_and_decoded_once() {
         let dir = tempfile::tempdir().unwrap();
         std::fs::create_dir(dir.path().join("textures")).unwrap();
-        let png = crate::texture::png_bytes(1, 1, &[255, 255, 255]);
+        let png = crate::shading::texture::png_bytes(1, 1, &[255, 255, 255]);
         std::fs::write(dir.path().join("textures/white.png"), png).unwrap();
         let source = format!(
             "{CAMERA}[materials.a]\ndiffuse = {{ image = 'textures/white.png' }}\n\
@@ -383,7 +385,7 @@ mod tests {
     #[test]
     fn a_display_scene_reads_colour_images_as_stored() {
         let dir = tempfile::tempdir().unwrap();
-        let png = crate::texture::png_bytes(1, 1, &[128, 128, 128]);
+        let png = crate::shading::texture::png_bytes(1, 1, &[128, 128, 128]);
         std::fs::write(dir.path().join("grey.png"), png).unwrap();
         let texel = |colours: &str| {
             let source = format!(
@@ -391,7 +393,7 @@ mod tests {
                  [materials.a]\ndiffuse = {{ image = 'grey.png' }}\n"
             );
             let s = super::super::parse_scene(&source, &dir.path().join("s.toml")).unwrap();
-            s.materials[0].diffuse.at(DVec2::splat(0.5)).x
+            s.materials[0].diffuse.at(DVec2::splat(0.5)).r
         };
         assert!((texel("display") - 128.0 / 255.0).abs() < 1e-6);
         assert!((texel("linear") - 0.2158605).abs() < 1e-6);
@@ -423,7 +425,7 @@ mod tests {
     #[test]
     fn normal_and_bump_maps_are_read_as_data_with_their_options() {
         let dir = tempfile::tempdir().unwrap();
-        let png = crate::texture::png_bytes(1, 1, &[128, 128, 255]);
+        let png = crate::shading::texture::png_bytes(1, 1, &[128, 128, 255]);
         std::fs::write(dir.path().join("n.png"), png).unwrap();
         let source = format!(
             "{CAMERA}[materials.a]\nnormal_map = {{ image = 'n.png', strength = 0.5, \
@@ -443,7 +445,7 @@ mod tests {
         assert_eq!(normals.wrap, Wrap::Clamp);
         // Data: 128 is 128/255, not the sRGB-decoded 0.2158.
         let texel = normals.at(DVec2::splat(0.5));
-        assert!((texel.x - 128.0 / 255.0).abs() < 1e-6, "{texel}");
+        assert!((texel.r - 128.0 / 255.0).abs() < 1e-6, "{texel}");
         let Some(Bump::Height {
             texture: Texture::Image(heights),
             strength,

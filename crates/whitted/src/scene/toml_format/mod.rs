@@ -47,12 +47,15 @@ use toml_span::Span;
 use toml_span::value::Value;
 
 use self::reader::{Parsed, Reader};
-use crate::camera::{Camera, CameraError};
-use crate::color_space::ColorSpace;
-use crate::material::{Material, MaterialId};
-use crate::math::{Color, Vec3};
+use crate::image::ColorSpace;
+use crate::math::Vec3;
+use crate::render::{Camera, CameraError};
 use crate::render::{MAX_DEPTH, MAX_SIDE};
-use crate::scene::{Diagnostic, RenderSettings, Scene, SceneError};
+use crate::render::{RenderSettings, Scene};
+use crate::scene::{Diagnostic, SceneError};
+use crate::shading::Color;
+use crate::shading::Material;
+use crate::world::MaterialId;
 
 /// Reads a scene from the text of a scene file; `path` is only used in
 /// messages.
@@ -174,6 +177,7 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
             max_depth: max_depth?,
             min_weight: min_weight?,
             accel: accel?,
+            ..d
         },
         background: background?,
         ambient: ambient?,
@@ -269,7 +273,7 @@ pub(super) mod tests {
         assert_eq!(s.color_space, ColorSpace::Linear);
         assert_eq!(s.camera.up(), Vec3::Y);
         assert_eq!(s.camera.fov_degrees(), 45.0);
-        assert!(s.materials.is_empty() && s.lights.is_empty() && s.primitives.is_empty());
+        assert!(s.materials.is_empty() && s.lights.is_empty() && s.objects.primitives.is_empty());
     }
 
     #[test]
@@ -288,6 +292,7 @@ pub(super) mod tests {
                 max_depth: 0,
                 min_weight: 0.0,
                 accel: AccelKind::Linear,
+                ..RenderSettings::default()
             }
         );
         assert_eq!(s.background, Color::new(0.1, 0.2, 0.3));

@@ -191,9 +191,11 @@ fn build_step(r: &mut Reader<'_>, key: &str, value: &Value<'_>) -> Parsed<Transf
 mod tests {
     use super::super::tests::{CAMERA, errors, scene};
     use super::shapes::SHAPE_KINDS;
-    use crate::material::{Material, MaterialId};
     use crate::math::{Transform, Vec3};
-    use crate::scene::{Scene, TransformId};
+    use crate::render::Scene;
+    use crate::shading::Material;
+    use crate::world::MaterialId;
+    use crate::world::TransformId;
 
     /// The world transform of the only object in `steps`.
     fn transform(steps: &str) -> Transform {
@@ -204,10 +206,10 @@ mod tests {
     }
 
     fn world_from_object(s: &Scene, index: usize) -> Transform {
-        s.primitives[index]
+        s.objects.primitives[index]
             .transform
             .map_or(Transform::IDENTITY, |TransformId(i)| {
-                s.transforms[i as usize]
+                s.objects.transforms[i as usize]
             })
     }
 
@@ -251,11 +253,11 @@ mod tests {
              [[objects]]\nshape = 'sphere'\nradius = 1\n\
              [[objects]]\nshape = 'sphere'\nradius = 1\n"
         ));
-        let ids: Vec<MaterialId> = s.primitives.iter().map(|p| p.material).collect();
+        let ids: Vec<MaterialId> = s.objects.primitives.iter().map(|p| p.material).collect();
         assert_eq!(ids, [MaterialId(1), MaterialId(2), MaterialId(2)]);
         assert_eq!(s.materials.len(), 3);
         assert_eq!(s.materials[2], Material::default());
-        assert!(s.primitives.iter().all(|p| p.transform.is_none()));
+        assert!(s.objects.primitives.iter().all(|p| p.transform.is_none()));
     }
 
     #[test]

@@ -12,10 +12,11 @@ use std::sync::Arc;
 use toml_span::Span;
 use toml_span::value::{Key, Table, Value};
 
-use crate::color_space::ColorSpace;
-use crate::math::{Color, Vec3, unit};
+use crate::image::ColorSpace;
+use crate::math::{Vec3, unit};
 use crate::scene::{Diagnostic, SceneError, Severity, push_limited};
-use crate::texture::{Decoding, ImageCache, ImageData};
+use crate::shading::Color;
+use crate::shading::texture::{Decoding, ImageCache, ImageData};
 
 /// A value was wrong and its error has been recorded. Only [`Reader::error`]
 /// makes one, so a failed walk always has at least one diagnostic.
@@ -456,7 +457,7 @@ impl<'s> Reader<'s> {
     pub(super) fn color(&mut self, value: &Value<'_>, key: &str) -> Parsed<Color> {
         if value.as_array().is_some() {
             self.numbers::<3>(value, key, Self::non_negative)
-                .map(Color::from_array)
+                .map(Color::from)
         } else if value.as_integer().is_some() || value.as_float().is_some() {
             self.non_negative(value, key).map(Color::splat)
         } else {

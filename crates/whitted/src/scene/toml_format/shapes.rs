@@ -321,11 +321,11 @@ mod tests {
     /// transform.
     fn placed(keys: &str) -> (Shape, Transform) {
         let mut s = scene(&format!("{CAMERA}[[objects]]\n{keys}\n"));
-        assert_eq!(s.primitives.len(), 1);
-        let primitive = s.primitives.remove(0);
-        let transform = primitive
-            .transform
-            .map_or(Transform::IDENTITY, |id| s.transforms[id.0 as usize]);
+        assert_eq!(s.objects.primitives.len(), 1);
+        let primitive = s.objects.primitives.remove(0);
+        let transform = primitive.transform.map_or(Transform::IDENTITY, |id| {
+            s.objects.transforms[id.0 as usize]
+        });
         (primitive.shape, transform)
     }
 

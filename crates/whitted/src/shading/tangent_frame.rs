@@ -62,7 +62,7 @@ impl TangentFrame {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::random::Rng;
+    use crate::math::random::Rng;
 
     fn assert_orthonormal(f: &TangentFrame) {
         for (a, b) in [

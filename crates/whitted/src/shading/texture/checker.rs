@@ -1,6 +1,8 @@
 //! A procedural checkerboard over (u, v).
 
-use crate::math::{Color, DVec2};
+use crate::shading::Color;
+
+use crate::math::DVec2;
 
 /// A checkerboard in texture space.
 #[derive(Clone, Debug, PartialEq)]

@@ -19,12 +19,13 @@ pub(crate) use self::decode::tests::{png_bytes, rgba_png_bytes};
 pub use self::decode::{Decoding, ImageCache, ImageLoadError, decode_image};
 pub use self::dissolve::DissolveMap;
 pub use self::image::{ImageData, ImageTexture, Wrap};
-use crate::math::{Color, DVec2};
+use crate::math::DVec2;
+use crate::shading::Color;
 
 /// The luminance of a linear RGB colour (Rec. 709 weights, which sum to 1:
 /// a grey's luminance is its level).
 pub fn luminance(c: Color) -> f64 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+    0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b
 }
 
 /// What a material slot's colour is at a surface point.
@@ -124,7 +125,7 @@ mod tests {
         assert!(!Texture::Constant(Color::new(1.0, 1.0, 0.5)).is_white());
         let t = Texture::Checker(Checker {
             even: Color::ZERO,
-            odd: Color::X,
+            odd: Color::RED,
             size: 1.0,
         });
         assert!(!t.is_black() && !t.is_white());

@@ -21,13 +21,10 @@
 //! reflected ray gets `α (kr + kt F)`. Without it, total internal reflection
 //! alone moves the refracted weight onto the reflected ray.
 
-use crate::bump::Bump;
-use crate::math::{Color, DVec2};
-use crate::texture::Texture;
-
-/// Index of a material in [`crate::scene::Scene::materials`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct MaterialId(pub u32);
+use crate::math::DVec2;
+use crate::shading::Bump;
+use crate::shading::Color;
+use crate::shading::Texture;
 
 /// A Whitted/Phong surface description.
 #[derive(Clone, Debug, PartialEq)]

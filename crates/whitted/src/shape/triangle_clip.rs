@@ -98,7 +98,7 @@ fn clip(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::random::Rng;
+    use crate::math::random::Rng;
 
     fn cube(min: f64, max: f64) -> Aabb {
         Aabb::new(Vec3::splat(min), Vec3::splat(max))

@@ -250,11 +250,11 @@ pub(crate) mod tests {
         };
         // sRGB 128 is 0.2158605 linear; 188 is 0.5028865.
         let left = t(0);
-        assert_eq!(left.x, 0.0);
-        assert!((left.y - 0.215_860_5).abs() < 1e-6, "{left}");
-        assert!((left.z - 1.0).abs() < 1e-6);
+        assert_eq!(left.r, 0.0);
+        assert!((left.g - 0.215_860_5).abs() < 1e-6, "{left}");
+        assert!((left.b - 1.0).abs() < 1e-6);
         assert!(
-            (t(1) - crate::math::Color::splat(0.502_886_5))
+            (t(1) - crate::shading::Color::splat(0.502_886_5))
                 .abs()
                 .max_element()
                 < 1e-6
@@ -264,7 +264,7 @@ pub(crate) mod tests {
     #[test]
     fn jpeg_is_decoded_and_srgb_linearised() {
         // 16 x 8: the left half sRGB (200, 100, 50), the right half 128 grey.
-        let bytes = include_bytes!("../../tests/textures/two_blocks.jpg");
+        let bytes = include_bytes!("../../../tests/textures/two_blocks.jpg");
         let image = decode_image(bytes, Decoding::Color).unwrap();
         assert_eq!((image.width(), image.height()), (16, 8));
         let t = super::super::ImageTexture::new(Arc::new(image));
@@ -273,14 +273,14 @@ pub(crate) mod tests {
         // JPEG is lossy: allow about one 8-bit step.
         let expected = [200, 100, 50].map(|c| f64::from(srgb_to_linear(c as f32 / 255.0)));
         assert!(
-            (left - crate::math::Color::from(expected))
+            (left - crate::shading::Color::from(expected))
                 .abs()
                 .max_element()
                 < 0.01,
             "{left}"
         );
         assert!(
-            (right - crate::math::Color::splat(0.215_860_5))
+            (right - crate::shading::Color::splat(0.215_860_5))
                 .abs()
                 .max_element()
                 < 0.01
@@ -289,7 +289,7 @@ pub(crate) mod tests {
 
     #[test]
     fn a_short_jpeg_claiming_a_huge_size_is_refused_before_decoding() {
-        let mut bytes = include_bytes!("../../tests/textures/two_blocks.jpg").to_vec();
+        let mut bytes = include_bytes!("../../../tests/textures/two_blocks.jpg").to_vec();
         let sof = bytes
             .windows(2)
             .position(|w| w == [0xff, 0xc0] || w == [0xff, 0xc2])
@@ -328,7 +328,7 @@ pub(crate) mod tests {
         let t = super::super::ImageTexture::new(Arc::new(image));
         assert_eq!(
             t.at(crate::math::DVec2::splat(0.5)),
-            crate::math::Color::ONE
+            crate::shading::Color::ONE
         );
     }
 
@@ -339,22 +339,30 @@ pub(crate) mod tests {
             super::super::ImageTexture::new(Arc::new(image)).at(crate::math::DVec2::splat(0.5))
         };
         let rgb = png_bytes(1, 1, &[0, 51, 255]);
-        let expected = crate::math::Color::new(0.0, 0.2, 1.0);
-        assert!((texel(&rgb, Decoding::Data) - expected).length() < 1e-7);
-        assert!((texel(&rgb, Decoding::Opacity) - expected).length() < 1e-7);
+        let expected = crate::shading::Color::new(0.0, 0.2, 1.0);
+        assert!((texel(&rgb, Decoding::Data) - expected).abs().max_element() < 1e-7);
+        assert!(
+            (texel(&rgb, Decoding::Opacity) - expected)
+                .abs()
+                .max_element()
+                < 1e-7
+        );
         let rgba = rgba_png_bytes(1, 1, &[255, 255, 255, 102]);
         let alpha = texel(&rgba, Decoding::Opacity);
         assert!(
-            (alpha - crate::math::Color::splat(0.4)).length() < 1e-7,
+            (alpha - crate::shading::Color::splat(0.4))
+                .abs()
+                .max_element()
+                < 1e-7,
             "{alpha}"
         );
-        assert_eq!(texel(&rgba, Decoding::Color), crate::math::Color::ONE);
-        let jpeg = include_bytes!("../../tests/textures/two_blocks.jpg");
+        assert_eq!(texel(&rgba, Decoding::Color), crate::shading::Color::ONE);
+        let jpeg = include_bytes!("../../../tests/textures/two_blocks.jpg");
         let grey = decode_image(jpeg, Decoding::Data).unwrap();
         let right =
             super::super::ImageTexture::new(Arc::new(grey)).at(crate::math::DVec2::new(0.75, 0.5));
         assert!(
-            (right - crate::math::Color::splat(128.0 / 255.0))
+            (right - crate::shading::Color::splat(128.0 / 255.0))
                 .abs()
                 .max_element()
                 < 0.01

@@ -11,11 +11,12 @@
 use std::ops::Range;
 use std::path::Path;
 
-use crate::camera::Camera;
-use crate::material::Material;
 use crate::math::{Aabb, Transform, Vec3};
 use crate::mesh::{MeshError, TriangleMesh};
-use crate::scene::{Diagnostic, Scene, SceneError, Severity, push_limited};
+use crate::render::Camera;
+use crate::render::Scene;
+use crate::scene::{Diagnostic, SceneError, Severity, push_limited};
+use crate::shading::Material;
 
 /// Positions and triangles as they appear in the file.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -221,7 +222,7 @@ mod tests {
         let soup = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 4\nf 1 2 3\n").unwrap();
         let camera = Camera::framing(&soup.bounds(), 1.0, 50.0).unwrap();
         let scene = soup.to_scene(camera).unwrap();
-        let geometry = crate::geometry::Geometry::new(&scene);
+        let geometry = crate::world::World::new(&scene.objects);
         assert_eq!(geometry.len(), 2);
         let ray = crate::math::Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z);
         assert_eq!(geometry.intersect(&ray).unwrap().primitive, 1);

@@ -5,7 +5,9 @@
 //! (Warn's model) scales its intensity by `cos(α)^falloff` for directions at
 //! angle `α` from its axis, and is dark beyond its cut-off angle.
 
-use crate::math::{Color, Vec3};
+use crate::shading::Color;
+
+use crate::math::Vec3;
 
 /// Distance fall-off coefficients.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -186,7 +188,7 @@ mod tests {
         assert_eq!(on_axis.intensity, Color::ONE);
         let inside = light.sample(Vec3::new(0.5, 0.0, 0.0)).unwrap();
         let cos = 1.0 / 1.25f64.sqrt();
-        assert!((inside.intensity.x - cos * cos).abs() < 1e-12);
+        assert!((inside.intensity.r - cos * cos).abs() < 1e-12);
         assert!(light.sample(Vec3::new(1.5, 0.0, 0.0)).is_none());
     }
 

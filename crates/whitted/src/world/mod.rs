@@ -1,22 +1,26 @@
-//! The scene's primitives made ready for ray queries: world-space bounds, an
-//! acceleration structure over the bounded ones, a short list of the
-//! unbounded ones, and the two queries every tracer needs — the closest hit
-//! and any hit — plus the full surface description of a final hit.
+//! What the renderer traces: the scene's objects prepared once for ray
+//! queries. World-space bounds, an acceleration structure over the bounded
+//! primitives, a short list of the unbounded ones, and the two queries every
+//! integrator needs — the closest hit and any hit — plus the full surface
+//! description of a final hit.
 //!
-//! Primitives are numbered once for the whole scene: first the shapes of
-//! [`Scene::primitives`] in order, then the triangles of each mesh instance
-//! of [`Scene::mesh_instances`] in order. That number is what [`Hit`]
-//! reports (and the `id` AOV shows).
+//! Primitives are numbered once for the whole world: first the shapes of
+//! [`Objects::primitives`] in order, then the triangles of each mesh
+//! instance of [`Objects::mesh_instances`] in order. That number is what
+//! [`Hit`] reports (and the `id` AOV shows).
+
+mod hit;
+mod objects;
+
+pub use hit::{Hit, Surface};
+pub use objects::{MaterialId, MeshId, MeshInstance, Objects, Primitive, TransformId};
 
 use crate::accel::{AccelKind, Accelerator, TraversalCounters};
-use crate::material::MaterialId;
-use crate::math::{Aabb, DVec2, Ray, Transform, Vec3};
+use crate::math::{Aabb, Ray, Transform, Vec3};
 use crate::mesh::TriangleMesh;
-use crate::scene::{MeshInstance, Primitive, Scene, TransformId};
 #[cfg(target_arch = "x86_64")]
 use crate::shape::{Hits4, LANES, watertight4};
-use crate::shape::{LocalSurface, RayShear, Shape, ShapeHit, watertight};
-use crate::triangle_clip::clipped_triangle_bounds;
+use crate::shape::{RayShear, Shape, ShapeHit, clipped_triangle_bounds, watertight};
 use rayon::prelude::*;
 use std::ops::Range;
 
@@ -24,61 +28,23 @@ use std::ops::Range;
 /// on the calling thread.
 const PARALLEL_CHUNK: usize = 4096;
 
-/// The closest hit found by [`Geometry::intersect`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Hit {
-    /// The primitive's number in the whole scene (see the module doc).
-    pub primitive: u32,
-    /// What the shape recorded (its `t` is the ray parameter).
-    pub shape_hit: ShapeHit,
-}
-
-impl Hit {
-    /// The ray parameter of the hit.
-    pub fn t(&self) -> f64 {
-        self.shape_hit.t
-    }
-}
-
-/// The surface at a hit, in world space.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Surface {
-    /// The hit point.
-    pub point: Vec3,
-    /// Absolute bound on the error of `point`, per axis.
-    pub point_error: Vec3,
-    /// Unit geometric normal, outward (not yet turned towards the ray).
-    pub normal: Vec3,
-    /// Unit normal for shading: the geometric one, or the one interpolated
-    /// from a mesh's vertex normals.
-    pub shading_normal: Vec3,
-    /// Texture coordinates.
-    pub uv: DVec2,
-    /// Derivative of the point along u (a tangent; not normalised).
-    pub dpdu: Vec3,
-    /// Derivative of the point along v (a tangent; not normalised).
-    pub dpdv: Vec3,
-    /// The surface's material.
-    pub material: MaterialId,
-}
-
 /// What a primitive number stands for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum PrimitiveRef {
-    /// Index into [`Scene::primitives`].
+    /// Index into [`Objects::primitives`].
     Shape(u32),
     /// Triangle `triangle` of mesh instance `instance`.
     Triangle {
-        /// Index into [`Scene::mesh_instances`].
+        /// Index into [`Objects::mesh_instances`].
         instance: u32,
         /// The triangle in that instance's mesh.
         triangle: u32,
     },
 }
 
-/// The scene's geometry, ready for ray queries.
+/// The objects of a scene, ready for ray queries.
 #[derive(Debug)]
-pub struct Geometry<'a> {
+pub struct World<'a> {
     primitives: &'a [Primitive],
     instances: &'a [MeshInstance],
     meshes: &'a [TriangleMesh],
@@ -105,7 +71,7 @@ pub struct Geometry<'a> {
     unbounded: Vec<u32>,
 }
 
-/// The primitive of one entry of [`Geometry::entries`]: its number, and
+/// The primitive of one entry of [`World::entries`]: its number, and
 /// its corners when it is an untransformed triangle (of a mesh or a
 /// triangle shape, which then takes the mesh triangles' path: the same
 /// watertight test on the same corners). The number shares the corners'
@@ -118,7 +84,7 @@ pub struct Geometry<'a> {
 /// within noise).
 #[derive(Clone, Copy, Debug)]
 struct EntryPrimitive {
-    /// The primitive's number (its index in `Geometry::refs`).
+    /// The primitive's number (its index in `World::refs`).
     number: u32,
     /// Whether `corners` holds a triangle's.
     triangle: bool,
@@ -162,29 +128,24 @@ impl Query<'_> {
     }
 }
 
-impl<'a> Geometry<'a> {
-    /// Prepares the scene's primitives with the default structure.
-    pub fn new(scene: &'a Scene) -> Self {
-        Self::with_accel(scene, AccelKind::default())
+impl<'a> World<'a> {
+    /// Prepares the objects with the default structure.
+    pub fn new(objects: &'a Objects) -> Self {
+        Self::build(objects, AccelKind::default())
     }
 
-    /// Prepares the scene's primitives with the structure `kind`.
-    pub fn with_accel(scene: &'a Scene, kind: AccelKind) -> Self {
-        let n = scene.primitives.len()
-            + scene
-                .mesh_instances
-                .iter()
-                .map(|m| scene.meshes[m.mesh.0 as usize].len())
-                .sum::<usize>();
+    /// Prepares the objects with the structure `kind`.
+    pub fn build(objects: &'a Objects, kind: AccelKind) -> Self {
+        let n = objects.primitive_count();
         let mut refs = Vec::with_capacity(n);
         let mut bounded = Vec::with_capacity(n);
         let mut unbounded = Vec::new();
         let mut boxes = Vec::with_capacity(n);
         let to_world = |transform: Option<TransformId>, local: Aabb| match transform {
-            Some(id) => scene.transforms[id.0 as usize].bounds_to_world(&local),
+            Some(id) => objects.transforms[id.0 as usize].bounds_to_world(&local),
             None => local,
         };
-        for (i, p) in scene.primitives.iter().enumerate() {
+        for (i, p) in objects.primitives.iter().enumerate() {
             let local = p.shape.bounds();
             if local.is_finite() {
                 boxes.push(to_world(p.transform, local));
@@ -195,12 +156,12 @@ impl<'a> Geometry<'a> {
             refs.push(PrimitiveRef::Shape(i as u32));
         }
         // The first structure slot of each mesh instance's triangles.
-        let mut instance_slots = Vec::with_capacity(scene.mesh_instances.len());
+        let mut instance_slots = Vec::with_capacity(objects.mesh_instances.len());
         // A mesh's triangles are prepared in parallel: on the bunny this
         // loop, and the fresh memory it touches, took a fifth of the time
         // `whitted bench` reports as the BVH build.
-        for (instance, m) in scene.mesh_instances.iter().enumerate() {
-            let mesh = &scene.meshes[m.mesh.0 as usize];
+        for (instance, m) in objects.mesh_instances.iter().enumerate() {
+            let mesh = &objects.meshes[m.mesh.0 as usize];
             let triangles = || {
                 (0..mesh.len() as u32)
                     .into_par_iter()
@@ -227,7 +188,7 @@ impl<'a> Geometry<'a> {
         // untransformed triangle. A triangle shape then takes the mesh
         // triangles' path: the same watertight test on the same corners.
         // Shapes take the first slots, and a shape's primitive number is
-        // its index in `Scene::primitives`. A mesh triangle is found from
+        // its index in `Objects::primitives`. A mesh triangle is found from
         // its slot's offset in its instance's run of slots: going through
         // `bounded` and `refs`, two more random reads per slot, made the
         // gather below take 60 instead of 37 ms on the dragon.
@@ -236,7 +197,7 @@ impl<'a> Geometry<'a> {
             .map_or(bounded.len(), |&s| s as usize);
         let slot_corners = |slot: u32| {
             if (slot as usize) < shape_slots {
-                return match &scene.primitives[bounded[slot as usize] as usize] {
+                return match &objects.primitives[bounded[slot as usize] as usize] {
                     Primitive {
                         shape: Shape::Triangle(t),
                         transform: None,
@@ -246,8 +207,8 @@ impl<'a> Geometry<'a> {
                 };
             }
             let instance = instance_slots.partition_point(|&first| first <= slot) - 1;
-            let m = &scene.mesh_instances[instance];
-            let mesh = &scene.meshes[m.mesh.0 as usize];
+            let m = &objects.mesh_instances[instance];
+            let mesh = &objects.meshes[m.mesh.0 as usize];
             let triangle = slot - instance_slots[instance];
             m.transform.is_none().then(|| mesh.corners(triangle))
         };
@@ -276,10 +237,10 @@ impl<'a> Geometry<'a> {
             .collect();
         let has_triangles = entries.par_iter().any(|e| e.triangle);
         Self {
-            primitives: &scene.primitives,
-            instances: &scene.mesh_instances,
-            meshes: &scene.meshes,
-            transforms: &scene.transforms,
+            primitives: &objects.primitives,
+            instances: &objects.mesh_instances,
+            meshes: &objects.meshes,
+            transforms: &objects.transforms,
             refs,
             accel,
             bounds,
@@ -581,35 +542,17 @@ fn intersect_triangle([p0, p1, p2]: &[Vec3; 3], query: &Query, t_max: f64) -> Op
     watertight(*p0, *p1, *p2, &ray, &query.shear())
 }
 
-impl Surface {
-    fn from_local(s: LocalSurface, shading_normal: Vec3, material: MaterialId) -> Self {
-        Self {
-            point: s.point,
-            point_error: s.point_error,
-            normal: s.normal,
-            shading_normal,
-            uv: s.uv,
-            dpdu: s.dpdu,
-            dpdv: s.dpdv,
-            material,
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::camera::Camera;
-    use crate::material::Material;
-    use crate::random::Rng;
+    use crate::math::DVec2;
+    use crate::math::random::Rng;
     use crate::shape::{Plane, Shape, Sphere, Triangle};
 
-    fn scene_with(shape: Shape, transform: Transform) -> Scene {
-        let camera = Camera::new(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0).unwrap();
-        let mut scene = Scene::new(camera);
-        let m = scene.add_material(Material::default());
-        scene.add_primitive(shape, m, transform);
-        scene
+    fn scene_with(shape: Shape, transform: Transform) -> Objects {
+        let mut objects = Objects::default();
+        objects.add_primitive(shape, MaterialId(0), transform);
+        objects
     }
 
     #[test]
@@ -622,30 +565,30 @@ mod tests {
             .then_after(&Transform::scale(Vec3::new(2.0, 1.0, 1.0)).unwrap());
         let sphere = Shape::Sphere(Sphere::new(Vec3::ZERO, 1.0).unwrap());
         let scene = scene_with(sphere, transform);
-        let geometry = Geometry::new(&scene);
+        let world = World::new(&scene);
 
         let down = Ray::new(Vec3::new(5.0, 10.0, 0.0), -Vec3::Y);
-        let hit = geometry.intersect(&down).unwrap();
+        let hit = world.intersect(&down).unwrap();
         assert!((hit.t() - 8.0).abs() < 1e-12);
-        let s = geometry.surface(&down, &hit);
+        let s = world.surface(&down, &hit);
         assert!((s.point - Vec3::new(5.0, 2.0, 0.0)).length() < 1e-12);
         assert!((s.normal - Vec3::Y).length() < 1e-12);
 
         let across = Ray::new(Vec3::new(0.0, 0.0, 0.0), Vec3::X);
-        let hit = geometry.intersect(&across).unwrap();
+        let hit = world.intersect(&across).unwrap();
         assert!((hit.t() - 4.0).abs() < 1e-12);
-        assert!((geometry.surface(&across, &hit).normal + Vec3::X).length() < 1e-12);
+        assert!((world.surface(&across, &hit).normal + Vec3::X).length() < 1e-12);
 
         // Off-axis: the ellipsoid x'² + (y/2)² + z² = 1 around (5, 0, 0) has
         // its normal along (x', y/4, z) at (x', y, z).
         let y = 3f64.sqrt();
         let oblique = Ray::new(Vec3::new(10.0, y, 0.0), -Vec3::X);
-        let hit = geometry.intersect(&oblique).unwrap();
-        let s = geometry.surface(&oblique, &hit);
+        let hit = world.intersect(&oblique).unwrap();
+        let s = world.surface(&oblique, &hit);
         assert!((s.point - Vec3::new(5.5, y, 0.0)).length() < 1e-12);
         let expected = Vec3::new(0.5, y / 4.0, 0.0).normalize();
         assert!((s.normal - expected).length() < 1e-12);
-        assert!(geometry.occluded(&oblique));
+        assert!(world.occluded(&oblique));
     }
 
     #[test]
@@ -655,17 +598,17 @@ mod tests {
             .then_after(&Transform::scale(Vec3::new(3.0, 0.5, 1.0)).unwrap());
         let sphere = Shape::Sphere(Sphere::new(Vec3::new(1.0, 0.0, 0.0), 1.0).unwrap());
         let scene = scene_with(sphere, transform);
-        let geometry = Geometry::new(&scene);
-        assert_eq!(geometry.accel.stats().references, 1);
-        let world = transform.bounds_to_world(&scene.primitives[0].shape.bounds());
-        let mut rng = crate::random::Rng::new(5);
+        let world = World::new(&scene);
+        assert_eq!(world.accel.stats().references, 1);
+        let bounds = transform.bounds_to_world(&scene.primitives[0].shape.bounds());
+        let mut rng = crate::math::random::Rng::new(5);
         let mut hits = 0;
         for _ in 0..500 {
             let target = rng.unit_vector() * 3.0;
             let ray = Ray::new(Vec3::splat(20.0), target - Vec3::splat(20.0));
-            if let Some(hit) = geometry.intersect(&ray) {
-                let p = geometry.surface(&ray, &hit).point;
-                assert!(p.cmpge(world.min - 1e-9).all() && p.cmple(world.max + 1e-9).all());
+            if let Some(hit) = world.intersect(&ray) {
+                let p = world.surface(&ray, &hit).point;
+                assert!(p.cmpge(bounds.min - 1e-9).all() && p.cmple(bounds.max + 1e-9).all());
                 hits += 1;
             }
         }
@@ -684,20 +627,20 @@ mod tests {
             Shape::Cylinder(Cylinder::new(1.0, 2.0, true).unwrap()),
             Shape::AxisBox(AxisBox::new(Vec3::splat(-1.0), Vec3::ONE).unwrap()),
         ];
-        let mut rng = crate::random::Rng::new(8);
+        let mut rng = crate::math::random::Rng::new(8);
         for shape in shapes {
             let scene = scene_with(shape, transform);
-            let geometry = Geometry::new(&scene);
+            let world = World::new(&scene);
             let mut checked = 0;
             for _ in 0..300 {
                 let target =
                     transform.point_to_world(rng.point_in(Vec3::splat(-0.9), Vec3::splat(0.9)));
                 let origin = target + 20.0 * rng.unit_vector();
                 let ray = Ray::new(origin, target - origin);
-                let Some(hit) = geometry.intersect(&ray) else {
+                let Some(hit) = world.intersect(&ray) else {
                     continue;
                 };
-                let s = geometry.surface(&ray, &hit);
+                let s = world.surface(&ray, &hit);
                 for (tangent, along) in [(s.dpdu, DVec2::X), (s.dpdv, DVec2::Y)] {
                     assert!(tangent.dot(s.normal).abs() < 1e-12 * tangent.length());
                     if tangent.length() < 1e-3 {
@@ -706,10 +649,10 @@ mod tests {
                     let h = 1e-6;
                     let back_origin = s.point + h * tangent + 0.01 * s.normal;
                     let back = Ray::new(back_origin, -s.normal);
-                    let Some(moved) = geometry.intersect(&back) else {
+                    let Some(moved) = world.intersect(&back) else {
                         continue;
                     };
-                    let change = geometry.surface(&back, &moved).uv - s.uv;
+                    let change = world.surface(&back, &moved).uv - s.uv;
                     if moved.shape_hit.part != hit.shape_hit.part
                         || change.abs().max_element() > 0.5
                     {
@@ -733,9 +676,8 @@ mod tests {
         // rebuilt from the primitive itself must lie where the ray is at
         // `t` (which the corners, shared by all, cannot fake).
         let mut rng = Rng::new(5);
-        let camera = Camera::new(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0).unwrap();
-        let mut scene = Scene::new(camera);
-        let m = scene.add_material(Material::default());
+        let mut scene = Objects::default();
+        let m = MaterialId(0);
         for _ in 0..40 {
             let centre = rng.point_in(Vec3::splat(-4.0), Vec3::splat(4.0));
             let sphere = Sphere::new(centre, rng.range(0.05, 0.4)).unwrap();
@@ -767,7 +709,7 @@ mod tests {
         let plane = Plane::new(Vec3::new(0.0, -6.0, 0.0), Vec3::Y).unwrap();
         scene.add_primitive(Shape::Plane(plane), m, Transform::IDENTITY);
 
-        let oracle = Geometry::with_accel(&scene, AccelKind::Linear);
+        let oracle = World::build(&scene, AccelKind::Linear);
         let rays: Vec<Ray> = (0..2000)
             .map(|i| {
                 let origin = rng.point_in(Vec3::splat(-6.0), Vec3::splat(6.0));
@@ -780,14 +722,14 @@ mod tests {
             })
             .collect();
         for kind in AccelKind::ALL {
-            let geometry = Geometry::with_accel(&scene, kind);
+            let world = World::build(&scene, kind);
             let mut hits = 0;
             for ray in &rays {
                 let expected = oracle.intersect(ray);
-                assert_eq!(geometry.intersect(ray), expected, "{kind:?} {ray:?}");
-                assert_eq!(geometry.occluded(ray), expected.is_some(), "{kind:?}");
+                assert_eq!(world.intersect(ray), expected, "{kind:?} {ray:?}");
+                assert_eq!(world.occluded(ray), expected.is_some(), "{kind:?}");
                 if let Some(hit) = expected {
-                    let point = geometry.surface(ray, &hit).point;
+                    let point = world.surface(ray, &hit).point;
                     assert!(
                         (point - ray.at(hit.t())).length() < 1e-9,
                         "{kind:?} {ray:?}"
@@ -804,12 +746,12 @@ mod tests {
     fn unbounded_planes_are_tested_beside_the_structure() {
         let plane = Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Y).unwrap());
         let scene = scene_with(plane, Transform::IDENTITY);
-        let geometry = Geometry::new(&scene);
-        assert_eq!(geometry.accel.stats().references, 0);
+        let world = World::new(&scene);
+        assert_eq!(world.accel.stats().references, 0);
         let ray = Ray::new(Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, -1.0, 0.0));
-        assert_eq!(geometry.intersect(&ray).unwrap().t(), 1.0);
-        assert!(geometry.occluded(&ray));
+        assert_eq!(world.intersect(&ray).unwrap().t(), 1.0);
+        assert!(world.occluded(&ray));
         let up = Ray::new(Vec3::new(0.0, 1.0, 0.0), Vec3::Y);
-        assert!(geometry.intersect(&up).is_none() && !geometry.occluded(&up));
+        assert!(world.intersect(&up).is_none() && !world.occluded(&up));
     }
 }

@@ -2,89 +2,33 @@
 //! samples placed by a pattern seeded from the pixel's position, so the
 //! picture is identical bit for bit whatever the number of threads.
 
+mod camera;
+mod scene;
+mod settings;
+
+pub use camera::{Camera, CameraError};
+pub use scene::Scene;
+pub use settings::{Aov, MAX_DEPTH, MAX_PIXELS, MAX_SIDE, RenderSettings};
+
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 
-use crate::accel::TraversalCounters;
 use crate::image::Film;
-use crate::math::Color;
-use crate::random::hash64;
-use crate::sampling::pixel_sample;
-use crate::scene::{RenderSettings, Scene};
-use crate::trace::{RayCounts, Tracer};
+use crate::integrator::{Integrator, RayCounts, RayKind, Shading, WhittedLimits};
+use crate::math::random::hash64;
+use crate::math::sampling::pixel_sample;
+use crate::shading::Color;
+use crate::world::World;
 
 /// Side of the square tiles the image is cut into, in pixels.
 const TILE_SIZE: u32 = 16;
-
-/// The deepest recursion a render accepts. Each level takes a few
-/// kilobytes of a worker's stack, which is sized for it.
-pub const MAX_DEPTH: u32 = 1000;
 
 /// Worker stack: a base for everything but the recursion, plus room for
 /// each level (one level measured at about 1.5 KiB in a release build; the
 /// margin covers debug builds).
 fn worker_stack_bytes(max_depth: u32) -> usize {
     (2 << 20) + max_depth as usize * (16 << 10)
-}
-
-/// Longest side of an image a render accepts, in pixels.
-pub const MAX_SIDE: u32 = 65535;
-
-/// Largest image (in pixels) a render accepts: a few gigabytes of film.
-pub const MAX_PIXELS: u64 = 1 << 28;
-
-/// Per-pixel data besides the colour.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Aov {
-    /// Distance along the unit-length primary ray through the pixel centre
-    /// to the first hit; +∞ where nothing is hit.
-    Depth,
-    /// World-space shading normal at that hit (facing the camera); 0 for a
-    /// miss.
-    Normal,
-    /// Index of the primitive hit, as a float; -1 for a miss.
-    Id,
-    /// Traversal cost of that ray: acceleration-structure nodes visited plus
-    /// primitives tested.
-    Cost,
-}
-
-impl Aov {
-    /// Every AOV.
-    pub const ALL: [Aov; 4] = [Aov::Depth, Aov::Normal, Aov::Id, Aov::Cost];
-
-    /// The name used on the command line.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Aov::Depth => "depth",
-            Aov::Normal => "normal",
-            Aov::Id => "id",
-            Aov::Cost => "cost",
-        }
-    }
-
-    /// The AOV called `name`.
-    pub fn from_name(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|a| a.name() == name)
-    }
-
-    /// Values per pixel.
-    pub fn channels(&self) -> usize {
-        match self {
-            Aov::Normal => 3,
-            Aov::Depth | Aov::Id | Aov::Cost => 1,
-        }
-    }
-}
-
-/// What to produce besides the settings in the scene.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct RenderOptions {
-    /// Worker threads; `None` uses every core.
-    pub threads: Option<usize>,
-    /// Per-pixel data to produce alongside the colour.
-    pub aovs: Vec<Aov>,
 }
 
 /// How far a render has come.
@@ -105,6 +49,8 @@ pub struct RenderOutput {
     pub aovs: Vec<(Aov, Film)>,
     /// How many rays of each kind were traced.
     pub rays: RayCounts,
+    /// The kinds of rays the integrator traces, in report order.
+    pub ray_kinds: &'static [RayKind],
 }
 
 /// Why a render could not start.
@@ -155,14 +101,14 @@ struct Tile {
     rays: RayCounts,
 }
 
-/// Renders `scene` with its settings; `progress` is called from worker
-/// threads as tiles finish.
+/// Renders `scene` with its settings: builds its world once, hands it to
+/// the integrator and spreads the tiles over the worker threads.
+/// `progress` is called from worker threads as tiles finish.
 pub fn render(
     scene: &Scene,
-    options: &RenderOptions,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<RenderOutput, RenderError> {
-    let settings = scene.settings.clone();
+    let settings = &scene.settings;
     let (width, height) = (settings.width, settings.height);
     if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
         return Err(RenderError::BadSize { width, height });
@@ -178,15 +124,26 @@ pub fn render(
     }
     let mut pool =
         rayon::ThreadPoolBuilder::new().stack_size(worker_stack_bytes(settings.max_depth));
-    if let Some(threads) = options.threads {
+    if let Some(threads) = settings.threads {
         pool = pool.num_threads(threads);
     }
     let pool = pool.build().map_err(|e| RenderError::Threads {
-        threads: options.threads.unwrap_or(0),
+        threads: settings.threads.unwrap_or(0),
         message: e.to_string(),
     })?;
 
-    let tracer = Tracer::new(scene, settings.clone());
+    let world = World::build(&scene.objects, settings.accel);
+    let shading = Shading {
+        materials: &scene.materials,
+        lights: &scene.lights,
+        background: scene.background,
+        ambient: scene.ambient,
+    };
+    let limits = WhittedLimits {
+        max_depth: settings.max_depth,
+        min_weight: settings.min_weight,
+    };
+    let integrator = Integrator::new(settings.integrator, &world, shading, limits);
     let tiles_x = width.div_ceil(TILE_SIZE);
     let tiles_y = height.div_ceil(TILE_SIZE);
     let total = u64::from(width) * u64::from(height);
@@ -196,9 +153,9 @@ pub fn render(
             .into_par_iter()
             .map(|index| {
                 let tile = render_tile(
-                    &tracer,
-                    &settings,
-                    options,
+                    &integrator,
+                    &scene.camera,
+                    settings,
                     index % tiles_x,
                     index / tiles_x,
                 );
@@ -211,7 +168,7 @@ pub fn render(
     });
 
     let mut image = Film::new(width, height, 3).with_color_space(scene.color_space);
-    let mut aovs: Vec<(Aov, Film)> = options
+    let mut aovs: Vec<(Aov, Film)> = settings
         .aovs
         .iter()
         .map(|&a| (a, Film::new(width, height, a.channels())))
@@ -231,13 +188,19 @@ pub fn render(
             }
         }
     }
-    Ok(RenderOutput { image, aovs, rays })
+    Ok(RenderOutput {
+        image,
+        aovs,
+        rays,
+        ray_kinds: integrator.ray_kinds(),
+    })
 }
 
+/// Renders one tile of the image.
 fn render_tile(
-    tracer: &Tracer,
+    integrator: &Integrator,
+    camera: &Camera,
     settings: &RenderSettings,
-    options: &RenderOptions,
     tile_x: u32,
     tile_y: u32,
 ) -> Tile {
@@ -252,14 +215,13 @@ fn render_tile(
         width,
         height,
         color: Vec::with_capacity(3 * pixels),
-        aovs: options
+        aovs: settings
             .aovs
             .iter()
             .map(|a| Vec::with_capacity(a.channels() * pixels))
             .collect(),
         rays: RayCounts::default(),
     };
-    let camera = &tracer.scene().camera;
     let spp = settings.samples_per_pixel;
     for y in y0..y0 + height {
         for x in x0..x0 + width {
@@ -274,16 +236,15 @@ fn render_tile(
                     f64::from(x) + offset.x,
                     f64::from(y) + offset.y,
                 );
-                let sample = tracer.trace_primary(&ray, &mut tile.rays);
+                let sample = integrator.trace_primary(&ray, &mut tile.rays);
                 if spp == 1 {
                     centre = Some((ray, sample.first_hit));
                 }
                 sum += sample.color;
             }
             let color = sum / f64::from(spp);
-            tile.color
-                .extend_from_slice(&[color.x as f32, color.y as f32, color.z as f32]);
-            if options.aovs.is_empty() {
+            tile.color.extend_from_slice(&color.to_f32());
+            if settings.aovs.is_empty() {
                 continue;
             }
             let (ray, first_hit) = centre.unwrap_or_else(|| {
@@ -293,10 +254,10 @@ fn render_tile(
                     f64::from(x) + 0.5,
                     f64::from(y) + 0.5,
                 );
-                let hit = tracer.first_hit(&ray);
+                let hit = integrator.first_hit(&ray);
                 (ray, hit)
             });
-            for (aov, data) in options.aovs.iter().zip(&mut tile.aovs) {
+            for (aov, data) in settings.aovs.iter().zip(&mut tile.aovs) {
                 match (aov, &first_hit) {
                     (Aov::Depth, Some((hit, _))) => data.push(hit.t() as f32),
                     (Aov::Depth, None) => data.push(f32::INFINITY),
@@ -312,8 +273,7 @@ fn render_tile(
                     (Aov::Id, Some((hit, _))) => data.push(hit.primitive as f32),
                     (Aov::Id, None) => data.push(-1.0),
                     (Aov::Cost, _) => {
-                        let mut counters = TraversalCounters::default();
-                        tracer.geometry().intersect_counted(&ray, &mut counters);
+                        let counters = integrator.traversal_cost(&ray);
                         data.push((counters.nodes + counters.primitives) as f32);
                     }
                 }

@@ -31,10 +31,11 @@
 //! surface); [`shading_normal`] bends it back until it makes an angle of at
 //! most `acos(0.01)` with the direction to the viewer.
 
-use crate::geometry::Surface;
 use crate::math::{DVec2, Vec3};
-use crate::tangent_frame::TangentFrame;
-use crate::texture::{Texture, luminance};
+use crate::shading::Texture;
+use crate::shading::tangent_frame::TangentFrame;
+use crate::shading::texture::luminance;
+use crate::world::Surface;
 
 /// How far a tilted normal may turn from the viewer: the smallest cosine
 /// allowed between it and the direction to the viewer.
@@ -82,7 +83,8 @@ impl Bump {
                 strength,
                 flip_green,
             } => {
-                let c = 2.0 * texture.at(uv) - Vec3::ONE;
+                // A normal map stores a direction in its colour channels.
+                let c = 2.0 * Vec3::from_array(texture.at(uv).to_array()) - Vec3::ONE;
                 let y = if *flip_green { -c.y } else { c.y };
                 let local = Vec3::new(*strength * c.x, *strength * y, c.z);
                 TangentFrame::new(normal, dpdu, dpdv)
@@ -169,9 +171,9 @@ mod tests {
     use std::sync::Arc;
 
     use super::*;
-    use crate::math::Color;
-    use crate::random::Rng;
-    use crate::texture::{ImageData, ImageTexture, Wrap};
+    use crate::math::random::Rng;
+    use crate::shading::Color;
+    use crate::shading::texture::{ImageData, ImageTexture, Wrap};
 
     fn constant_normal_map(rgb: Color) -> Bump {
         Bump::Normal {

@@ -7,7 +7,8 @@
 
 use super::image::ImageTexture;
 use super::luminance;
-use crate::math::{Color, DVec2};
+use crate::math::DVec2;
+use crate::shading::Color;
 
 /// A dissolve map, as an opacity or as a transmission.
 #[derive(Clone, Debug, PartialEq)]
@@ -51,7 +52,7 @@ mod tests {
     use std::sync::Arc;
 
     use super::*;
-    use crate::texture::ImageData;
+    use crate::shading::texture::ImageData;
 
     #[test]
     fn the_map_scales_the_dissolve_per_texel() {

@@ -9,7 +9,9 @@
 use std::fmt;
 use std::sync::Arc;
 
-use crate::math::{Color, DVec2};
+use crate::shading::Color;
+
+use crate::math::DVec2;
 
 /// Decoded texels in linear RGB, row 0 at the top of the image.
 #[derive(Clone, PartialEq)]
@@ -189,9 +191,9 @@ mod tests {
     #[test]
     fn texel_centres_give_the_texels_with_v_zero_at_the_bottom() {
         let t = two_by_two(Wrap::Repeat);
-        assert!(close(t.at(DVec2::new(0.25, 0.75)), Color::X));
-        assert!(close(t.at(DVec2::new(0.75, 0.75)), Color::Y));
-        assert!(close(t.at(DVec2::new(0.25, 0.25)), Color::Z));
+        assert!(close(t.at(DVec2::new(0.25, 0.75)), Color::RED));
+        assert!(close(t.at(DVec2::new(0.75, 0.75)), Color::GREEN));
+        assert!(close(t.at(DVec2::new(0.25, 0.25)), Color::BLUE));
         assert!(close(t.at(DVec2::new(0.75, 0.25)), Color::ONE));
     }
 
@@ -212,7 +214,7 @@ mod tests {
     #[test]
     fn repeat_tiles_and_blends_across_the_edge() {
         let t = two_by_two(Wrap::Repeat);
-        assert!(close(t.at(DVec2::new(1.25, -0.75)), Color::Z));
+        assert!(close(t.at(DVec2::new(1.25, -0.75)), Color::BLUE));
         // At u = 0 the left and right columns of the top row meet.
         assert!(close(
             t.at(DVec2::new(0.0, 0.75)),
@@ -223,8 +225,8 @@ mod tests {
     #[test]
     fn clamp_extends_the_edge_texels() {
         let t = two_by_two(Wrap::Clamp);
-        assert!(close(t.at(DVec2::new(0.0, 0.75)), Color::X));
-        assert!(close(t.at(DVec2::new(-3.0, 0.75)), Color::X));
+        assert!(close(t.at(DVec2::new(0.0, 0.75)), Color::RED));
+        assert!(close(t.at(DVec2::new(-3.0, 0.75)), Color::RED));
         assert!(close(t.at(DVec2::new(7.0, -2.0)), Color::ONE));
     }
 
@@ -232,10 +234,10 @@ mod tests {
     fn mirror_reflects_every_other_copy() {
         let t = two_by_two(Wrap::Mirror);
         // Just right of u = 1 is the mirrored copy: green first.
-        assert!(close(t.at(DVec2::new(1.25, 0.75)), Color::Y));
-        assert!(close(t.at(DVec2::new(1.75, 0.75)), Color::X));
-        assert!(close(t.at(DVec2::new(2.25, 0.75)), Color::X));
-        assert!(close(t.at(DVec2::new(1.0, 0.75)), Color::Y));
+        assert!(close(t.at(DVec2::new(1.25, 0.75)), Color::GREEN));
+        assert!(close(t.at(DVec2::new(1.75, 0.75)), Color::RED));
+        assert!(close(t.at(DVec2::new(2.25, 0.75)), Color::RED));
+        assert!(close(t.at(DVec2::new(1.0, 0.75)), Color::GREEN));
     }
 
     #[test]
@@ -246,7 +248,7 @@ mod tests {
             ..two_by_two(Wrap::Repeat)
         };
         // (0.125, 0.375) · 2 + (0.5, 0) = (0.75, 0.75): green.
-        assert!(close(t.at(DVec2::new(0.125, 0.375)), Color::Y));
+        assert!(close(t.at(DVec2::new(0.125, 0.375)), Color::GREEN));
     }
 
     #[test]

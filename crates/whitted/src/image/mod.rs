@@ -10,7 +10,11 @@
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use crate::color_space::ColorSpace;
+mod color_space;
+mod heat_map;
+
+pub use color_space::{ColorSpace, encode_display8, encode_srgb8};
+pub use heat_map::{heat_map, ramp};
 
 /// A `width` × `height` grid of pixels with `channels` float values each,
 /// row 0 at the top, and what its values mean.

@@ -1,0 +1,121 @@
+//! Integrators: what colour arrives along a camera ray. The renderer calls
+//! one through the closed enum [`Integrator`], so a new algorithm (photon
+//! mapping, a reference path tracer) is one more variant beside
+//! [`Whitted`], dispatched by `match`.
+//!
+//! An integrator traces in a prepared [`World`] and shades with what the
+//! scene says of light and surfaces ([`Shading`]). It counts the rays it
+//! traces by kind ([`RayCounts`]); [`Integrator::ray_kinds`] says which
+//! kinds it can trace.
+
+mod ray_counts;
+mod whitted;
+
+pub use ray_counts::{RayCounts, RayKind};
+pub use whitted::{Whitted, WhittedLimits};
+
+use crate::accel::TraversalCounters;
+use crate::math::Ray;
+use crate::shading::{Color, Light, Material};
+use crate::world::{Hit, Surface, World};
+
+/// What the scene says of light and surfaces, borrowed for shading.
+#[derive(Clone, Copy, Debug)]
+pub struct Shading<'a> {
+    /// Materials, indexed by [`crate::world::MaterialId`].
+    pub materials: &'a [Material],
+    /// Light sources.
+    pub lights: &'a [Light],
+    /// Colour of rays that hit nothing.
+    pub background: Color,
+    /// Global ambient light `Ia`.
+    pub ambient: Color,
+}
+
+/// Which integrator to use.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum IntegratorKind {
+    /// Whitted's recursive ray tracing ([`Whitted`]).
+    #[default]
+    Whitted,
+}
+
+impl IntegratorKind {
+    /// Every kind.
+    pub const ALL: [IntegratorKind; 1] = [IntegratorKind::Whitted];
+
+    /// The name used on the command line and in scene files.
+    pub fn name(&self) -> &'static str {
+        match self {
+            IntegratorKind::Whitted => "whitted",
+        }
+    }
+}
+
+/// The result of tracing one camera ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PrimarySample {
+    /// The colour seen.
+    pub color: Color,
+    /// The first hit, if any, with its world-space surface.
+    pub first_hit: Option<(Hit, Surface)>,
+}
+
+/// An integrator ready to trace: the closed set of algorithms.
+#[derive(Debug)]
+pub enum Integrator<'a> {
+    /// Whitted's recursive ray tracing.
+    Whitted(Whitted<'a>),
+}
+
+impl<'a> Integrator<'a> {
+    /// Prepares an integrator of `kind` over `world`, shading with
+    /// `shading`, within `limits`.
+    pub fn new(
+        kind: IntegratorKind,
+        world: &'a World<'a>,
+        shading: Shading<'a>,
+        limits: WhittedLimits,
+    ) -> Self {
+        match kind {
+            IntegratorKind::Whitted => Integrator::Whitted(Whitted::new(world, shading, limits)),
+        }
+    }
+
+    /// The world it traces in.
+    pub fn world(&self) -> &'a World<'a> {
+        match self {
+            Integrator::Whitted(w) => w.world(),
+        }
+    }
+
+    /// The kinds of rays it traces, in report order.
+    pub fn ray_kinds(&self) -> &'static [RayKind] {
+        match self {
+            Integrator::Whitted(_) => Whitted::RAY_KINDS,
+        }
+    }
+
+    /// The colour seen along a camera ray (unit direction) and its first
+    /// hit; the rays traced are added to `counts`.
+    #[inline]
+    pub fn trace_primary(&self, ray: &Ray, counts: &mut RayCounts) -> PrimarySample {
+        match self {
+            Integrator::Whitted(w) => w.trace_primary(ray, counts),
+        }
+    }
+
+    /// The first hit along a ray and its surface, without shading.
+    pub fn first_hit(&self, ray: &Ray) -> Option<(Hit, Surface)> {
+        let world = self.world();
+        let hit = world.intersect(ray)?;
+        Some((hit, world.surface(ray, &hit)))
+    }
+
+    /// The traversal work of the closest-hit query for `ray`.
+    pub fn traversal_cost(&self, ray: &Ray) -> TraversalCounters {
+        let mut counters = TraversalCounters::default();
+        self.world().intersect_counted(ray, &mut counters);
+        counters
+    }
+}

@@ -1,0 +1,265 @@
+//! The recursive Whitted integrator.
+//!
+//! For the closest hit of a ray it sums emission, ambient, direct light from
+//! every light (Phong diffuse and specular, each light seen through one
+//! shadow ray), and the mirror-reflected and refracted rays, recursively.
+//! See [`crate::shading::material`] for the formula and the Fresnel option.
+//!
+//! - Shading is two-sided: the normal is turned to face the incoming ray.
+//!   A material's bump or normal map tilts it (see [`crate::shading::bump`]); a
+//!   light behind the geometric surface then lights nothing.
+//! - Shadow rays pass through transmissive and dissolved surfaces, each
+//!   crossing scaling the light by what that surface lets through
+//!   (`α kt + 1 - α`); an opaque surface blocks it.
+//! - Refraction follows Snell's law with the index of the medium the ray is
+//!   in, tracked on a small stack of the media it has entered; total
+//!   internal reflection moves the refracted weight onto the reflected ray.
+//! - Recursion stops at `max_depth`, and earlier when a branch's weight on
+//!   the pixel falls below `min_weight` (adaptive depth control).
+
+use crate::integrator::{PrimarySample, RayCounts, RayKind, Shading};
+use crate::math::{Ray, Vec3, offset_ray_origin};
+use crate::shading::optics::{reflect, refract, schlick_reflectance};
+use crate::shading::{Color, Crossing, Light, Material, MediumStack, shading_normal};
+use crate::world::{Surface, World};
+
+/// Longest chain of transmissive surfaces one shadow ray passes through.
+const MAX_SHADOW_CROSSINGS: usize = 64;
+
+/// How deep the recursion may go.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WhittedLimits {
+    /// Deepest reflection/refraction recursion; 0 traces primary rays only.
+    pub max_depth: u32,
+    /// A branch whose weight on the pixel falls below this stops early
+    /// (adaptive depth control, Hall and Greenberg 1983).
+    pub min_weight: f64,
+}
+
+/// Whitted's recursive ray tracer over a prepared world.
+#[derive(Debug)]
+pub struct Whitted<'a> {
+    world: &'a World<'a>,
+    shading: Shading<'a>,
+    limits: WhittedLimits,
+    any_transmissive: bool,
+}
+
+impl<'a> Whitted<'a> {
+    /// The kinds of rays it traces.
+    pub const RAY_KINDS: &'static [RayKind] = &RayKind::ALL;
+
+    /// Prepares to trace in `world`, shading with `shading`, within
+    /// `limits`.
+    pub fn new(world: &'a World<'a>, shading: Shading<'a>, limits: WhittedLimits) -> Self {
+        Self {
+            world,
+            shading,
+            limits,
+            any_transmissive: shading.materials.iter().any(Material::is_transmissive),
+        }
+    }
+
+    /// The world it traces in.
+    pub fn world(&self) -> &'a World<'a> {
+        self.world
+    }
+
+    /// The colour seen along a camera ray (unit direction), and its first hit.
+    pub fn trace_primary(&self, ray: &Ray, counts: &mut RayCounts) -> PrimarySample {
+        counts[RayKind::Primary] += 1;
+        match self.world.intersect(ray) {
+            None => PrimarySample {
+                color: self.shading.background,
+                first_hit: None,
+            },
+            Some(hit) => {
+                let surface = self.world.surface(ray, &hit);
+                let color = self.shade(ray, &surface, 0, 1.0, MediumStack::default(), counts);
+                PrimarySample {
+                    color,
+                    first_hit: Some((hit, surface)),
+                }
+            }
+        }
+    }
+
+    /// The colour seen along a secondary ray (unit direction).
+    fn trace(
+        &self,
+        ray: &Ray,
+        depth: u32,
+        weight: f64,
+        media: MediumStack,
+        counts: &mut RayCounts,
+    ) -> Color {
+        match self.world.intersect(ray) {
+            None => self.shading.background,
+            Some(hit) => {
+                let surface = self.world.surface(ray, &hit);
+                self.shade(ray, &surface, depth, weight, media, counts)
+            }
+        }
+    }
+
+    /// The colour leaving `s` back along `ray`. `weight` is the largest
+    /// factor by which this colour reaches the pixel.
+    fn shade(
+        &self,
+        ray: &Ray,
+        s: &Surface,
+        depth: u32,
+        weight: f64,
+        media: MediumStack,
+        counts: &mut RayCounts,
+    ) -> Color {
+        let m = &self.shading.materials[s.material.0 as usize];
+        let incident = ray.dir;
+        let view = -incident;
+        let entering = incident.dot(s.normal) < 0.0;
+        let facing = if entering { s.normal } else { -s.normal };
+        // The shading normal (interpolated on meshes, tilted by a bump or
+        // normal map) on the viewer's side.
+        let n = shading_normal(m.bump.as_ref(), s, facing, view);
+        // A tilted normal may see a light that is behind the surface itself.
+        let bumped = m.bump.is_some();
+
+        // The opacity weighs the surface's own light and mirror; the
+        // dissolved rest joins the transmitted ray.
+        let alpha = m.opacity.at(s.uv);
+        let mut local = m.emission.at(s.uv) + m.ambient.at(s.uv) * self.shading.ambient;
+
+        let diffuse = m.diffuse.at(s.uv);
+        let specular = m.specular.at(s.uv);
+        if alpha != Color::ZERO && (diffuse != Color::ZERO || specular != Color::ZERO) {
+            for light in self.shading.lights {
+                let Some(sample) = light.sample(s.point) else {
+                    continue;
+                };
+                let n_dot_l = n.dot(sample.to_light);
+                if n_dot_l <= 0.0 || (bumped && facing.dot(sample.to_light) <= 0.0) {
+                    continue;
+                }
+                let shadow = self.transmittance(s, light, sample.to_light, sample.distance, counts);
+                if shadow == Color::ZERO {
+                    continue;
+                }
+                let mut direct = diffuse * n_dot_l;
+                let r_dot_v = reflect(-sample.to_light, n).dot(view);
+                if r_dot_v > 0.0 && specular != Color::ZERO {
+                    direct += specular * r_dot_v.powf(m.shininess);
+                }
+                local += shadow * sample.intensity * direct;
+            }
+        }
+        let mut color = alpha * local;
+
+        if depth >= self.limits.max_depth {
+            return color;
+        }
+        let kr = m.reflection.at(s.uv);
+        let kt = m.transmission.at(s.uv);
+        if kr == Color::ZERO && kt == Color::ZERO && alpha == Color::ONE {
+            return color;
+        }
+
+        let Crossing {
+            n_from,
+            n_to,
+            after: inside_after,
+        } = media.cross(s.material, m.ior, entering);
+        let cos_i = view.dot(n).clamp(0.0, 1.0);
+        let (reflected, transmitted) = if m.fresnel && kt != Color::ZERO {
+            let f = schlick_reflectance(cos_i, n_from, n_to);
+            (kr + kt * f, kt * (1.0 - f))
+        } else {
+            (kr, kt)
+        };
+        let mut reflected_weight = alpha * reflected;
+        let mut transmitted_weight = alpha * transmitted + (Color::ONE - alpha);
+        let refracted = if transmitted_weight == Color::ZERO {
+            None
+        } else {
+            refract(incident, n, n_from / n_to)
+        };
+        if refracted.is_none() {
+            reflected_weight += transmitted_weight;
+            transmitted_weight = Color::ZERO;
+        }
+
+        let child = weight * reflected_weight.max_element();
+        if child >= self.limits.min_weight && reflected_weight != Color::ZERO {
+            counts[RayKind::Reflected] += 1;
+            let dir = reflect(incident, n);
+            let origin = offset_ray_origin(s.point, s.point_error, s.normal, dir);
+            let c = self.trace(&Ray::new(origin, dir), depth + 1, child, media, counts);
+            color += reflected_weight * c;
+        }
+        if let Some(dir) = refracted {
+            let child = weight * transmitted_weight.max_element();
+            if child >= self.limits.min_weight {
+                counts[RayKind::Refracted] += 1;
+                let dir = dir.normalize();
+                let origin = offset_ray_origin(s.point, s.point_error, s.normal, dir);
+                let c = self.trace(
+                    &Ray::new(origin, dir),
+                    depth + 1,
+                    child,
+                    inside_after,
+                    counts,
+                );
+                color += transmitted_weight * c;
+            }
+        }
+        color
+    }
+
+    /// How much of `light` reaches `s` along `to_light` (unit) over
+    /// `distance`: 0 behind an opaque surface, the product of what every
+    /// transmissive or dissolved surface crossed lets through otherwise
+    /// ([`Material::pass_through`]).
+    fn transmittance(
+        &self,
+        s: &Surface,
+        light: &Light,
+        to_light: Vec3,
+        distance: f64,
+        counts: &mut RayCounts,
+    ) -> Color {
+        counts[RayKind::Shadow] += 1;
+        let origin = offset_ray_origin(s.point, s.point_error, s.normal, to_light);
+        let target = match light {
+            Light::Directional { .. } => None,
+            Light::Point { position, .. } | Light::Spot { position, .. } => Some(*position),
+        };
+        let segment = |origin: Vec3| {
+            let t_max = target.map_or(distance, |p| (p - origin).dot(to_light));
+            Ray::segment(origin, to_light, t_max)
+        };
+        let mut ray = segment(origin);
+        if !self.any_transmissive {
+            return if self.world.occluded(&ray) {
+                Color::ZERO
+            } else {
+                Color::ONE
+            };
+        }
+        let mut through = Color::ONE;
+        for _ in 0..MAX_SHADOW_CROSSINGS {
+            let Some(hit) = self.world.intersect(&ray) else {
+                return through;
+            };
+            let blocker = self.world.surface(&ray, &hit);
+            let m = &self.shading.materials[blocker.material.0 as usize];
+            through *= m.pass_through(blocker.uv);
+            if through.max_element() <= 0.0 {
+                return Color::ZERO;
+            }
+            counts[RayKind::Shadow] += 1;
+            let origin =
+                offset_ray_origin(blocker.point, blocker.point_error, blocker.normal, to_light);
+            ray = segment(origin);
+        }
+        Color::ZERO
+    }
+}

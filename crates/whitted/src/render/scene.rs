@@ -1,0 +1,73 @@
+//! The scene: everything needed to render one picture, whatever file format
+//! it came from. Every reader (the `scene` module) produces a [`Scene`]; the
+//! renderer only ever sees this.
+
+use crate::image::ColorSpace;
+use crate::math::Transform;
+use crate::mesh::TriangleMesh;
+use crate::render::{Camera, RenderSettings};
+use crate::shading::{Color, Light, Material};
+use crate::shape::Shape;
+use crate::world::{MaterialId, MeshId, Objects};
+
+/// Everything needed to render one picture.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// The viewpoint.
+    pub camera: Camera,
+    /// Image size and quality.
+    pub settings: RenderSettings,
+    /// Colour of rays that hit nothing.
+    pub background: Color,
+    /// Global ambient light `Ia`.
+    pub ambient: Color,
+    /// What the colour values of the scene (and so of its picture) mean:
+    /// linear light, or display values (NFF).
+    pub color_space: ColorSpace,
+    /// Materials, indexed by [`MaterialId`].
+    pub materials: Vec<Material>,
+    /// Light sources.
+    pub lights: Vec<Light>,
+    /// The shapes and meshes placed in the world.
+    pub objects: Objects,
+}
+
+impl Scene {
+    /// An empty scene seen by `camera`, with default settings, a black
+    /// background, no ambient light and linear colours.
+    pub fn new(camera: Camera) -> Self {
+        Self {
+            camera,
+            settings: RenderSettings::default(),
+            background: Color::ZERO,
+            ambient: Color::ZERO,
+            color_space: ColorSpace::Linear,
+            materials: Vec::new(),
+            lights: Vec::new(),
+            objects: Objects::default(),
+        }
+    }
+
+    /// Adds a material and returns its id.
+    pub fn add_material(&mut self, material: Material) -> MaterialId {
+        self.materials.push(material);
+        MaterialId((self.materials.len() - 1) as u32)
+    }
+
+    /// Adds a shape with a material and an object-to-world transform
+    /// ([`Objects::add_primitive`]).
+    pub fn add_primitive(&mut self, shape: Shape, material: MaterialId, transform: Transform) {
+        self.objects.add_primitive(shape, material, transform);
+    }
+
+    /// Adds a mesh and returns its id ([`Objects::add_mesh`]).
+    pub fn add_mesh(&mut self, mesh: TriangleMesh) -> MeshId {
+        self.objects.add_mesh(mesh)
+    }
+
+    /// Places a mesh with a material and a transform
+    /// ([`Objects::add_mesh_instance`]).
+    pub fn add_mesh_instance(&mut self, mesh: MeshId, material: MaterialId, transform: Transform) {
+        self.objects.add_mesh_instance(mesh, material, transform);
+    }
+}

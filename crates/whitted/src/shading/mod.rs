@@ -1,0 +1,20 @@
+//! How surfaces and lights look: colours, materials (Phong coefficients,
+//! mirror and glass, with textures, bump and normal maps), light sources,
+//! and the optics of smooth surfaces (reflection, refraction, Fresnel) with
+//! the media a refracted ray is inside.
+
+pub mod bump;
+mod color;
+pub mod light;
+pub mod material;
+pub mod medium;
+pub mod optics;
+pub mod tangent_frame;
+pub mod texture;
+
+pub use bump::{Bump, shading_normal};
+pub use color::Color;
+pub use light::{Attenuation, Light, LightSample};
+pub use material::Material;
+pub use medium::{Crossing, MediumStack};
+pub use texture::Texture;

@@ -1,0 +1,60 @@
+//! What a query reports: the small record kept during traversal ([`Hit`])
+//! and the full world-space surface computed once for the final hit
+//! ([`Surface`]).
+
+use crate::math::{DVec2, Vec3};
+use crate::shape::{LocalSurface, ShapeHit};
+use crate::world::MaterialId;
+
+/// The closest hit found by [`crate::world::World::intersect`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// The primitive's number in the whole scene (see the module doc).
+    pub primitive: u32,
+    /// What the shape recorded (its `t` is the ray parameter).
+    pub shape_hit: ShapeHit,
+}
+
+impl Hit {
+    /// The ray parameter of the hit.
+    pub fn t(&self) -> f64 {
+        self.shape_hit.t
+    }
+}
+
+/// The surface at a hit, in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Surface {
+    /// The hit point.
+    pub point: Vec3,
+    /// Absolute bound on the error of `point`, per axis.
+    pub point_error: Vec3,
+    /// Unit geometric normal, outward (not yet turned towards the ray).
+    pub normal: Vec3,
+    /// Unit normal for shading: the geometric one, or the one interpolated
+    /// from a mesh's vertex normals.
+    pub shading_normal: Vec3,
+    /// Texture coordinates.
+    pub uv: DVec2,
+    /// Derivative of the point along u (a tangent; not normalised).
+    pub dpdu: Vec3,
+    /// Derivative of the point along v (a tangent; not normalised).
+    pub dpdv: Vec3,
+    /// The surface's material.
+    pub material: MaterialId,
+}
+
+impl Surface {
+    pub(crate) fn from_local(s: LocalSurface, shading_normal: Vec3, material: MaterialId) -> Self {
+        Self {
+            point: s.point,
+            point_error: s.point_error,
+            normal: s.normal,
+            shading_normal,
+            uv: s.uv,
+            dpdu: s.dpdu,
+            dpdv: s.dpdv,
+            material,
+        }
+    }
+}
