@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use clap::Args;
 use serde_json::{Value, json};
-use whitted::accel::{AccelKind, AccelStats};
+use whitted::accel::{AccelKind, AccelStats, AccelerationStructure};
 use whitted::bench::obj_positions::load_obj_positions;
 use whitted::bench::ray_files::{RayFile, agreement, read_ray_file};
 use whitted::bench::{RayKind, RaySet, TraceResults, scene_ray_sets, time_set, trace_all};

@@ -8,7 +8,7 @@
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use whitted::accel::{AccelKind, Accelerator, TraversalCounters};
+use whitted::accel::{AccelKind, AccelerationStructure, Accelerator, QueryContext};
 use whitted::math::random::Rng;
 use whitted::math::{Aabb, Ray, Vec3};
 use whitted::mesh::TriangleMesh;
@@ -94,12 +94,12 @@ fn traverse(c: &mut Criterion) {
         let accel = Accelerator::build(kind, &boxes);
         group.bench_function(BenchmarkId::new(kind.name(), mesh.len()), |b| {
             b.iter(|| {
-                let mut counters = TraversalCounters::default();
+                let mut ctx = QueryContext::default();
                 let mut hits = 0usize;
                 for ray in &rays {
                     let shear = RayShear::new(ray);
                     let mut local = *ray;
-                    let t = accel.intersect(ray, &mut counters, |i, t_max| {
+                    let t = accel.intersect(ray, &mut ctx, |i, t_max| {
                         local.t_max = t_max;
                         mesh.intersect(i, &local, &shear).map(|h| h.t)
                     });

@@ -92,7 +92,10 @@ fn violations() -> Vec<String> {
         let first = relative.components().next().unwrap();
         let module = first.as_os_str().to_str().unwrap().trim_end_matches(".rs");
         let Some(mine) = layer_of(module) else {
-            found.push(format!("{}: module `{module}` is in no layer", relative.display()));
+            found.push(format!(
+                "{}: module `{module}` is in no layer",
+                relative.display()
+            ));
             continue;
         };
         let only = ONLY.iter().find(|(m, _)| *m == module).map(|(_, o)| *o);

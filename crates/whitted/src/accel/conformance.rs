@@ -7,7 +7,7 @@
 //!
 //! A structure's tests call [`assert_conforms`] with its [`AccelKind`].
 
-use super::{AccelKind, Accelerator, TraversalCounters};
+use super::{AccelKind, AccelerationStructure, Accelerator, QueryContext, RayCoherence};
 use crate::math::random::Rng;
 use crate::math::{Aabb, Ray, Vec3};
 use crate::shape::{AxisBox, Shape, Sphere, Triangle};
@@ -217,10 +217,15 @@ fn rays(bounds: &Aabb, boxes: &[Aabb], rng: &mut Rng) -> Vec<Ray> {
 }
 
 /// Closest hit through a structure: (t, primitive).
-fn closest(accel: &Accelerator, prims: &[TestPrimitive], ray: &Ray) -> Option<(f64, u32)> {
+fn closest(
+    accel: &Accelerator,
+    prims: &[TestPrimitive],
+    ray: &Ray,
+    coherence: RayCoherence,
+) -> Option<(f64, u32)> {
     let mut best = None;
-    let mut counters = TraversalCounters::default();
-    let t = accel.intersect(ray, &mut counters, |i, t_max| {
+    let mut ctx = QueryContext::new(coherence);
+    let t = accel.intersect(ray, &mut ctx, |i, t_max| {
         let mut r = *ray;
         r.t_max = t_max;
         let t = prims[i as usize].intersect(&r)?;
@@ -230,8 +235,17 @@ fn closest(accel: &Accelerator, prims: &[TestPrimitive], ray: &Ray) -> Option<(f
     t.zip(best)
 }
 
-/// Builds `kind` over every test scene and checks it against brute force.
+/// Builds `kind` over every test scene and checks it against brute force,
+/// with the rays said to be coherent and then incoherent (the hint may
+/// change how a structure walks, never its answer).
 pub(crate) fn assert_conforms(kind: AccelKind) {
+    for coherence in [RayCoherence::Coherent, RayCoherence::Incoherent] {
+        assert_conforms_with(kind, coherence);
+    }
+}
+
+/// [`assert_conforms`] with one hint.
+fn assert_conforms_with(kind: AccelKind, coherence: RayCoherence) {
     let mut rng = Rng::new(7);
     for (name, prims) in scenes() {
         let boxes: Vec<Aabb> = prims.iter().map(TestPrimitive::bounds).collect();
@@ -242,8 +256,8 @@ pub(crate) fn assert_conforms(kind: AccelKind) {
             panic!("{} on {name}: invalid structure: {why}", kind.name());
         }
         for ray in rays(&bounds, &boxes, &mut rng) {
-            let expected = closest(&oracle, &prims, &ray);
-            let actual = closest(&accel, &prims, &ray);
+            let expected = closest(&oracle, &prims, &ray, coherence);
+            let actual = closest(&accel, &prims, &ray, coherence);
             match (expected, actual) {
                 (None, None) => {}
                 (Some((te, pe)), Some((ta, pa))) if te == ta => {
@@ -265,8 +279,8 @@ pub(crate) fn assert_conforms(kind: AccelKind) {
                     kind.name()
                 ),
             }
-            let mut counters = TraversalCounters::default();
-            let occluded = accel.occluded(&ray, &mut counters, |i| {
+            let mut ctx = QueryContext::new(coherence);
+            let occluded = accel.occluded(&ray, &mut ctx, |i| {
                 prims[i as usize].intersect(&ray).is_some()
             });
             assert_eq!(

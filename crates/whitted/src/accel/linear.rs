@@ -1,7 +1,7 @@
 //! Brute force: every primitive tested against every ray. The reference that
 //! every faster structure is checked against.
 
-use super::{AccelStats, TraversalCounters};
+use super::{AccelStats, QueryContext};
 use crate::math::{Aabb, Ray};
 
 /// Tests every primitive whose box the ray meets, in index order.
@@ -33,9 +33,10 @@ impl Linear {
     pub fn intersect(
         &self,
         ray: &Ray,
-        counters: &mut TraversalCounters,
+        ctx: &mut QueryContext,
         mut hit: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<f64> {
+        let counters = &mut ctx.counters;
         let mut closest = None;
         let mut clipped = *ray;
         for (i, b) in self.bounds.iter().enumerate() {
@@ -57,9 +58,10 @@ impl Linear {
     pub fn occluded(
         &self,
         ray: &Ray,
-        counters: &mut TraversalCounters,
+        ctx: &mut QueryContext,
         mut occludes: impl FnMut(u32) -> bool,
     ) -> bool {
+        let counters = &mut ctx.counters;
         self.bounds.iter().enumerate().any(|(i, b)| {
             counters.nodes += 1;
             if b.intersect_ray(ray).is_none() {

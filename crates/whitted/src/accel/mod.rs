@@ -7,20 +7,16 @@
 //! structure: the world (the `world` module, a layer above) tests them in
 //! a short list beside it.
 //!
-//! Every structure offers the same inherent methods, dispatched by
-//! [`Accelerator`]:
-//! - `intersect(ray, counters, hit)`: the closest hit. `hit(i, t_max)`
-//!   intersects primitive `i` and returns the parameter of a hit closer than
-//!   `t_max`, if any; the structure returns the closest parameter found.
-//! - `occluded(ray, counters, occludes)`: any hit; stops at the first
-//!   primitive for which `occludes(i)` holds.
-//! - `validate(boxes)`: checks the built structure's invariants.
-//! - `stats()`: its size and quality.
+//! Every structure implements [`AccelerationStructure`]: the closest hit
+//! (`intersect`), any hit (`occluded`), both also a leaf at a time for
+//! callers that keep primitive data in leaf order, `validate` and `stats`.
+//! [`Accelerator`] is the enum over the four, dispatched by `match`.
 //!
-//! A caller may say how the rays it traces on a thread relate
-//! ([`with_ray_coherence`]); a structure may pick how it walks by it, never
-//! the closest `t` it returns (on an exact tie, which primitive may
-//! change, as between structures).
+//! Every query takes a [`QueryContext`]: the caller says there how its
+//! rays relate ([`RayCoherence`]), and the structure adds the work it did.
+//! A structure may pick how it walks by the hint, never the closest `t` it
+//! returns (on an exact tie, which primitive may change, as between
+//! structures).
 //!
 //! Culling must be conservative: a structure may skip a primitive only when
 //! the ray provably cannot meet its box within the interval, so every
@@ -28,7 +24,7 @@
 //! returns (ties at equal `t` may pick either primitive).
 
 pub mod bvh;
-mod coherence;
+mod context;
 pub mod grid;
 pub mod kdtree;
 pub mod linear;
@@ -39,30 +35,13 @@ mod stack;
 pub(crate) mod conformance;
 
 pub use bvh::{Bvh, BvhBuildParams};
-pub use coherence::{RayCoherence, current_ray_coherence, with_ray_coherence};
+pub use context::{QueryContext, RayCoherence, TraversalCounters};
 pub use grid::{Grid, GridBuildParams};
 pub use kdtree::{Clipper, KdTree, KdTreeBuildParams};
 pub use linear::Linear;
 
 use crate::math::{Aabb, Ray};
 use std::ops::Range;
-
-/// Work done for one or more rays: what the cost AOV and `whitted bench`
-/// report.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct TraversalCounters {
-    /// Interior nodes, leaves or cells visited.
-    pub nodes: u64,
-    /// Primitive intersection tests made.
-    pub primitives: u64,
-}
-
-impl std::ops::AddAssign for TraversalCounters {
-    fn add_assign(&mut self, o: Self) {
-        self.nodes += o.nodes;
-        self.primitives += o.primitives;
-    }
-}
 
 /// Size and quality of a built structure.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -121,6 +100,137 @@ impl AccelKind {
     }
 }
 
+/// What every acceleration structure offers, checked by the compiler;
+/// [`Accelerator`] dispatches to the four by `match`. Positions in
+/// [`Self::leaf_order`] are what the leaf-order queries hand out.
+pub trait AccelerationStructure {
+    /// The closest hit: `hit(i, t_max)` intersects primitive `i` and returns
+    /// the parameter of a hit closer than `t_max`, if any; the structure
+    /// returns the closest parameter found.
+    fn intersect(
+        &self,
+        ray: &Ray,
+        ctx: &mut QueryContext,
+        hit: impl FnMut(u32, f64) -> Option<f64>,
+    ) -> Option<f64>;
+
+    /// Any hit: stops at the first primitive for which `occludes(i)` holds.
+    fn occluded(
+        &self,
+        ray: &Ray,
+        ctx: &mut QueryContext,
+        occludes: impl FnMut(u32) -> bool,
+    ) -> bool;
+
+    /// The primitive numbers that the positions handed out by the
+    /// leaf-order queries stand for, each leaf's together; `None` when the
+    /// positions are the primitive numbers themselves.
+    fn leaf_order(&self) -> Option<&[u32]> {
+        None
+    }
+
+    /// The closest hit, with `hit` given a whole leaf at a time: a range of
+    /// positions (see [`Self::leaf_order`]) and the closest hit so far; it
+    /// returns the closest hit among them nearer than that. By default
+    /// each primitive comes as a leaf of its own.
+    fn intersect_in_leaf_order(
+        &self,
+        ray: &Ray,
+        ctx: &mut QueryContext,
+        mut hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
+    ) -> Option<f64> {
+        self.intersect(ray, ctx, |p, t_max| hit(p..p + 1, t_max))
+    }
+
+    /// Any hit, with `occludes` given a whole leaf at a time as for
+    /// [`Self::intersect_in_leaf_order`]; it says whether any of them lies
+    /// in the ray's interval.
+    fn occluded_in_leaf_order(
+        &self,
+        ray: &Ray,
+        ctx: &mut QueryContext,
+        mut occludes: impl FnMut(Range<u32>) -> bool,
+    ) -> bool {
+        self.occluded(ray, ctx, |p| occludes(p..p + 1))
+    }
+
+    /// Checks the structure's invariants against the boxes it was built
+    /// from: every primitive reachable, children inside parents, depth
+    /// within the traversal stack.
+    fn validate(&self, boxes: &[Aabb]) -> Result<(), String>;
+
+    /// Size and quality.
+    fn stats(&self) -> AccelStats;
+}
+
+/// Implements [`AccelerationStructure`] for a structure by its inherent
+/// methods of the same names; `leaf order` names the structures whose
+/// leaf-order queries are their own.
+macro_rules! structure_by_inherent_methods {
+    ($structure:ty $(, leaf order: $indices:ident)?) => {
+        impl AccelerationStructure for $structure {
+            #[inline(always)]
+            fn intersect(
+                &self,
+                ray: &Ray,
+                ctx: &mut QueryContext,
+                hit: impl FnMut(u32, f64) -> Option<f64>,
+            ) -> Option<f64> {
+                <$structure>::intersect(self, ray, ctx, hit)
+            }
+
+            #[inline(always)]
+            fn occluded(
+                &self,
+                ray: &Ray,
+                ctx: &mut QueryContext,
+                occludes: impl FnMut(u32) -> bool,
+            ) -> bool {
+                <$structure>::occluded(self, ray, ctx, occludes)
+            }
+
+            $(
+            fn leaf_order(&self) -> Option<&[u32]> {
+                Some(self.$indices())
+            }
+
+            #[inline(always)]
+            fn intersect_in_leaf_order(
+                &self,
+                ray: &Ray,
+                ctx: &mut QueryContext,
+                hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
+            ) -> Option<f64> {
+                <$structure>::intersect_in_leaf_order(self, ray, ctx, hit)
+            }
+
+            #[inline(always)]
+            fn occluded_in_leaf_order(
+                &self,
+                ray: &Ray,
+                ctx: &mut QueryContext,
+                occludes: impl FnMut(Range<u32>) -> bool,
+            ) -> bool {
+                <$structure>::occluded_in_leaf_order(self, ray, ctx, occludes)
+            }
+            )?
+
+            fn validate(&self, boxes: &[Aabb]) -> Result<(), String> {
+                <$structure>::validate(self, boxes)
+            }
+
+            fn stats(&self) -> AccelStats {
+                <$structure>::stats(self)
+            }
+        }
+    };
+}
+
+structure_by_inherent_methods!(Bvh, leaf order: indices);
+structure_by_inherent_methods!(KdTree, leaf order: indices);
+structure_by_inherent_methods!(Grid);
+structure_by_inherent_methods!(Linear);
+
 /// A built acceleration structure of any kind.
 #[derive(Clone, Debug)]
 pub enum Accelerator {
@@ -134,28 +244,29 @@ pub enum Accelerator {
     KdTree(KdTree),
 }
 
+/// Calls `$call` on the structure inside an [`Accelerator`], whatever its
+/// kind.
+macro_rules! each_structure {
+    ($accel:expr, $s:ident => $call:expr) => {
+        match $accel {
+            Accelerator::Bvh($s) => $call,
+            Accelerator::Linear($s) => $call,
+            Accelerator::Grid($s) => $call,
+            Accelerator::KdTree($s) => $call,
+        }
+    };
+}
+
 impl Accelerator {
-    /// Builds a structure of `kind` over primitives `0..boxes.len()`.
+    /// Builds a structure of `kind` over primitives `0..boxes.len()`. (A
+    /// kd-tree that should clip straddling primitives to its cells is built
+    /// with [`KdTree::build_clipped`].)
     pub fn build(kind: AccelKind, boxes: &[Aabb]) -> Self {
         match kind {
             AccelKind::Bvh => Accelerator::Bvh(Bvh::build(boxes)),
             AccelKind::Linear => Accelerator::Linear(Linear::build(boxes)),
             AccelKind::Grid => Accelerator::Grid(Grid::build(boxes)),
             AccelKind::KdTree => Accelerator::KdTree(KdTree::build(boxes)),
-        }
-    }
-
-    /// Builds a structure of `kind` over primitives `0..boxes.len()`; a
-    /// kd-tree clips its straddling primitives to the cells with `clip`
-    /// ([`KdTree::build_clipped`]), the other structures ignore it.
-    pub fn build_clipped(kind: AccelKind, boxes: &[Aabb], clip: Clipper) -> Self {
-        match kind {
-            AccelKind::KdTree => Accelerator::KdTree(KdTree::build_clipped(
-                boxes,
-                &KdTreeBuildParams::default(),
-                clip,
-            )),
-            _ => Self::build(kind, boxes),
         }
     }
 
@@ -168,110 +279,58 @@ impl Accelerator {
             Accelerator::KdTree(_) => AccelKind::KdTree,
         }
     }
+}
 
-    /// The closest hit; see the module documentation.
+impl AccelerationStructure for Accelerator {
     #[inline]
-    pub fn intersect(
+    fn intersect(
         &self,
         ray: &Ray,
-        counters: &mut TraversalCounters,
+        ctx: &mut QueryContext,
         hit: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<f64> {
-        match self {
-            Accelerator::Bvh(s) => s.intersect(ray, counters, hit),
-            Accelerator::Linear(s) => s.intersect(ray, counters, hit),
-            Accelerator::Grid(s) => s.intersect(ray, counters, hit),
-            Accelerator::KdTree(s) => s.intersect(ray, counters, hit),
-        }
+        each_structure!(self, s => AccelerationStructure::intersect(s, ray, ctx, hit))
     }
 
-    /// Any hit; see the module documentation.
     #[inline]
-    pub fn occluded(
+    fn occluded(
         &self,
         ray: &Ray,
-        counters: &mut TraversalCounters,
+        ctx: &mut QueryContext,
         occludes: impl FnMut(u32) -> bool,
     ) -> bool {
-        match self {
-            Accelerator::Bvh(s) => s.occluded(ray, counters, occludes),
-            Accelerator::Linear(s) => s.occluded(ray, counters, occludes),
-            Accelerator::Grid(s) => s.occluded(ray, counters, occludes),
-            Accelerator::KdTree(s) => s.occluded(ray, counters, occludes),
-        }
+        each_structure!(self, s => AccelerationStructure::occluded(s, ray, ctx, occludes))
     }
 
-    /// The primitive numbers that the positions handed out by
-    /// [`Self::intersect_in_leaf_order`] and [`Self::occluded_in_leaf_order`]
-    /// stand for, each leaf's together, for the structures that list them
-    /// (BVH, kd-tree); `None` for the others, whose positions are the
-    /// primitive numbers themselves.
-    pub fn leaf_order(&self) -> Option<&[u32]> {
-        match self {
-            Accelerator::Bvh(s) => Some(s.indices()),
-            Accelerator::KdTree(s) => Some(s.indices()),
-            Accelerator::Linear(_) | Accelerator::Grid(_) => None,
-        }
+    fn leaf_order(&self) -> Option<&[u32]> {
+        each_structure!(self, s => s.leaf_order())
     }
 
-    /// The closest hit, with `hit` given a whole leaf at a time: a range of
-    /// positions (see [`Self::leaf_order`]) and the closest hit so far; it
-    /// returns the closest hit among them nearer than that. A grid or brute
-    /// force hands each primitive over as a leaf of its own.
     #[inline]
-    pub fn intersect_in_leaf_order(
+    fn intersect_in_leaf_order(
         &self,
         ray: &Ray,
-        counters: &mut TraversalCounters,
-        mut hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
+        ctx: &mut QueryContext,
+        hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
     ) -> Option<f64> {
-        match self {
-            Accelerator::Bvh(s) => s.intersect_in_leaf_order(ray, counters, hit),
-            Accelerator::KdTree(s) => s.intersect_in_leaf_order(ray, counters, hit),
-            Accelerator::Linear(_) | Accelerator::Grid(_) => {
-                self.intersect(ray, counters, |p, t_max| hit(p..p + 1, t_max))
-            }
-        }
+        each_structure!(self, s => AccelerationStructure::intersect_in_leaf_order(s, ray, ctx, hit))
     }
 
-    /// Any hit, with `occludes` given a whole leaf at a time as for
-    /// [`Self::intersect_in_leaf_order`]; it says whether any of them lies
-    /// in the ray's interval.
     #[inline]
-    pub fn occluded_in_leaf_order(
+    fn occluded_in_leaf_order(
         &self,
         ray: &Ray,
-        counters: &mut TraversalCounters,
-        mut occludes: impl FnMut(Range<u32>) -> bool,
+        ctx: &mut QueryContext,
+        occludes: impl FnMut(Range<u32>) -> bool,
     ) -> bool {
-        match self {
-            Accelerator::Bvh(s) => s.occluded_in_leaf_order(ray, counters, occludes),
-            Accelerator::KdTree(s) => s.occluded_in_leaf_order(ray, counters, occludes),
-            Accelerator::Linear(_) | Accelerator::Grid(_) => {
-                self.occluded(ray, counters, |p| occludes(p..p + 1))
-            }
-        }
+        each_structure!(self, s => AccelerationStructure::occluded_in_leaf_order(s, ray, ctx, occludes))
     }
 
-    /// Checks the structure's invariants against the boxes it was built
-    /// from: every primitive reachable, children inside parents, depth
-    /// within the traversal stack.
-    pub fn validate(&self, boxes: &[Aabb]) -> Result<(), String> {
-        match self {
-            Accelerator::Bvh(s) => s.validate(boxes),
-            Accelerator::Linear(s) => s.validate(boxes),
-            Accelerator::Grid(s) => s.validate(boxes),
-            Accelerator::KdTree(s) => s.validate(boxes),
-        }
+    fn validate(&self, boxes: &[Aabb]) -> Result<(), String> {
+        each_structure!(self, s => AccelerationStructure::validate(s, boxes))
     }
 
-    /// Size and quality.
-    pub fn stats(&self) -> AccelStats {
-        match self {
-            Accelerator::Bvh(s) => s.stats(),
-            Accelerator::Linear(s) => s.stats(),
-            Accelerator::Grid(s) => s.stats(),
-            Accelerator::KdTree(s) => s.stats(),
-        }
+    fn stats(&self) -> AccelStats {
+        each_structure!(self, s => AccelerationStructure::stats(s))
     }
 }

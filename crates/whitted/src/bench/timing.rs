@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use super::RaySet;
-use crate::accel::{TraversalCounters, with_ray_coherence};
+use crate::accel::{QueryContext, TraversalCounters};
 use crate::math::Ray;
 use crate::world::World;
 
@@ -26,17 +26,12 @@ pub enum TraceResults {
 /// traversal work of all of them. Here and in [`time_set`] the queries are
 /// told how the set's rays relate ([`super::RayKind::coherence`]).
 pub fn trace_all(geometry: &World, set: &RaySet) -> (TraceResults, TraversalCounters) {
-    with_ray_coherence(set.kind.coherence(), || trace_all_here(geometry, set))
-}
-
-/// [`trace_all`], with the hint already in place.
-fn trace_all_here(geometry: &World, set: &RaySet) -> (TraceResults, TraversalCounters) {
-    let mut counters = TraversalCounters::default();
+    let mut ctx = QueryContext::new(set.kind.coherence());
     let results = if set.kind.is_any_hit() {
         TraceResults::Occluded(
             set.rays
                 .iter()
-                .map(|r| geometry.occluded_counted(r, &mut counters))
+                .map(|r| geometry.occluded_with(r, &mut ctx))
                 .collect(),
         )
     } else {
@@ -45,13 +40,13 @@ fn trace_all_here(geometry: &World, set: &RaySet) -> (TraceResults, TraversalCou
                 .iter()
                 .map(|r| {
                     geometry
-                        .intersect_counted(r, &mut counters)
+                        .intersect_with(r, &mut ctx)
                         .map(|h| (h.t(), h.primitive))
                 })
                 .collect(),
         )
     };
-    (results, counters)
+    (results, ctx.counters)
 }
 
 /// The best time in seconds of `runs` passes (after one warm-up pass) over
@@ -74,12 +69,12 @@ pub fn time_set(
         .map_err(|e| format!("could not start {threads} threads: {e}"))?;
     let chunks: Vec<&[Ray]> = set.rays.chunks(CHUNK).collect();
     let next = AtomicUsize::new(0);
-    let trace = |chunk: &[Ray], counters: &mut TraversalCounters| {
+    let trace = |chunk: &[Ray], ctx: &mut QueryContext| {
         let found = |r: &&Ray| {
             if set.kind.is_any_hit() {
-                geometry.occluded_counted(r, counters)
+                geometry.occluded_with(r, ctx)
             } else {
-                geometry.intersect_counted(r, counters).is_some()
+                geometry.intersect_with(r, ctx).is_some()
             }
         };
         chunk.iter().filter(found).count()
@@ -87,14 +82,12 @@ pub fn time_set(
     let pass = || {
         next.store(0, Ordering::Relaxed);
         let per_thread = pool.broadcast(|_| {
-            with_ray_coherence(set.kind.coherence(), || {
-                let mut counters = TraversalCounters::default();
-                let mut found = 0;
-                while let Some(chunk) = chunks.get(next.fetch_add(1, Ordering::Relaxed)) {
-                    found += trace(chunk, &mut counters);
-                }
-                found
-            })
+            let mut ctx = QueryContext::new(set.kind.coherence());
+            let mut found = 0;
+            while let Some(chunk) = chunks.get(next.fetch_add(1, Ordering::Relaxed)) {
+                found += trace(chunk, &mut ctx);
+            }
+            found
         });
         per_thread.into_iter().sum::<usize>()
     };

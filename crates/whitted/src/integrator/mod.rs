@@ -14,7 +14,7 @@ mod whitted;
 pub use ray_counts::{RayCounts, RayKind};
 pub use whitted::{Whitted, WhittedLimits};
 
-use crate::accel::TraversalCounters;
+use crate::accel::{QueryContext, TraversalCounters};
 use crate::math::Ray;
 use crate::shading::{Color, Light, Material};
 use crate::world::{Hit, Surface, World};
@@ -114,8 +114,8 @@ impl<'a> Integrator<'a> {
 
     /// The traversal work of the closest-hit query for `ray`.
     pub fn traversal_cost(&self, ray: &Ray) -> TraversalCounters {
-        let mut counters = TraversalCounters::default();
-        self.world().intersect_counted(ray, &mut counters);
-        counters
+        let mut ctx = QueryContext::default();
+        self.world().intersect_with(ray, &mut ctx);
+        ctx.counters
     }
 }

@@ -15,7 +15,9 @@ mod objects;
 pub use hit::{Hit, Surface};
 pub use objects::{MaterialId, MeshId, MeshInstance, Objects, Primitive, TransformId};
 
-use crate::accel::{AccelKind, Accelerator, TraversalCounters};
+use crate::accel::{
+    AccelKind, AccelerationStructure, Accelerator, KdTree, KdTreeBuildParams, QueryContext,
+};
 use crate::math::{Aabb, Ray, Transform, Vec3};
 use crate::mesh::TriangleMesh;
 #[cfg(target_arch = "x86_64")]
@@ -219,7 +221,14 @@ impl<'a> World<'a> {
             Some(c) => clipped_triangle_bounds(c, cell),
             None => boxes[slot as usize].intersection(cell),
         };
-        let accel = Accelerator::build_clipped(kind, &boxes, &clip);
+        let accel = match kind {
+            AccelKind::KdTree => Accelerator::KdTree(KdTree::build_clipped(
+                &boxes,
+                &KdTreeBuildParams::default(),
+                &clip,
+            )),
+            _ => Accelerator::build(kind, &boxes),
+        };
         // Gathered straight from the scene, in parallel, in the order the
         // queries name them: per entry of a BVH's or kd-tree's index
         // array, per slot for the other structures. Copying them in slot
@@ -454,11 +463,12 @@ impl<'a> World<'a> {
 
     /// The closest hit in the ray's interval.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.intersect_counted(ray, &mut TraversalCounters::default())
+        self.intersect_with(ray, &mut QueryContext::default())
     }
 
-    /// The closest hit, adding the traversal work to `counters`.
-    pub fn intersect_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> Option<Hit> {
+    /// The closest hit, walking as `ctx` says the rays relate and adding
+    /// the traversal work to its counters.
+    pub fn intersect_with(&self, ray: &Ray, ctx: &mut QueryContext) -> Option<Hit> {
         let query = self.query(ray);
         let mut best: Option<Hit> = None;
         let mut t_max = ray.t_max;
@@ -474,7 +484,7 @@ impl<'a> World<'a> {
         let mut clipped = *ray;
         clipped.t_max = t_max;
         self.accel
-            .intersect_in_leaf_order(&clipped, counters, |entries, t_max| {
+            .intersect_in_leaf_order(&clipped, ctx, |entries, t_max| {
                 self.hit_leaf(entries, &query, t_max, &mut best)
             });
         best
@@ -482,16 +492,17 @@ impl<'a> World<'a> {
 
     /// True when anything lies in the ray's interval.
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.occluded_counted(ray, &mut TraversalCounters::default())
+        self.occluded_with(ray, &mut QueryContext::default())
     }
 
-    /// Any hit, adding the traversal work to `counters`.
-    pub fn occluded_counted(&self, ray: &Ray, counters: &mut TraversalCounters) -> bool {
+    /// Any hit, walking as `ctx` says the rays relate and adding the
+    /// traversal work to its counters.
+    pub fn occluded_with(&self, ray: &Ray, ctx: &mut QueryContext) -> bool {
         let query = self.query(ray);
         self.unbounded.iter().any(|&i| self.occluded_by(i, &query))
-            || self.accel.occluded_in_leaf_order(ray, counters, |entries| {
-                self.leaf_occludes(entries, &query)
-            })
+            || self
+                .accel
+                .occluded_in_leaf_order(ray, ctx, |entries| self.leaf_occludes(entries, &query))
     }
 
     /// The world-space surface at a hit returned for `ray`.

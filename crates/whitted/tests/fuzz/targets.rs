@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use whitted::accel::AccelKind;
+use whitted::accel::{AccelKind, AccelerationStructure};
 use whitted::bench::obj_positions::parse_obj_positions;
 use whitted::bench::ray_files::read_ray_file;
 use whitted::bench::{RayKind, trace_all};

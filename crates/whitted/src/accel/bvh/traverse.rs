@@ -87,8 +87,8 @@ use super::slabs::{Halves, Planes, SlabTest};
 #[cfg(target_arch = "x86_64")]
 use super::slabs_avx::Avx;
 use super::{Bvh, MAX_DEPTH};
-use crate::accel::TraversalCounters;
 use crate::accel::stack::Stack;
+use crate::accel::{QueryContext, TraversalCounters};
 use crate::math::Ray;
 
 /// Entries the stack needs for a tree whose leaves lie at most `depth` deep:
@@ -149,10 +149,10 @@ impl Bvh {
     pub fn intersect(
         &self,
         ray: &Ray,
-        counters: &mut TraversalCounters,
+        ctx: &mut QueryContext,
         mut hit: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<f64> {
-        self.intersect_in_leaf_order(ray, counters, |entries, mut t_max| {
+        self.intersect_in_leaf_order(ray, ctx, |entries, mut t_max| {
             let mut found = None;
             for entry in entries {
                 if let Some(t) = hit(self.indices[entry as usize], t_max) {
@@ -173,9 +173,10 @@ impl Bvh {
     pub fn intersect_in_leaf_order(
         &self,
         ray: &Ray,
-        counters: &mut TraversalCounters,
+        ctx: &mut QueryContext,
         hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
     ) -> Option<f64> {
+        let counters = &mut ctx.counters;
         if self.nodes.is_empty() {
             None
         } else if self.max_depth <= SHALLOW {
@@ -285,10 +286,10 @@ impl Bvh {
     pub fn occluded(
         &self,
         ray: &Ray,
-        counters: &mut TraversalCounters,
+        ctx: &mut QueryContext,
         mut occludes: impl FnMut(u32) -> bool,
     ) -> bool {
-        self.occluded_in_leaf_order(ray, counters, |mut entries| {
+        self.occluded_in_leaf_order(ray, ctx, |mut entries| {
             entries.any(|entry| occludes(self.indices[entry as usize]))
         })
     }
@@ -302,9 +303,10 @@ impl Bvh {
     pub fn occluded_in_leaf_order(
         &self,
         ray: &Ray,
-        counters: &mut TraversalCounters,
+        ctx: &mut QueryContext,
         occludes: impl FnMut(Range<u32>) -> bool,
     ) -> bool {
+        let counters = &mut ctx.counters;
         if self.nodes.is_empty() {
             false
         } else if self.max_depth <= SHALLOW {
@@ -395,7 +397,7 @@ impl Bvh {
 #[cfg(test)]
 mod tests {
     use super::{Halves, MAX_DEPTH, stack_size};
-    use crate::accel::{Bvh, Linear, TraversalCounters};
+    use crate::accel::{Bvh, Linear, QueryContext, TraversalCounters};
     use crate::math::random::Rng;
     use crate::math::{Aabb, Ray, Vec3};
 
@@ -425,17 +427,17 @@ mod tests {
             (Vec3::new(600.0, 0.5, 0.5), -Vec3::X, 255),
         ] {
             let ray = Ray::new(origin, dir);
-            let mut counters = TraversalCounters::default();
+            let mut ctx = QueryContext::default();
             let mut hit_prim = None;
-            let t = bvh.intersect(&ray, &mut counters, |i, t_max| {
+            let t = bvh.intersect(&ray, &mut ctx, |i, t_max| {
                 let t = box_entry(&boxes, &ray, i, t_max)?;
                 hit_prim = Some(i);
                 Some(t)
             });
             assert_eq!(hit_prim, Some(first));
             assert_eq!(t, boxes[first as usize].intersect_ray(&ray).map(|(n, _)| n));
-            assert!(counters.primitives <= 8, "{counters:?}");
-            assert!(counters.nodes <= 3 * 8 + 8, "{counters:?}");
+            assert!(ctx.counters.primitives <= 8, "{:?}", ctx.counters);
+            assert!(ctx.counters.nodes <= 3 * 8 + 8, "{:?}", ctx.counters);
         }
     }
 
@@ -444,11 +446,11 @@ mod tests {
         let boxes = row(256);
         let bvh = Bvh::build(&boxes);
         let ray = Ray::new(Vec3::new(-5.0, 0.5, 0.5), Vec3::X);
-        let mut counters = TraversalCounters::default();
-        assert!(bvh.occluded(&ray, &mut counters, |_| true));
-        assert_eq!(counters.primitives, 1);
+        let mut ctx = QueryContext::default();
+        assert!(bvh.occluded(&ray, &mut ctx, |_| true));
+        assert_eq!(ctx.counters.primitives, 1);
         let above = Ray::new(Vec3::new(-5.0, 1.5, 0.5), Vec3::X);
-        assert!(!bvh.occluded(&above, &mut counters, |_| true));
+        assert!(!bvh.occluded(&above, &mut ctx, |_| true));
     }
 
     #[test]
@@ -472,14 +474,14 @@ mod tests {
                 for dir in [Vec3::new(1.0, dy, dz), Vec3::new(-1.0, dy, dz)] {
                     let origin = Vec3::new(0.4 - 2.0 * dir.x, y, 0.0);
                     let ray = Ray::new(origin, dir);
-                    let mut counters = TraversalCounters::default();
+                    let mut ctx = QueryContext::default();
                     let expected =
-                        linear.intersect(&ray, &mut counters, |i, t| box_entry(&boxes, &ray, i, t));
+                        linear.intersect(&ray, &mut ctx, |i, t| box_entry(&boxes, &ray, i, t));
                     let actual =
-                        bvh.intersect(&ray, &mut counters, |i, t| box_entry(&boxes, &ray, i, t));
+                        bvh.intersect(&ray, &mut ctx, |i, t| box_entry(&boxes, &ray, i, t));
                     assert!(expected.is_some());
                     assert_eq!(actual, expected, "{ray:?}");
-                    assert!(bvh.occluded(&ray, &mut counters, |_| true));
+                    assert!(bvh.occluded(&ray, &mut ctx, |_| true));
                 }
             }
         }
@@ -493,14 +495,14 @@ mod tests {
         let bvh = Bvh::build(boxes);
         bvh.validate(boxes).unwrap();
         let linear = Linear::build(boxes);
-        let mut counters = TraversalCounters::default();
+        let mut ctx = QueryContext::default();
         let mut hits = 0;
         const N: usize = stack_size(MAX_DEPTH);
         for ray in rays {
-            let expected = linear.intersect(ray, &mut counters, |i, t| box_entry(boxes, ray, i, t));
-            let actual = bvh.intersect(ray, &mut counters, |i, t| box_entry(boxes, ray, i, t));
+            let expected = linear.intersect(ray, &mut ctx, |i, t| box_entry(boxes, ray, i, t));
+            let actual = bvh.intersect(ray, &mut ctx, |i, t| box_entry(boxes, ray, i, t));
             assert_eq!(actual, expected, "{ray:?}");
-            let halves = bvh.closest::<N, Halves>(ray, &mut counters, |entries, mut t_max| {
+            let halves = bvh.closest::<N, Halves>(ray, &mut ctx.counters, |entries, mut t_max| {
                 let mut found = None;
                 for entry in entries {
                     let i = bvh.indices()[entry as usize];
@@ -514,7 +516,7 @@ mod tests {
             assert_eq!(halves, expected, "{ray:?}");
             let occluded = |i: u32| box_entry(boxes, ray, i, ray.t_max).is_some();
             assert_eq!(
-                bvh.occluded(ray, &mut counters, occluded),
+                bvh.occluded(ray, &mut ctx, occluded),
                 expected.is_some(),
                 "{ray:?}"
             );
@@ -522,7 +524,7 @@ mod tests {
                 entries.any(|entry| occluded(bvh.indices()[entry as usize]))
             };
             assert_eq!(
-                bvh.any::<N, Halves>(ray, &mut counters, leaf_occluded),
+                bvh.any::<N, Halves>(ray, &mut ctx.counters, leaf_occluded),
                 expected.is_some(),
                 "{ray:?}"
             );
@@ -632,18 +634,18 @@ mod tests {
         assert_eq!(assert_agrees_with_brute_force(&boxes, &rays), rays.len());
         let bvh = Bvh::build(&boxes);
         let nan = Ray::new(Vec3::new(f64::NAN, 0.0, 0.0), Vec3::X);
-        let mut counters = TraversalCounters::default();
-        assert_eq!(bvh.intersect(&nan, &mut counters, |_, _| None), None);
-        assert!(!bvh.occluded(&nan, &mut counters, |_| false));
+        let mut ctx = QueryContext::default();
+        assert_eq!(bvh.intersect(&nan, &mut ctx, |_, _| None), None);
+        assert!(!bvh.occluded(&nan, &mut ctx, |_| false));
     }
 
     #[test]
     fn nothing_to_hit_without_primitives() {
         let bvh = Bvh::build(&[]);
         let ray = Ray::new(Vec3::ZERO, Vec3::X);
-        let mut counters = TraversalCounters::default();
-        assert_eq!(bvh.intersect(&ray, &mut counters, |_, _| Some(1.0)), None);
-        assert!(!bvh.occluded(&ray, &mut counters, |_| true));
-        assert_eq!(counters, TraversalCounters::default());
+        let mut ctx = QueryContext::default();
+        assert_eq!(bvh.intersect(&ray, &mut ctx, |_, _| Some(1.0)), None);
+        assert!(!bvh.occluded(&ray, &mut ctx, |_| true));
+        assert_eq!(ctx.counters, TraversalCounters::default());
     }
 }

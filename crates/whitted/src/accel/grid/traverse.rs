@@ -10,7 +10,7 @@
 
 use super::Grid;
 use super::dda::DdaCells;
-use crate::accel::TraversalCounters;
+use crate::accel::QueryContext;
 use crate::accel::mailbox::Mailbox;
 use crate::math::Ray;
 
@@ -21,9 +21,10 @@ impl Grid {
     pub fn intersect(
         &self,
         ray: &Ray,
-        counters: &mut TraversalCounters,
+        ctx: &mut QueryContext,
         mut hit: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<f64> {
+        let counters = &mut ctx.counters;
         let mut closest = None;
         let mut clipped = *ray;
         let mut mailbox = Mailbox::new();
@@ -53,9 +54,10 @@ impl Grid {
     pub fn occluded(
         &self,
         ray: &Ray,
-        counters: &mut TraversalCounters,
+        ctx: &mut QueryContext,
         mut occludes: impl FnMut(u32) -> bool,
     ) -> bool {
+        let counters = &mut ctx.counters;
         let mut mailbox = Mailbox::new();
         for (cell, _, _) in DdaCells::new(&self.lattice, ray) {
             counters.nodes += 1;
@@ -109,19 +111,19 @@ mod tests {
             .map(|(cell, _, _)| grid.cell(cell).len())
             .sum();
         let mut tested = vec![0; boxes.len()];
-        let mut counters = TraversalCounters::default();
-        let found = grid.occluded(&ray, &mut counters, |i| {
+        let mut ctx = QueryContext::default();
+        let found = grid.occluded(&ray, &mut ctx, |i| {
             tested[i as usize] += 1;
             false
         });
         assert!(!found);
         assert!(tested.iter().all(|&n| n <= 1));
-        assert_eq!(counters.primitives, tested.iter().sum::<u64>());
+        assert_eq!(ctx.counters.primitives, tested.iter().sum::<u64>());
         // The slab at y = 5 lies along the whole walk: one test instead of
         // one per cell.
         assert_eq!(tested[5], 1);
-        assert!(counters.nodes >= u64::from(grid.resolution()[0]));
-        assert!(counters.primitives + counters.nodes - 1 <= memberships as u64);
+        assert!(ctx.counters.nodes >= u64::from(grid.resolution()[0]));
+        assert!(ctx.counters.primitives + ctx.counters.nodes - 1 <= memberships as u64);
     }
 
     #[test]
@@ -141,16 +143,16 @@ mod tests {
         assert!(grid.resolution()[0] > 4);
         let ray = Ray::new(Vec3::new(-1.0, 0.5, 0.5), Vec3::X);
         let hit_at = [10.0, 6.0, f64::INFINITY];
-        let mut counters = TraversalCounters::default();
-        let t = grid.intersect(&ray, &mut counters, |i, t_max| {
+        let mut ctx = QueryContext::default();
+        let t = grid.intersect(&ray, &mut ctx, |i, t_max| {
             let t = hit_at[i as usize];
             (t < t_max).then_some(t)
         });
         assert_eq!(t, Some(6.0));
-        assert_eq!(counters.primitives, 2);
+        assert_eq!(ctx.counters.primitives, 2);
         let cells_to_the_hit = DdaCells::new(&grid.lattice, &ray)
             .take_while(|c| c.1 < 6.0)
             .count();
-        assert_eq!(counters.nodes, cells_to_the_hit as u64);
+        assert_eq!(ctx.counters.nodes, cells_to_the_hit as u64);
     }
 }

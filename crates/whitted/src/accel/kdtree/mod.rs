@@ -62,8 +62,9 @@
 //!
 //! Rays whose directions are unrelated from one to the next make the
 //! branch on the direction a coin flip. For rays the caller says are
-//! incoherent ([`crate::accel::with_ray_coherence`]; `whitted bench` says
-//! so of its diffuse rays), a ray starting inside the tree first goes down
+//! incoherent ([`crate::accel::RayCoherence::Incoherent`] in the query's
+//! [`crate::accel::QueryContext`]; `whitted bench` says so of its diffuse
+//! rays), a ray starting inside the tree first goes down
 //! the cells holding its origin, choosing each child by the origin's side
 //! of the plane (a branch neighbouring origins take alike) and pushing the
 //! other without a branch on the direction (`traverse.rs`, `descend`); it
@@ -127,8 +128,9 @@ impl Default for KdTreeBuildParams {
 /// A kd-tree over primitive boxes.
 ///
 /// Its queries start the walk of a ray at its origin's leaf when the
-/// caller says the rays are incoherent ([`crate::accel::with_ray_coherence`]),
-/// at the root otherwise. Only their speed depends on it: both starts
+/// caller says the rays are incoherent
+/// ([`crate::accel::RayCoherence::Incoherent`] in the query's
+/// [`crate::accel::QueryContext`]), at the root otherwise. Only their speed depends on it: both starts
 /// return the same closest `t` (on an exact tie, possibly another
 /// primitive).
 #[derive(Clone, Debug)]

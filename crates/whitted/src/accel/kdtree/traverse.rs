@@ -29,7 +29,7 @@ use super::KdTree;
 use super::node::NodeKind;
 use crate::accel::mailbox::Mailbox;
 use crate::accel::stack::Stack;
-use crate::accel::{RayCoherence, TraversalCounters, current_ray_coherence};
+use crate::accel::{QueryContext, RayCoherence, TraversalCounters};
 use crate::math::{Ray, gamma};
 use std::ops::Range;
 
@@ -63,11 +63,13 @@ impl KdTree {
     pub fn intersect(
         &self,
         ray: &Ray,
-        counters: &mut TraversalCounters,
+        ctx: &mut QueryContext,
         mut hit: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<f64> {
+        let coherence = ctx.coherence;
+        let counters = &mut ctx.counters;
         let mut mailbox = Mailbox::new();
-        self.closest_leaf(ray, counters, |entries, mut t_max, counters| {
+        self.closest_leaf(ray, coherence, counters, |entries, mut t_max, counters| {
             let mut found = None;
             for p in entries.map(|entry| self.indices[entry]) {
                 if !mailbox.first_visit(p) {
@@ -95,10 +97,12 @@ impl KdTree {
     pub fn intersect_in_leaf_order(
         &self,
         ray: &Ray,
-        counters: &mut TraversalCounters,
+        ctx: &mut QueryContext,
         mut hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
     ) -> Option<f64> {
-        self.closest_leaf(ray, counters, |entries, t_max, counters| {
+        let coherence = ctx.coherence;
+        let counters = &mut ctx.counters;
+        self.closest_leaf(ray, coherence, counters, |entries, t_max, counters| {
             counters.primitives += entries.len() as u64;
             hit(entries.start as u32..entries.end as u32, t_max)
         })
@@ -113,6 +117,7 @@ impl KdTree {
     fn closest_leaf(
         &self,
         ray: &Ray,
+        coherence: RayCoherence,
         counters: &mut TraversalCounters,
         mut leaf: impl FnMut(Range<usize>, f64, &mut TraversalCounters) -> Option<f64>,
     ) -> Option<f64> {
@@ -129,7 +134,7 @@ impl KdTree {
             }
         }
         let mut t_max = clipped.t_max;
-        self.walk(&clipped, counters, |entries, counters| {
+        self.walk(&clipped, coherence, counters, |entries, counters| {
             if let Some(t) = leaf(entries, t_max, counters) {
                 (t_max, closest) = (t, Some(t));
             }
@@ -144,11 +149,13 @@ impl KdTree {
     pub fn occluded(
         &self,
         ray: &Ray,
-        counters: &mut TraversalCounters,
+        ctx: &mut QueryContext,
         mut occludes: impl FnMut(u32) -> bool,
     ) -> bool {
+        let coherence = ctx.coherence;
+        let counters = &mut ctx.counters;
         let mut mailbox = Mailbox::new();
-        self.any_leaf(ray, counters, |entries, counters| {
+        self.any_leaf(ray, coherence, counters, |entries, counters| {
             entries.map(|entry| self.indices[entry]).any(|p| {
                 if !mailbox.first_visit(p) {
                     return false;
@@ -171,10 +178,12 @@ impl KdTree {
     pub fn occluded_in_leaf_order(
         &self,
         ray: &Ray,
-        counters: &mut TraversalCounters,
+        ctx: &mut QueryContext,
         mut occludes: impl FnMut(Range<u32>) -> bool,
     ) -> bool {
-        self.any_leaf(ray, counters, |entries, counters| {
+        let coherence = ctx.coherence;
+        let counters = &mut ctx.counters;
+        self.any_leaf(ray, coherence, counters, |entries, counters| {
             counters.primitives += entries.len() as u64;
             occludes(entries.start as u32..entries.end as u32)
         })
@@ -187,6 +196,7 @@ impl KdTree {
     fn any_leaf(
         &self,
         ray: &Ray,
+        coherence: RayCoherence,
         counters: &mut TraversalCounters,
         mut leaf: impl FnMut(Range<usize>, &mut TraversalCounters) -> bool,
     ) -> bool {
@@ -199,7 +209,7 @@ impl KdTree {
             }
         }
         let mut found = false;
-        self.walk(ray, counters, |entries, counters| {
+        self.walk(ray, coherence, counters, |entries, counters| {
             if leaf(entries, counters) {
                 found = true;
                 Flow::Stop
@@ -217,13 +227,14 @@ impl KdTree {
     fn walk(
         &self,
         ray: &Ray,
+        coherence: RayCoherence,
         counters: &mut TraversalCounters,
         leaf: impl FnMut(Range<usize>, &mut TraversalCounters) -> Flow,
     ) {
         if self.max_depth <= SHALLOW {
-            self.walk_with::<SHALLOW>(ray, counters, leaf);
+            self.walk_with::<SHALLOW>(ray, coherence, counters, leaf);
         } else {
-            self.walk_with::<STACK_CAPACITY>(ray, counters, leaf);
+            self.walk_with::<STACK_CAPACITY>(ray, coherence, counters, leaf);
         }
     }
 
@@ -237,6 +248,7 @@ impl KdTree {
     fn walk_with<const N: usize>(
         &self,
         ray: &Ray,
+        coherence: RayCoherence,
         counters: &mut TraversalCounters,
         mut leaf: impl FnMut(Range<usize>, &mut TraversalCounters) -> Flow,
     ) {
@@ -257,7 +269,7 @@ impl KdTree {
         };
         // A ray starting inside the tree, among rays said to go every way,
         // first goes down to its origin's leaf.
-        if current_ray_coherence() == RayCoherence::Incoherent && t_min <= ray.t_min {
+        if coherence == RayCoherence::Incoherent && t_min <= ray.t_min {
             let Some(start) = self
                 .descend(entry, &axes, &mut stack, &mut work)
                 .or_else(|| stack.pop())
