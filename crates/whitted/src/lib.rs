@@ -60,6 +60,8 @@ pub mod sampling;
 pub mod scene;
 pub mod shape;
 pub mod tangent_frame;
+#[cfg(all(test, target_arch = "x86_64"))]
+mod test_support;
 pub mod texture;
 pub mod trace;
 pub mod triangle_clip;
