@@ -158,10 +158,22 @@ fn scenes_folder() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
 }
 
+/// `value` as a finite number, or a failure naming `what`.
+fn finite(value: &serde_json::Value, what: &str) -> f64 {
+    let number = value
+        .as_f64()
+        .unwrap_or_else(|| panic!("{what} is not a number: {value}"));
+    assert!(number.is_finite(), "{what} is {number}");
+    number
+}
+
 #[test]
-fn bench_reports_every_structure_and_ray_kind_as_json() {
+fn bench_json_reports_each_structure_and_the_work_of_each_ray_kind_consistently() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = scenes_folder().join("whitted.toml");
+    // Seven bounded primitives: a quad, two spheres, a cone, a cylinder, a
+    // hexagon and a patch's triangle.
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../whitted/tests/nff/spd_like.nff");
+    let (width, height, primitives) = (16, 12, 7);
     let out = whitted(
         &[
             "bench",
@@ -178,15 +190,112 @@ fn bench_reports_every_structure_and_ray_kind_as_json() {
     );
     assert!(out.status.success(), "{}", stderr(&out));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["primitives"], primitives);
+    assert_eq!(
+        (&report["width"], &report["height"]),
+        (&width.into(), &height.into())
+    );
+    assert_eq!(report["runs"], 1);
+    assert!(report["rays_from"].is_null());
+    assert!(report["threads"].as_u64().unwrap() >= 1);
     let structures = report["structures"].as_array().unwrap();
-    assert_eq!(structures.len(), whitted::accel::AccelKind::ALL.len());
+    let names: Vec<&str> = structures
+        .iter()
+        .map(|s| s["accel"].as_str().unwrap())
+        .collect();
+    let all: Vec<&str> = whitted::accel::AccelKind::ALL
+        .iter()
+        .map(|k| k.name())
+        .collect();
+    assert_eq!(names, all);
+    // The ray sets are made once and traced by every structure.
+    let mut counts_of_first: Option<Vec<u64>> = None;
     for s in structures {
+        let accel = s["accel"].as_str().unwrap();
+        let what = |field: &str| format!("{accel} {field}");
+        assert!(finite(&s["build_ms"], &what("build_ms")) >= 0.0);
+        assert!(s["memory_bytes"].as_u64().unwrap() > 0, "{accel}");
+        let nodes = s["nodes"].as_u64().unwrap();
+        let leaves = s["leaves"].as_u64().unwrap();
+        let references = s["references"].as_u64().unwrap();
+        assert!(
+            nodes >= 1 && leaves >= 1,
+            "{accel}: {nodes} nodes, {leaves} leaves"
+        );
+        // Every primitive is stored at least once; the BVH and brute force
+        // store each once, the kd-tree and the grid may store one in
+        // several leaves.
+        assert!(references >= primitives, "{accel}: {references} references");
+        if accel == "bvh" || accel == "linear" {
+            assert_eq!(references, primitives, "{accel}");
+        }
+        let sah_cost = finite(&s["sah_cost"], &what("sah_cost"));
+        // The grid has no SAH cost (0); the others cost at least a test.
+        if accel == "grid" {
+            assert!(sah_cost >= 0.0);
+        } else {
+            assert!(sah_cost >= 1.0, "{accel}: SAH cost {sah_cost}");
+        }
+        if accel == "linear" {
+            // One leaf of every primitive, tested one by one.
+            assert_eq!((nodes, leaves, s["max_depth"].as_u64()), (1, 1, Some(0)));
+            assert_eq!(sah_cost, primitives as f64);
+        }
+
         let kinds = s["kinds"].as_array().unwrap();
         let names: Vec<&str> = kinds.iter().map(|k| k["rays"].as_str().unwrap()).collect();
         assert_eq!(names, ["primary", "shadow", "diffuse"]);
-        assert_eq!(kinds[0]["count"], 16 * 12);
-        assert!(kinds[0]["mrays_per_s_1_thread"].as_f64().unwrap() > 0.0);
-        assert!(kinds[0]["nodes_per_ray"].as_f64().unwrap() > 0.0);
+        let counts: Vec<u64> = kinds.iter().map(|k| k["count"].as_u64().unwrap()).collect();
+        // One primary ray per pixel; one diffuse ray per primary hit; one
+        // shadow ray per primary hit that faces the light.
+        let [primary, shadow, diffuse] = counts[..] else {
+            unreachable!()
+        };
+        assert_eq!(primary, width * height);
+        assert!(
+            0 < shadow && shadow <= diffuse && diffuse <= primary,
+            "{counts:?}"
+        );
+        assert_eq!(
+            counts_of_first.get_or_insert_with(|| counts.clone()),
+            &counts,
+            "{accel}"
+        );
+        for k in kinds {
+            let kind = k["rays"].as_str().unwrap();
+            let what = |field: &str| format!("{accel} {kind} {field}");
+            assert!(finite(&k["mrays_per_s_1_thread"], &what("Mrays/s")) > 0.0);
+            assert!(finite(&k["mrays_per_s_all_threads"], &what("Mrays/s")) > 0.0);
+            assert!(k["agreeing"].is_null(), "{}", what("agreeing"));
+            let nodes_per_ray = finite(&k["nodes_per_ray"], &what("nodes per ray"));
+            let primitives_per_ray = finite(&k["primitives_per_ray"], &what("primitives per ray"));
+            // Each ray enters some nodes and tests some primitives, no
+            // node or leaf twice and no reference twice (brute force's
+            // `nodes` per ray are its boxes: below).
+            assert!(0.0 < nodes_per_ray, "{}", what("nodes per ray"));
+            assert!(
+                accel == "linear" || nodes_per_ray <= (nodes + leaves) as f64,
+                "{}: {nodes_per_ray}",
+                what("nodes per ray")
+            );
+            assert!(
+                0.0 < primitives_per_ray && primitives_per_ray <= references as f64,
+                "{}: {primitives_per_ray}",
+                what("primitives per ray")
+            );
+            if accel == "linear" {
+                // Brute force tests every primitive's box (its `nodes`) and
+                // the primitives whose box the ray meets. A closest hit
+                // never stops early: every box, for every ray; an any-hit
+                // query stops at the first blocker.
+                if kind == "shadow" {
+                    assert!(nodes_per_ray <= primitives as f64, "{nodes_per_ray}");
+                } else {
+                    assert_eq!(nodes_per_ray, primitives as f64, "{}", what("boxes"));
+                }
+                assert!(primitives_per_ray <= nodes_per_ray, "{}", what("tests"));
+            }
+        }
     }
 }
 

@@ -1,5 +1,8 @@
-//! NFF files that must be read: the SPD reference scenes (when the shared
-//! folder is there) and a small SPD-like fixture kept in the repository.
+//! NFF files that must be read: the SPD reference scenes (in the shared
+//! folder; ignored by default, run with `cargo test -- --ignored`) and a
+//! small SPD-like fixture kept in the repository.
+
+mod shared_folder;
 
 use std::path::{Path, PathBuf};
 
@@ -8,19 +11,19 @@ use whitted::scene::{load_any, load_nff};
 use whitted::shading::Color;
 use whitted::shading::Light;
 
+use shared_folder::shared_path;
+
 /// The SPD scenes, outside the repository: `shared/scenes/spd` beside it.
 fn spd_folder() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes/spd")
+    shared_path("scenes/spd")
 }
 
 #[test]
-fn every_spd_scene_parses() {
+#[ignore = "needs ../shared/scenes/spd (the SPD scenes); run with: cargo test -- --ignored"]
+fn every_spd_scene_parses_into_primitives_and_lights() {
     let folder = spd_folder();
-    let Ok(entries) = std::fs::read_dir(&folder) else {
-        println!("skipped: no SPD scenes at {}", folder.display());
-        return;
-    };
-    let mut files: Vec<PathBuf> = entries
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&folder)
+        .unwrap_or_else(|e| panic!("cannot list {}: {e}", folder.display()))
         .filter_map(|entry| entry.ok().map(|e| e.path()))
         .filter(|path| path.extension().is_some_and(|e| e == "nff"))
         .collect();
@@ -41,6 +44,7 @@ fn every_spd_scene_parses() {
 }
 
 #[test]
+#[ignore = "needs ../shared/scenes/spd (the SPD scenes); run with: cargo test -- --ignored"]
 fn the_spd_primitive_counts_are_kept() {
     // Totals from the SPD's own statistics, as listed in its README.
     for (name, total) in [
@@ -49,11 +53,7 @@ fn the_spd_primitive_counts_are_kept() {
         ("teapot", 9264),
         ("tree", 8191),
     ] {
-        let file = spd_folder().join(format!("{name}.nff"));
-        if !file.exists() {
-            println!("skipped: no {}", file.display());
-            continue;
-        }
+        let file = shared_path(&format!("scenes/spd/{name}.nff"));
         let scene = load_nff(&file).unwrap();
         assert_eq!(scene.objects.primitive_count(), total, "{name}");
     }

@@ -1,4 +1,7 @@
-//! OBJ models read from `tests/obj/` and, when present, the shared kitchen.
+//! OBJ models read from `tests/obj/` and the shared kitchen (ignored by
+//! default: it needs the shared folder; run with `cargo test -- --ignored`).
+
+mod shared_folder;
 
 use std::path::{Path, PathBuf};
 
@@ -11,6 +14,8 @@ use whitted::scene::{LoadedScene, load_obj};
 use whitted::shading::Color;
 use whitted::shading::Texture;
 use whitted::shape::RayShear;
+
+use shared_folder::shared_path;
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -86,13 +91,9 @@ fn missing_libraries_and_materials_are_warnings_with_a_grey_fallback() {
 }
 
 #[test]
-fn the_kitchen_loads_with_its_33_materials() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/scenes/models/kitchen/kitchen.obj");
-    if !path.exists() {
-        eprintln!("skipped: {} is absent", path.display());
-        return;
-    }
+#[ignore = "needs ../shared/scenes/models/kitchen; run with: cargo test -- --ignored"]
+fn the_kitchen_loads_with_its_33_materials_and_no_warnings() {
+    let path = shared_path("scenes/models/kitchen/kitchen.obj");
     let loaded = load_obj(&path).unwrap();
     assert_eq!(loaded.scene.materials.len(), 33);
     assert_eq!(loaded.scene.objects.meshes.len(), 33);

@@ -13,6 +13,8 @@
 
 pub mod random;
 pub mod sampling;
+#[cfg(all(test, target_arch = "x86_64"))]
+pub(crate) mod test_support;
 
 pub use glam::{DAffine3, DMat3, DVec2, DVec3};
 

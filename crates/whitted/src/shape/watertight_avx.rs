@@ -266,17 +266,9 @@ mod tests {
         hits.mask.count_ones() as usize
     }
 
-    fn has_avx() -> bool {
-        let avx = is_x86_feature_detected!("avx");
-        if !avx {
-            eprintln!("skipped: this processor has no AVX");
-        }
-        avx
-    }
-
     #[test]
     fn random_triangles_match_the_one_triangle_test_bit_for_bit() {
-        if !has_avx() {
+        if !crate::math::test_support::has_avx_or_skip_allowed() {
             return;
         }
         let mut rng = Rng::new(7);
@@ -302,7 +294,7 @@ mod tests {
 
     #[test]
     fn vertices_edges_planes_and_degenerate_triangles_match_too() {
-        if !has_avx() {
+        if !crate::math::test_support::has_avx_or_skip_allowed() {
             return;
         }
         let unit = [Vec3::ZERO, Vec3::X, Vec3::Y];

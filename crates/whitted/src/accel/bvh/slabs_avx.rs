@@ -100,8 +100,7 @@ mod tests {
 
     #[test]
     fn agrees_with_the_two_halves_bit_for_bit() {
-        if !is_x86_feature_detected!("avx") {
-            eprintln!("skipped: this processor has no AVX");
+        if !crate::math::test_support::has_avx_or_skip_allowed() {
             return;
         }
         for (node, ray, t_max) in random_cases(9) {

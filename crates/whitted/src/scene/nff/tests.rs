@@ -2,6 +2,7 @@
 //! errors.
 
 use super::*;
+use crate::scene::{Diagnostic, Severity};
 use crate::shape::Shape;
 
 /// A view block, to put in front of a test's own entities.
@@ -191,31 +192,251 @@ fn a_missing_file_is_an_io_error_naming_it() {
     assert!(error.to_string().contains("/nonexistent/scene.nff"));
 }
 
-#[test]
-fn truncated_and_mangled_files_give_errors_never_panics() {
-    let source = include_str!("../../../tests/nff/spd_like.nff");
-    for end in (0..=source.len()).filter(|&end| source.is_char_boundary(end)) {
-        let _ = parse_nff(&source[..end], Path::new("t.nff"));
+/// The fixture every entity of which the truncation and mangling tests cut
+/// or spoil.
+const SPD_LIKE: &str = include_str!("../../../tests/nff/spd_like.nff");
+
+/// The byte ranges of the words of `source`, `#` comments left out (a
+/// scanner of its own, so that the tests do not trust the lexer they test).
+fn word_spans(source: &str) -> Vec<Range<usize>> {
+    let mut spans = Vec::new();
+    let mut start = None;
+    let mut in_comment = false;
+    for (i, c) in source.char_indices().chain([(source.len(), '\n')]) {
+        if in_comment {
+            in_comment = c != '\n';
+            continue;
+        }
+        if c.is_ascii_whitespace() || c == '#' {
+            if let Some(s) = start.take() {
+                spans.push(s..i);
+            }
+            in_comment = c == '#';
+        } else if start.is_none() {
+            start = Some(i);
+        }
     }
-    // Seeded replacements of single tokens by troublesome words.
-    let words = [
-        "-1",
-        "0",
-        "nan",
-        "1e999",
-        "x",
-        "p",
-        "pp",
-        "#",
-        "99999999999",
-        "é",
-    ];
-    let tokens: Vec<&str> = source.split_ascii_whitespace().collect();
-    let mut rng = crate::math::random::Rng::new(7);
-    for _ in 0..2000 {
-        let mut mangled = tokens.clone();
-        let at = rng.below(mangled.len() as u32) as usize;
-        mangled[at] = words[rng.below(words.len() as u32) as usize];
-        let _ = parse_nff(&mangled.join(" "), Path::new("t.nff"));
+    spans
+}
+
+/// The text of the line `end` is on, from its start to `end`.
+fn line_before(source: &str, end: usize) -> &str {
+    &source[source[..end].rfind('\n').map_or(0, |i| i + 1)..end]
+}
+
+/// Checks that `result`, from reading `source` as `t.nff`, is an error
+/// whose every diagnostic is an error located in the file: `t.nff:L:C:`
+/// with line `L` and column `C` a place in `source` (up to just after its
+/// last character). Returns the diagnostics.
+fn located_errors(result: Result<Scene, SceneError>, source: &str) -> Vec<Diagnostic> {
+    let diagnostics = match result {
+        Ok(_) => panic!("no error in:\n{source}"),
+        Err(SceneError::Invalid { diagnostics }) => diagnostics,
+        Err(error) => panic!("not a located error: {error}\nin:\n{source}"),
+    };
+    assert!(
+        !diagnostics.is_empty(),
+        "an error without diagnostics in:\n{source}"
+    );
+    let lines: Vec<&str> = source.split('\n').collect();
+    for d in &diagnostics {
+        assert_eq!(d.severity, Severity::Error, "{d}");
+        assert_eq!(d.path, Path::new("t.nff"), "{d}");
+        let line = lines
+            .get(d.line.wrapping_sub(1))
+            .unwrap_or_else(|| panic!("line {} is not in the file: {d}\nin:\n{source}", d.line));
+        assert!(
+            (1..=line.chars().count() + 1).contains(&d.column),
+            "column {} is not on line {}: {d}\nin:\n{source}",
+            d.column,
+            d.line
+        );
+        let shown = d.to_string();
+        let place = format!("t.nff:{}:{}: error: ", d.line, d.column);
+        assert!(shown.starts_with(&place), "{shown}");
+    }
+    diagnostics
+}
+
+/// Cuts inside the last number of an entity that still leave a valid file:
+/// the digits left are a number the entity accepts.
+const CUT_NUMBERS_ACCEPTED: &[&str] = &[
+    // A 64 x 4 picture.
+    "resolution 64 4",
+    // The second light's blue: 0, 0 and 0.2 are colours.
+    "l -4 -2 5 0.3 0.3 0",
+    "l -4 -2 5 0.3 0.3 0.",
+    "l -4 -2 5 0.3 0.3 0.2",
+    // A cone's apex radius of 0: a pointed cone.
+    "1.5 0 1.5 0",
+    "1.5 0 1.5 0.",
+    "c -1.5 0 0 0.3 -1.5 0 1.5 0",
+    "c -1.5 0 0 0.3 -1.5 0 1.5 0.",
+    // An index of refraction of 1.
+    "f 1 1 1 0.1 0.1 101.148 0.9 1",
+    "f 1 1 1 0.1 0.1 101.148 0.9 1.",
+];
+
+/// Cuts inside the last number of an entity that leave an invalid one, with
+/// the error each gives.
+const CUT_NUMBERS_REFUSED: &[(&str, &str)] = &[
+    ("s 0 0 1 0", "radius must be a positive number, got 0"),
+    ("s 0 0 1 0.", "radius must be a positive number, got 0"),
+    (
+        "s -0.6 -1.6 0.5 0",
+        "radius must be a positive number, got 0",
+    ),
+    (
+        "s -0.6 -1.6 0.5 0.",
+        "radius must be a positive number, got 0",
+    ),
+];
+
+/// The hexagon with its last `z` of 0.01 cut.
+const HEXAGON: &str = "p 6 2 -2 0.01 3 -2 0.01 3 -1 0.01 2.5 -1.5 0.01 2 -1 0.01 2.2 -1.5 ";
+
+#[test]
+fn every_truncation_gives_located_errors_unless_it_ends_a_whole_entity() {
+    let source = SPD_LIKE;
+    let words = word_spans(source);
+    let text = |i: usize| &source[words[i].clone()];
+    // A word ends an entity when an entity keyword or the end of the file
+    // follows it, or when it ends a light's position (its colour may be
+    // left out). Only entities after the whole view can end a valid file.
+    let view_end = (0..words.len())
+        .position(|i| text(i) == "resolution")
+        .unwrap()
+        + 2;
+    let ends_entity = |i: usize| {
+        i >= view_end
+            && (i + 1 == words.len()
+                || ENTITY_KEYWORDS.contains(&text(i + 1))
+                || (i >= 3 && text(i - 3) == "l"))
+    };
+    let mut accepted_cuts = Vec::new();
+    let mut valid_prefixes = 0;
+    for end in (0..=source.len()).filter(|&end| source.is_char_boundary(end)) {
+        let prefix = &source[..end];
+        let result = parse_nff(prefix, Path::new("t.nff"));
+        // The last word that starts before the cut, and whether it is cut.
+        let last = words.iter().rposition(|w| w.start < end);
+        let cut_inside = last.is_some_and(|i| words[i].end > end);
+        let whole_entity = last.is_some_and(|i| ends_entity(i) && !cut_inside);
+        let line = line_before(source, end);
+        if whole_entity {
+            assert!(
+                result.is_ok(),
+                "{:?} ends an entity, but: {}",
+                line,
+                result.unwrap_err()
+            );
+            valid_prefixes += 1;
+        } else if last.is_some_and(|i| cut_inside && ends_entity(i)) {
+            if CUT_NUMBERS_ACCEPTED.contains(&line) {
+                assert!(result.is_ok(), "{line:?}: {}", result.unwrap_err());
+                accepted_cuts.push(line);
+                continue;
+            }
+            let errors = located_errors(result, prefix);
+            let expected = match CUT_NUMBERS_REFUSED.iter().find(|(cut, _)| *cut == line) {
+                Some((_, message)) => message.to_string(),
+                // 0 puts the last vertex off the plane z = 0.01 of the others.
+                None if [HEXAGON, "0"].concat() == line
+                    || [HEXAGON, "0."].concat() == line
+                    || [HEXAGON, "0.0"].concat() == line =>
+                {
+                    "the polygon is not planar: vertex".to_string()
+                }
+                None => panic!("a cut number not classified: {line:?} gives {errors:?}"),
+            };
+            assert!(
+                errors.iter().any(|d| d.message.contains(&expected)),
+                "{line:?}: expected `{expected}`, got {errors:?}"
+            );
+        } else {
+            // Cut inside an entity, or before the view is whole: an error,
+            // located no later than the cut.
+            let errors = located_errors(result, prefix);
+            let (line_count, column) = (
+                prefix.matches('\n').count() + 1,
+                line_before(source, end).chars().count() + 1,
+            );
+            let last_error = errors.last().unwrap();
+            assert!(
+                (last_error.line, last_error.column) <= (line_count, column),
+                "{last_error} lies after the cut at {line_count}:{column}"
+            );
+        }
+    }
+    // Every accepted cut was met: the table says no more than the file has.
+    assert_eq!(accepted_cuts, CUT_NUMBERS_ACCEPTED);
+    // The view and the 13 entities after it, each just after its last
+    // word and after the line break that follows it; and the second light
+    // cut after its position, before and after the space that follows.
+    assert_eq!(valid_prefixes, 2 * 14 + 2);
+}
+
+#[test]
+fn a_spoiled_word_gives_an_error_at_that_word() {
+    let source = SPD_LIKE;
+    let words = word_spans(source);
+    // Words no entity reads at any place: not a number, not finite, or not
+    // a word of the format; each must be reported where it stands.
+    for bad in ["x", "é", "nan", "1e999", "-inf"] {
+        for span in &words {
+            let spoiled = format!("{}{bad}{}", &source[..span.start], &source[span.end..]);
+            let errors = located_errors(parse_nff(&spoiled, Path::new("t.nff")), &spoiled);
+            let line = source[..span.start].matches('\n').count() + 1;
+            let column = line_before(source, span.start).chars().count() + 1;
+            assert!(
+                errors.iter().any(|d| (d.line, d.column) == (line, column)),
+                "`{bad}` in place of `{}` at {line}:{column}: {errors:?}",
+                &source[span.clone()]
+            );
+        }
+    }
+}
+
+#[test]
+fn a_keyword_in_place_of_any_word_gives_located_errors() {
+    let source = SPD_LIKE;
+    // Where a number belongs, a keyword cuts the entity short; in place of a
+    // keyword, the numbers that follow do not make the new entity (`p` and
+    // `pp` need a count then three or six numbers per vertex, none of the
+    // file's entities has that shape).
+    for keyword in ["p", "pp", "v"] {
+        for span in word_spans(source) {
+            if &source[span.clone()] == keyword {
+                continue;
+            }
+            let spoiled = format!("{}{keyword}{}", &source[..span.start], &source[span.end..]);
+            located_errors(parse_nff(&spoiled, Path::new("t.nff")), &spoiled);
+        }
+    }
+}
+
+#[test]
+fn plausible_words_anywhere_give_a_scene_or_located_errors_never_a_panic() {
+    let source = SPD_LIKE;
+    // Words that some entities accept at some places; `#` comments out the
+    // rest of its line.
+    for word in ["-1", "0", "99999999999", "#"] {
+        let (mut scenes, mut refused) = (0, 0);
+        for span in word_spans(source) {
+            let spoiled = format!("{}{word}{}", &source[..span.start], &source[span.end..]);
+            match parse_nff(&spoiled, Path::new("t.nff")) {
+                Ok(_) => scenes += 1,
+                result => {
+                    located_errors(result, &spoiled);
+                    refused += 1;
+                }
+            }
+        }
+        // Both answers occur: the word is neither always right nor always
+        // wrong, so both branches above were checked.
+        assert!(
+            scenes > 0 && refused > 0,
+            "`{word}`: {scenes} scenes, {refused} refused"
+        );
     }
 }
