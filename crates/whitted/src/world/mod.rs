@@ -4,12 +4,23 @@
 //! integrator needs — the closest hit and any hit — plus the full surface
 //! description of a final hit.
 //!
+//! Instances are kept as instances. A mesh placed once and where it was
+//! modelled (no transform) has its triangles in the world's structure
+//! itself, each with its own box: the fastest walk, and what a model read
+//! from a file is. A mesh placed several times, or moved, gets a structure
+//! of its own over its triangles in mesh space, built once; each placement
+//! is then one entry of the world's structure, with its world-space box,
+//! and a ray that reaches it is carried into mesh space once. Both levels
+//! use the structure the scene asks for.
+//!
 //! Primitives are numbered once for the whole world: first the shapes of
 //! [`Objects::primitives`] in order, then the triangles of each mesh
 //! instance of [`Objects::mesh_instances`] in order. That number is what
-//! [`Hit`] reports (and the `id` AOV shows).
+//! [`Hit`] reports (and the `id` AOV shows), however the instance is kept.
 
+mod entry;
 mod hit;
+mod instance;
 mod objects;
 
 pub use hit::{Hit, Surface};
@@ -18,13 +29,11 @@ pub use objects::{MaterialId, MeshId, MeshInstance, Objects, Primitive, Transfor
 use crate::accel::{
     AccelKind, AccelerationStructure, Accelerator, KdTree, KdTreeBuildParams, QueryContext,
 };
-use crate::math::{Aabb, Ray, Transform, Vec3};
-use crate::mesh::TriangleMesh;
-#[cfg(target_arch = "x86_64")]
-use crate::shape::{Hits4, LANES, watertight4};
-use crate::shape::{RayShear, Shape, ShapeHit, clipped_triangle_bounds, watertight};
+use crate::math::{Aabb, Ray, Transform};
+use crate::shape::{Shape, ShapeHit, clipped_triangle_bounds};
+use entry::{Entry, EntryKind, Query, leaf_hit, leaf_occludes};
+use instance::MeshStructure;
 use rayon::prelude::*;
-use std::ops::Range;
 
 /// Triangles per parallel task when preparing meshes: fewer are prepared
 /// on the calling thread.
@@ -47,87 +56,31 @@ enum PrimitiveRef {
 /// The objects of a scene, ready for ray queries.
 #[derive(Debug)]
 pub struct World<'a> {
-    primitives: &'a [Primitive],
-    instances: &'a [MeshInstance],
-    meshes: &'a [TriangleMesh],
-    transforms: &'a [Transform],
-    refs: Vec<PrimitiveRef>,
+    objects: &'a Objects,
+    /// The first primitive number of each mesh instance's triangles.
+    instance_first: Vec<u32>,
+    /// The structure of each mesh placed as an instance (several times,
+    /// or moved), by mesh id; `None` for the others.
+    mesh_structures: Vec<Option<MeshStructure>>,
     accel: Accelerator,
     bounds: Aabb,
-    /// Each primitive the structure's queries name, in their order: per
-    /// structure slot, or for a BVH or a kd-tree per entry of its index
-    /// array, so that a leaf's triangles lie together. The hot case reaches
-    /// its vertices without going through `refs`, the instance and the
-    /// mesh's index array (same test, same result). Tried and not kept
-    /// before this: renumbering the BVH's primitives to leaf order in its
-    /// build, no measurable change on the bunny (10.5/3.4/2.65 Mrays/s
-    /// either way), a slower build.
-    entries: Vec<EntryPrimitive>,
+    /// What the structure's queries name, in their order: per structure
+    /// slot, or for a BVH or a kd-tree per entry of its index array, so
+    /// that a leaf's triangles lie together (tried renumbering the BVH's
+    /// primitives to leaf order instead: no faster, a slower build).
+    entries: Vec<Entry>,
     /// Whether some entry of `entries` is a triangle, so queries compute
     /// the ray's shear up front.
     has_triangles: bool,
-    /// Whether the processor has AVX, so shadow rays test runs of a BVH's
-    /// or a kd-tree's leaf triangles four at a time.
-    #[cfg(target_arch = "x86_64")]
+    /// Whether the processor has AVX, so shadow rays test runs of a leaf's
+    /// triangles four at a time.
     wide_triangles: bool,
+    /// The unbounded shapes (infinite planes), tested beside the structure.
     unbounded: Vec<u32>,
-}
-
-/// The primitive of one entry of [`World::entries`]: its number, and
-/// its corners when it is an untransformed triangle (of a mesh or a
-/// triangle shape, which then takes the mesh triangles' path: the same
-/// watertight test on the same corners). The number shares the corners'
-/// 80 bytes, so a hit reads it from the line its test read. Looking it up
-/// through the structure's index array and the slots' numbers, two random
-/// reads, took a fifth of the dragon's triangle-test time on diffuse rays
-/// (perf); without them its diffuse rays run at 1.79 against 1.67 Mrays/s
-/// with the BVH and 0.94 against 0.89 with the kd-tree (1 thread, medians
-/// of 10 and 8 interleaved runs; the bunny's, whose data stay in cache,
-/// within noise).
-#[derive(Clone, Copy, Debug)]
-struct EntryPrimitive {
-    /// The primitive's number (its index in `World::refs`).
-    number: u32,
-    /// Whether `corners` holds a triangle's.
-    triangle: bool,
-    /// The triangle's corners, zero for other primitives.
-    corners: [Vec3; 3],
-}
-
-const _: () = assert!(size_of::<EntryPrimitive>() == 80);
-
-impl EntryPrimitive {
-    /// The entry of primitive `number`, with the corners if it is an
-    /// untransformed triangle.
-    fn new(number: u32, corners: Option<[Vec3; 3]>) -> Self {
-        Self {
-            number,
-            triangle: corners.is_some(),
-            corners: corners.unwrap_or([Vec3::ZERO; 3]),
-        }
-    }
-
-    /// The corners, if the primitive is an untransformed triangle.
-    #[inline(always)]
-    fn corners(&self) -> Option<&[Vec3; 3]> {
-        self.triangle.then_some(&self.corners)
-    }
-}
-
-/// A world-space ray with what the triangle test needs of it, computed once
-/// per query when the scene has untransformed triangles (a scene of other
-/// shapes does not pay for it).
-struct Query<'r> {
-    ray: &'r Ray,
-    shear: Option<RayShear>,
-}
-
-impl Query<'_> {
-    /// The ray's shear for the triangle test.
-    #[inline]
-    fn shear(&self) -> RayShear {
-        self.shear.unwrap_or_else(|| RayShear::new(self.ray))
-    }
+    /// How many mesh instances are kept as instances.
+    instance_count: usize,
+    /// How many primitives there are.
+    primitive_count: usize,
 }
 
 impl<'a> World<'a> {
@@ -136,49 +89,84 @@ impl<'a> World<'a> {
         Self::build(objects, AccelKind::default())
     }
 
-    /// Prepares the objects with the structure `kind`.
+    /// Prepares the objects with the structure `kind`, at both levels.
     pub fn build(objects: &'a Objects, kind: AccelKind) -> Self {
+        let to_world =
+            |transform: Option<TransformId>, local: Aabb| match objects.transform(transform) {
+                Some(t) => t.bounds_to_world(&local),
+                None => local,
+            };
+        let mesh_len = |m: &MeshInstance| objects.meshes[m.mesh.0 as usize].len() as u32;
+        let shapes = objects.primitives.len() as u32;
+        let mut instance_first = Vec::with_capacity(objects.mesh_instances.len());
+        let mut next = shapes;
+        for m in &objects.mesh_instances {
+            instance_first.push(next);
+            next += mesh_len(m);
+        }
+        // A mesh placed more than once, or moved, is kept as an instance.
+        let mut placements = vec![0u32; objects.meshes.len()];
+        for m in &objects.mesh_instances {
+            placements[m.mesh.0 as usize] += 1;
+        }
+        let instanced =
+            |m: &MeshInstance| m.transform.is_some() || placements[m.mesh.0 as usize] > 1;
+        let mut mesh_structures: Vec<Option<MeshStructure>> =
+            objects.meshes.iter().map(|_| None).collect();
+        for m in objects.mesh_instances.iter().filter(|m| instanced(m)) {
+            let slot = &mut mesh_structures[m.mesh.0 as usize];
+            if slot.is_none() {
+                *slot = Some(MeshStructure::build(
+                    &objects.meshes[m.mesh.0 as usize],
+                    kind,
+                ));
+            }
+        }
+
+        // The structure's slots: bounded shapes, then the triangles of each
+        // mesh placed directly, then the instances.
         let n = objects.primitive_count();
-        let mut refs = Vec::with_capacity(n);
-        let mut bounded = Vec::with_capacity(n);
-        let mut unbounded = Vec::new();
         let mut boxes = Vec::with_capacity(n);
-        let to_world = |transform: Option<TransformId>, local: Aabb| match transform {
-            Some(id) => objects.transforms[id.0 as usize].bounds_to_world(&local),
-            None => local,
-        };
+        let mut slot_shapes = Vec::new();
+        let mut unbounded = Vec::new();
         for (i, p) in objects.primitives.iter().enumerate() {
             let local = p.shape.bounds();
             if local.is_finite() {
                 boxes.push(to_world(p.transform, local));
-                bounded.push(refs.len() as u32);
+                slot_shapes.push(i as u32);
             } else {
-                unbounded.push(refs.len() as u32);
+                unbounded.push(i as u32);
             }
-            refs.push(PrimitiveRef::Shape(i as u32));
         }
-        // The first structure slot of each mesh instance's triangles.
-        let mut instance_slots = Vec::with_capacity(objects.mesh_instances.len());
-        // A mesh's triangles are prepared in parallel: on the bunny this
-        // loop, and the fresh memory it touches, took a fifth of the time
-        // `whitted bench` reports as the BVH build.
-        for (instance, m) in objects.mesh_instances.iter().enumerate() {
+        // The first slot of each directly placed mesh's run of triangles,
+        // and its instance. A mesh's triangles are prepared in parallel: on
+        // the bunny this loop, and the fresh memory it touches, took a
+        // fifth of the BVH build's time.
+        let mut run_first = Vec::new();
+        let mut run_instance = Vec::new();
+        for (k, m) in objects.mesh_instances.iter().enumerate() {
+            if instanced(m) {
+                continue;
+            }
             let mesh = &objects.meshes[m.mesh.0 as usize];
-            let triangles = || {
+            run_first.push(boxes.len() as u32);
+            run_instance.push(k as u32);
+            boxes.par_extend(
                 (0..mesh.len() as u32)
                     .into_par_iter()
                     .with_min_len(PARALLEL_CHUNK)
-            };
-            let first = refs.len() as u32;
-            instance_slots.push(bounded.len() as u32);
-            boxes.par_extend(triangles().map(|t| to_world(m.transform, mesh.triangle_bounds(t))));
-            bounded.extend(first..first + mesh.len() as u32);
-            refs.extend(
-                (0..mesh.len() as u32).map(|triangle| PrimitiveRef::Triangle {
-                    instance: instance as u32,
-                    triangle,
-                }),
+                    .map(|t| mesh.triangle_bounds(t)),
             );
+        }
+        let first_instance_slot = boxes.len() as u32;
+        let mut slot_instances = Vec::new();
+        for (k, m) in objects.mesh_instances.iter().enumerate() {
+            if let Some(structure) = &mesh_structures[m.mesh.0 as usize]
+                && instanced(m)
+            {
+                boxes.push(to_world(m.transform, structure.bounds()));
+                slot_instances.push(k as u32);
+            }
         }
         let bounds = boxes
             .par_chunks(PARALLEL_CHUNK)
@@ -186,258 +174,169 @@ impl<'a> World<'a> {
             .collect::<Vec<Aabb>>()
             .iter()
             .fold(Aabb::EMPTY, |a, b| a.union(b));
-        // The corners of the primitive in structure slot `slot` if it is an
-        // untransformed triangle. A triangle shape then takes the mesh
-        // triangles' path: the same watertight test on the same corners.
-        // Shapes take the first slots, and a shape's primitive number is
-        // its index in `Objects::primitives`. A mesh triangle is found from
-        // its slot's offset in its instance's run of slots: going through
-        // `bounded` and `refs`, two more random reads per slot, made the
-        // gather below take 60 instead of 37 ms on the dragon.
-        let shape_slots = instance_slots
-            .first()
-            .map_or(bounded.len(), |&s| s as usize);
-        let slot_corners = |slot: u32| {
-            if (slot as usize) < shape_slots {
-                return match &objects.primitives[bounded[slot as usize] as usize] {
+
+        // What structure slot `slot` names. A triangle shape without a
+        // transform takes the mesh triangles' path: the same watertight
+        // test on the same corners. A mesh triangle is found from its
+        // slot's offset in its run: going through tables of slots, two more
+        // random reads per slot, made the gather below take 60 instead of
+        // 37 ms on the dragon.
+        let shape_slots = slot_shapes.len() as u32;
+        let slot_entry = |slot: u32| {
+            if slot < shape_slots {
+                let i = slot_shapes[slot as usize];
+                return match &objects.primitives[i as usize] {
                     Primitive {
                         shape: Shape::Triangle(t),
                         transform: None,
                         ..
-                    } => Some(t.vertices()),
-                    _ => None,
+                    } => Entry::triangle(i, t.vertices()),
+                    _ => Entry::other(i, EntryKind::Primitive),
                 };
             }
-            let instance = instance_slots.partition_point(|&first| first <= slot) - 1;
-            let m = &objects.mesh_instances[instance];
-            let mesh = &objects.meshes[m.mesh.0 as usize];
-            let triangle = slot - instance_slots[instance];
-            m.transform.is_none().then(|| mesh.corners(triangle))
+            if slot >= first_instance_slot {
+                let k = slot_instances[(slot - first_instance_slot) as usize];
+                return Entry::other(k, EntryKind::Instance);
+            }
+            let run = run_first.partition_point(|&first| first <= slot) - 1;
+            let k = run_instance[run] as usize;
+            let mesh = &objects.meshes[objects.mesh_instances[k].mesh.0 as usize];
+            let triangle = slot - run_first[run];
+            Entry::triangle(instance_first[k] + triangle, mesh.corners(triangle))
         };
-        // Perfect splits for the kd-tree: an untransformed triangle's
-        // bounds in a cell are those of its part inside the cell; other
-        // primitives keep their box ∩ the cell.
-        let clip = |slot: u32, cell: &Aabb| match slot_corners(slot) {
-            Some(c) => clipped_triangle_bounds(c, cell),
-            None => boxes[slot as usize].intersection(cell),
-        };
+        // Perfect splits for the kd-tree: a triangle's bounds in a cell are
+        // those of its part inside the cell; other entries keep their box ∩
+        // the cell. The other structures have no use for a clipper.
         let accel = match kind {
-            AccelKind::KdTree => Accelerator::KdTree(KdTree::build_clipped(
-                &boxes,
-                &KdTreeBuildParams::default(),
-                &clip,
-            )),
+            AccelKind::KdTree => {
+                let clip = |slot: u32, cell: &Aabb| match slot_entry(slot).corners() {
+                    Some(c) => clipped_triangle_bounds(*c, cell),
+                    None => boxes[slot as usize].intersection(cell),
+                };
+                Accelerator::KdTree(KdTree::build_clipped(
+                    &boxes,
+                    &KdTreeBuildParams::default(),
+                    &clip,
+                ))
+            }
             _ => Accelerator::build(kind, &boxes),
         };
-        // Gathered straight from the scene, in parallel, in the order the
-        // queries name them: per entry of a BVH's or kd-tree's index
-        // array, per slot for the other structures. Copying them in slot
-        // order first, then to this order, made the dragon's BVH build 5%
-        // slower (324 against 307 ms, best of 15).
+        // Gathered straight from the objects, in parallel, in the order the
+        // queries name them (copying them in slot order first, then to this
+        // order, made the dragon's BVH build 5% slower).
         let order = accel.leaf_order();
-        let count = order.map_or(bounded.len(), <[u32]>::len);
-        let entries: Vec<_> = (0..count)
+        let count = order.map_or(boxes.len(), <[u32]>::len);
+        let entries: Vec<Entry> = (0..count)
             .into_par_iter()
             .with_min_len(PARALLEL_CHUNK)
-            .map(|entry| {
-                let slot = order.map_or(entry as u32, |o| o[entry]);
-                EntryPrimitive::new(bounded[slot as usize], slot_corners(slot))
-            })
+            .map(|entry| slot_entry(order.map_or(entry as u32, |o| o[entry])))
             .collect();
-        let has_triangles = entries.par_iter().any(|e| e.triangle);
+        let has_triangles = entries.par_iter().any(|e| e.kind == EntryKind::Triangle);
+        #[cfg(target_arch = "x86_64")]
+        let wide_triangles = is_x86_feature_detected!("avx");
+        #[cfg(not(target_arch = "x86_64"))]
+        let wide_triangles = false;
         Self {
-            primitives: &objects.primitives,
-            instances: &objects.mesh_instances,
-            meshes: &objects.meshes,
-            transforms: &objects.transforms,
-            refs,
+            objects,
+            instance_first,
+            mesh_structures,
             accel,
             bounds,
             entries,
             has_triangles,
-            #[cfg(target_arch = "x86_64")]
-            wide_triangles: is_x86_feature_detected!("avx"),
+            wide_triangles,
             unbounded,
+            instance_count: slot_instances.len(),
+            primitive_count: n,
         }
     }
 
-    fn transform(&self, id: Option<TransformId>) -> Option<&Transform> {
-        id.map(|id| &self.transforms[id.0 as usize])
-    }
-
-    /// A query for `ray`, with the shear precomputed if triangles may need it.
-    #[inline]
-    fn query<'r>(&self, ray: &'r Ray) -> Query<'r> {
-        Query {
-            ray,
-            shear: self.has_triangles.then(|| RayShear::new(ray)),
+    /// What primitive `number` stands for.
+    fn primitive_ref(&self, number: u32) -> PrimitiveRef {
+        if (number as usize) < self.objects.primitives.len() {
+            return PrimitiveRef::Shape(number);
+        }
+        let instance = self
+            .instance_first
+            .partition_point(|&first| first <= number)
+            - 1;
+        PrimitiveRef::Triangle {
+            instance: instance as u32,
+            triangle: number - self.instance_first[instance],
         }
     }
 
-    /// Primitive `index` hit by the query's ray, closer than `t_max`.
+    fn transform(&self, id: Option<TransformId>) -> Option<&'a Transform> {
+        self.objects.transform(id)
+    }
+
+    /// Shape `index` hit by the query's ray, closer than `t_max`.
     #[inline]
-    fn intersect_primitive(&self, index: u32, query: &Query, t_max: f64) -> Option<ShapeHit> {
+    fn intersect_shape(&self, index: u32, query: &Query, t_max: f64) -> Option<ShapeHit> {
         let mut ray = *query.ray;
         ray.t_max = t_max;
-        match self.refs[index as usize] {
-            PrimitiveRef::Shape(i) => {
-                let p = &self.primitives[i as usize];
-                match self.transform(p.transform) {
-                    Some(t) => p.shape.intersect(&t.ray_to_object(&ray)),
-                    None => p.shape.intersect(&ray),
-                }
-            }
-            PrimitiveRef::Triangle { instance, triangle } => {
-                let m = &self.instances[instance as usize];
-                let mesh = &self.meshes[m.mesh.0 as usize];
-                match self.transform(m.transform) {
-                    Some(t) => {
-                        let local = t.ray_to_object(&ray);
-                        mesh.intersect(triangle, &local, &RayShear::new(&local))
-                    }
-                    None => mesh.intersect(triangle, &ray, &query.shear()),
-                }
-            }
+        let p = &self.objects.primitives[index as usize];
+        match self.transform(p.transform) {
+            Some(t) => p.shape.intersect(&t.ray_to_object(&ray)),
+            None => p.shape.intersect(&ray),
         }
     }
 
-    /// The primitive of entry `entry` of `entries` hit by the query's ray,
-    /// closer than `t_max`, recorded in `best`; returns its `t`.
-    #[inline(always)]
-    fn hit_entry(
+    /// True when shape `index` lies in the query's ray interval.
+    #[inline]
+    fn shape_occludes(&self, index: u32, query: &Query) -> bool {
+        let p = &self.objects.primitives[index as usize];
+        match self.transform(p.transform) {
+            Some(t) => p.shape.occluded(&t.ray_to_object(query.ray)),
+            None => p.shape.occluded(query.ray),
+        }
+    }
+
+    /// Instance `k` and its mesh's structure, with the ray carried into
+    /// mesh space.
+    #[inline]
+    fn instance_ray(&self, k: u32, ray: &Ray) -> (&MeshStructure, Ray) {
+        let m = &self.objects.mesh_instances[k as usize];
+        let structure = self.mesh_structures[m.mesh.0 as usize]
+            .as_ref()
+            .expect("an instance entry is made only for a mesh with a structure");
+        let local = self
+            .transform(m.transform)
+            .map_or(*ray, |t| t.ray_to_object(ray));
+        (structure, local)
+    }
+
+    /// The entry `e` (a shape or an instance) hit by the query's ray closer
+    /// than `t_max`: the primitive number and the hit. An instance's walk
+    /// counts its work in `inner`.
+    #[inline]
+    fn intersect_other(
         &self,
-        entry: u32,
+        e: &Entry,
         query: &Query,
         t_max: f64,
-        best: &mut Option<Hit>,
-    ) -> Option<f64> {
-        let e = &self.entries[entry as usize];
-        let h = match e.corners() {
-            Some(corners) => intersect_triangle(corners, query, t_max),
-            None => self.intersect_primitive(e.number, query, t_max),
-        }?;
-        *best = Some(Hit {
-            primitive: e.number,
-            shape_hit: h,
-        });
-        Some(h.t)
-    }
-
-    /// The closest of the primitives of entries `entries` of
-    /// [`Self::entries`] hit by the query's ray, closer than `t_max`,
-    /// recorded in `best`; returns its `t`. One by one: testing runs
-    /// of triangles four at a time as [`Self::leaf_occludes`] does made
-    /// the bunny's primary and diffuse rays 10% and 6% slower (1 thread,
-    /// best of four interleaved runs), with 5% more instructions.
-    #[inline(always)]
-    fn hit_leaf(
-        &self,
-        entries: Range<u32>,
-        query: &Query,
-        mut t_max: f64,
-        best: &mut Option<Hit>,
-    ) -> Option<f64> {
-        let mut found = None;
-        for entry in entries {
-            if let Some(t) = self.hit_entry(entry, query, t_max, best) {
-                t_max = t;
-                found = Some(t);
+        inner: &mut QueryContext,
+    ) -> Option<(u32, ShapeHit)> {
+        match e.kind {
+            EntryKind::Instance => {
+                let (structure, local) = self.instance_ray(e.number, query.ray);
+                let (triangle, hit) = structure.intersect(&local, t_max, inner)?;
+                Some((self.instance_first[e.number as usize] + triangle, hit))
             }
-        }
-        found
-    }
-
-    /// True when a primitive of entries `entries` of [`Self::entries`] lies
-    /// in the query's ray interval. Where the processor has AVX, runs of
-    /// two to four triangles are tested at once, with the same answers as
-    /// one by one (see [`Self::triangle_run`]):
-    /// the same instructions on the bunny's shadow rays (callgrind), 18%
-    /// faster (5.74 against 4.84 Mrays/s, 1 thread, best of four
-    /// interleaved runs), having fewer branches on the edge tests' signs.
-    /// Measured again once the scalar test had lost those branches (1
-    /// thread, with and without AVX, medians of the best of 6 runs in 4
-    /// interleaved rounds on the bunny, of 6 in 3 on the kitchen, of 3 in
-    /// 3 on the dragon): kd-tree 3.42 against 3.32 Mrays/s on the bunny,
-    /// 1.72 against 1.63 on the dragon, 12.4 on the kitchen either way;
-    /// BVH 5.19 against 5.36 on the bunny (noise level), 3.06 against
-    /// 2.90 on the dragon, 17.4 and 17.3 on the kitchen.
-    #[inline(always)]
-    fn leaf_occludes(&self, entries: Range<u32>, query: &Query) -> bool {
-        let mut entry = entries.start;
-        while entry < entries.end {
-            #[cfg(target_arch = "x86_64")]
-            if let Some((run, hits)) = self.triangle_run(entry, entries.end, query) {
-                if hits.mask != 0 {
-                    return true;
-                }
-                entry += run;
-                continue;
-            }
-            if self.entry_occludes(entry, query) {
-                return true;
-            }
-            entry += 1;
-        }
-        false
-    }
-
-    /// With AVX, the run of two to [`LANES`] triangles that starts at entry
-    /// `entry` of [`Self::entries`] (and ends before `end`), tested at once
-    /// against the query's ray: its length and the hits, lane `i` for
-    /// entry `entry + i`. `None` without AVX or such a run.
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    fn triangle_run(&self, entry: u32, end: u32, query: &Query) -> Option<(u32, Hits4)> {
-        if !self.wide_triangles {
-            return None;
-        }
-        let available = (end - entry).min(LANES as u32) as usize;
-        let entries = &self.entries[entry as usize..entry as usize + available];
-        let run = entries.iter().take_while(|e| e.triangle).count();
-        if run < 2 {
-            return None;
-        }
-        // Lanes past the run repeat the first triangle; their answers are
-        // masked out.
-        let lane = |i: usize| &entries[if i < run { i } else { 0 }].corners;
-        // SAFETY: `wide_triangles` is set only where the processor has AVX.
-        let hits = unsafe {
-            watertight4(
-                [lane(0), lane(1), lane(2), lane(3)],
-                query.ray,
-                &query.shear(),
-                query.ray.t_max,
-            )
-        };
-        let mask = hits.mask & ((1 << run) - 1);
-        Some((run as u32, Hits4 { mask, ..hits }))
-    }
-
-    /// True when the primitive of entry `entry` of [`Self::entries`] lies
-    /// in the query's ray interval.
-    #[inline(always)]
-    fn entry_occludes(&self, entry: u32, query: &Query) -> bool {
-        let e = &self.entries[entry as usize];
-        match e.corners() {
-            Some(corners) => intersect_triangle(corners, query, query.ray.t_max).is_some(),
-            None => self.occluded_by(e.number, query),
+            _ => Some((e.number, self.intersect_shape(e.number, query, t_max)?)),
         }
     }
 
-    /// True when primitive `index` lies in the query's ray interval.
+    /// True when the entry `e` (a shape or an instance) lies in the query's
+    /// ray interval.
     #[inline]
-    fn occluded_by(&self, index: u32, query: &Query) -> bool {
-        match self.refs[index as usize] {
-            PrimitiveRef::Shape(i) => {
-                let p = &self.primitives[i as usize];
-                match self.transform(p.transform) {
-                    Some(t) => p.shape.occluded(&t.ray_to_object(query.ray)),
-                    None => p.shape.occluded(query.ray),
-                }
+    fn other_occludes(&self, e: &Entry, query: &Query, inner: &mut QueryContext) -> bool {
+        match e.kind {
+            EntryKind::Instance => {
+                let (structure, local) = self.instance_ray(e.number, query.ray);
+                structure.occluded(&local, self.wide_triangles, inner)
             }
-            PrimitiveRef::Triangle { .. } => self
-                .intersect_primitive(index, query, query.ray.t_max)
-                .is_some(),
+            _ => self.shape_occludes(e.number, query),
         }
     }
 
@@ -448,17 +347,24 @@ impl<'a> World<'a> {
 
     /// How many primitives (shapes and mesh triangles) there are.
     pub fn len(&self) -> usize {
-        self.refs.len()
+        self.primitive_count
     }
 
     /// True when there are none.
     pub fn is_empty(&self) -> bool {
-        self.refs.is_empty()
+        self.primitive_count == 0
     }
 
-    /// The acceleration structure over the bounded primitives.
+    /// The acceleration structure over the bounded primitives and the
+    /// instances (the top level).
     pub fn accelerator(&self) -> &Accelerator {
         &self.accel
+    }
+
+    /// How many mesh instances are kept as instances, each walking its
+    /// mesh's own structure.
+    pub fn instance_count(&self) -> usize {
+        self.instance_count
     }
 
     /// The closest hit in the ray's interval.
@@ -467,13 +373,13 @@ impl<'a> World<'a> {
     }
 
     /// The closest hit, walking as `ctx` says the rays relate and adding
-    /// the traversal work to its counters.
+    /// the traversal work (of both levels) to its counters.
     pub fn intersect_with(&self, ray: &Ray, ctx: &mut QueryContext) -> Option<Hit> {
-        let query = self.query(ray);
+        let query = Query::new(ray, self.has_triangles);
         let mut best: Option<Hit> = None;
         let mut t_max = ray.t_max;
         for &i in &self.unbounded {
-            if let Some(h) = self.intersect_primitive(i, &query, t_max) {
+            if let Some(h) = self.intersect_shape(i, &query, t_max) {
                 t_max = h.t;
                 best = Some(Hit {
                     primitive: i,
@@ -483,10 +389,24 @@ impl<'a> World<'a> {
         }
         let mut clipped = *ray;
         clipped.t_max = t_max;
+        let mut inner = QueryContext::new(ctx.coherence);
         self.accel
-            .intersect_in_leaf_order(&clipped, ctx, |entries, t_max| {
-                self.hit_leaf(entries, &query, t_max, &mut best)
+            .intersect_in_leaf_order(&clipped, ctx, |range, t_max| {
+                leaf_hit(
+                    &self.entries,
+                    range,
+                    &query,
+                    t_max,
+                    |e, t_max| self.intersect_other(e, &query, t_max, &mut inner),
+                    |primitive, shape_hit| {
+                        best = Some(Hit {
+                            primitive,
+                            shape_hit,
+                        })
+                    },
+                )
             });
+        ctx.counters += inner.counters;
         best
     }
 
@@ -496,31 +416,42 @@ impl<'a> World<'a> {
     }
 
     /// Any hit, walking as `ctx` says the rays relate and adding the
-    /// traversal work to its counters.
+    /// traversal work (of both levels) to its counters.
     pub fn occluded_with(&self, ray: &Ray, ctx: &mut QueryContext) -> bool {
-        let query = self.query(ray);
-        self.unbounded.iter().any(|&i| self.occluded_by(i, &query))
-            || self
-                .accel
-                .occluded_in_leaf_order(ray, ctx, |entries| self.leaf_occludes(entries, &query))
+        let query = Query::new(ray, self.has_triangles);
+        if self
+            .unbounded
+            .iter()
+            .any(|&i| self.shape_occludes(i, &query))
+        {
+            return true;
+        }
+        let mut inner = QueryContext::new(ctx.coherence);
+        let occluded = self.accel.occluded_in_leaf_order(ray, ctx, |range| {
+            leaf_occludes(&self.entries, range, &query, self.wide_triangles, |e| {
+                self.other_occludes(e, &query, &mut inner)
+            })
+        });
+        ctx.counters += inner.counters;
+        occluded
     }
 
     /// The world-space surface at a hit returned for `ray`.
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> Surface {
-        let (local, shading_normal, material, transform) = match self.refs[hit.primitive as usize] {
+        let (local, shading_normal, material, transform) = match self.primitive_ref(hit.primitive) {
             PrimitiveRef::Shape(i) => {
-                let p = &self.primitives[i as usize];
+                let p = &self.objects.primitives[i as usize];
                 let transform = self.transform(p.transform);
                 let object_ray = transform.map_or(*ray, |t| t.ray_to_object(ray));
                 let s = p.shape.surface(&object_ray, &hit.shape_hit);
                 (s, s.normal, p.material, transform)
             }
             PrimitiveRef::Triangle { instance, triangle } => {
-                let m = &self.instances[instance as usize];
+                let m = &self.objects.mesh_instances[instance as usize];
                 let transform = self.transform(m.transform);
                 let object_ray = transform.map_or(*ray, |t| t.ray_to_object(ray));
-                let s =
-                    self.meshes[m.mesh.0 as usize].surface(triangle, &object_ray, &hit.shape_hit);
+                let mesh = &self.objects.meshes[m.mesh.0 as usize];
+                let s = mesh.surface(triangle, &object_ray, &hit.shape_hit);
                 (s.local, s.shading_normal, m.material, transform)
             }
         };
@@ -544,20 +475,12 @@ impl<'a> World<'a> {
     }
 }
 
-/// The mesh triangle with these corners hit by the query's ray, closer than
-/// `t_max`.
-#[inline(always)]
-fn intersect_triangle([p0, p1, p2]: &[Vec3; 3], query: &Query, t_max: f64) -> Option<ShapeHit> {
-    let mut ray = *query.ray;
-    ray.t_max = t_max;
-    watertight(*p0, *p1, *p2, &ray, &query.shear())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::DVec2;
     use crate::math::random::Rng;
+    use crate::math::{DVec2, Vec3};
+    use crate::mesh::TriangleMesh;
     use crate::shape::{Plane, Shape, Sphere, Triangle};
 
     fn scene_with(shape: Shape, transform: Transform) -> Objects {
@@ -764,5 +687,77 @@ mod tests {
         assert!(world.occluded(&ray));
         let up = Ray::new(Vec3::new(0.0, 1.0, 0.0), Vec3::Y);
         assert!(world.intersect(&up).is_none() && !world.occluded(&up));
+    }
+
+    #[test]
+    fn a_mesh_placed_many_times_is_one_structure_and_hits_as_its_triangles_one_by_one() {
+        let mut rng = Rng::new(12);
+        let mut objects = Objects::default();
+        let positions: Vec<Vec3> = (0..240)
+            .map(|_| rng.point_in(Vec3::splat(-1.0), Vec3::splat(1.0)))
+            .collect();
+        let triangles: Vec<[u32; 3]> = (0..80).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        let mesh = objects.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
+        let placements: Vec<Transform> = (0..30)
+            .map(|i| {
+                let at = Vec3::new(f64::from(i % 6) * 2.5, f64::from(i / 6) * 2.5, 0.0);
+                Transform::translate(at)
+                    .unwrap()
+                    .then_after(&Transform::rotate(rng.unit_vector(), 37.0 * f64::from(i)).unwrap())
+                    .then_after(&Transform::scale(Vec3::splat(0.5 + 0.05 * f64::from(i))).unwrap())
+            })
+            .collect();
+        for t in &placements {
+            objects.add_mesh_instance(mesh, MaterialId(0), *t);
+        }
+        // The same mesh placed once where it was modelled stays flat.
+        let flat = objects.add_mesh(objects.meshes[0].clone());
+        objects.add_mesh_instance(flat, MaterialId(0), Transform::IDENTITY);
+        let shapes = objects.primitives.len() as u32;
+        for kind in AccelKind::ALL {
+            let world = World::build(&objects, kind);
+            assert_eq!(world.instance_count(), 30, "{kind:?}");
+            assert_eq!(world.len(), 31 * 80);
+            if matches!(kind, AccelKind::Bvh | AccelKind::Linear) {
+                // One reference per instance and per flat triangle (the
+                // kd-tree and the grid may refer to one several times).
+                assert_eq!(world.accel.stats().references, 30 + 80, "{kind:?}");
+            }
+            let mut hits = 0;
+            for _ in 0..600 {
+                let origin = rng.point_in(Vec3::new(-3.0, -3.0, -4.0), Vec3::new(15.0, 13.0, 4.0));
+                let ray = Ray::new(origin, rng.unit_vector());
+                // Every triangle of every placement, one by one.
+                let mut expected: Option<(f64, u32)> = None;
+                for (k, m) in objects.mesh_instances.iter().enumerate() {
+                    let local = objects
+                        .transform(m.transform)
+                        .map_or(ray, |t| t.ray_to_object(&ray));
+                    let shear = crate::shape::RayShear::new(&local);
+                    let mesh = &objects.meshes[m.mesh.0 as usize];
+                    for tri in 0..mesh.len() as u32 {
+                        if let Some(h) = mesh.intersect(tri, &local, &shear)
+                            && expected.is_none_or(|(t, _)| h.t < t)
+                        {
+                            expected = Some((h.t, shapes + 80 * k as u32 + tri));
+                        }
+                    }
+                }
+                let actual = world.intersect(&ray).map(|h| (h.t(), h.primitive));
+                assert_eq!(
+                    actual.map(|a| a.0),
+                    expected.map(|e| e.0),
+                    "{kind:?} {ray:?}"
+                );
+                assert_eq!(world.occluded(&ray), expected.is_some(), "{kind:?}");
+                if let (Some(hit), Some((_, primitive))) = (world.intersect(&ray), expected) {
+                    assert_eq!(hit.primitive, primitive, "{kind:?}");
+                    let point = world.surface(&ray, &hit).point;
+                    assert!((point - ray.at(hit.t())).length() < 1e-9);
+                }
+                hits += usize::from(expected.is_some());
+            }
+            assert!(hits > 60, "{kind:?}: {hits} hits");
+        }
     }
 }

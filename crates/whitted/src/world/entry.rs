@@ -1,0 +1,208 @@
+//! What a structure's queries name, kept in the order they name it: one
+//! [`Entry`] per position of a BVH's or kd-tree's index array (per slot for
+//! the other structures), so that a leaf's triangles lie together in
+//! memory, with their corners beside the number a hit reports.
+//!
+//! The leaf functions here serve both levels of the world: the top level
+//! (shapes, triangles of meshes placed once, and whole instances) and each
+//! instanced mesh's own structure (triangles only).
+
+use std::ops::Range;
+
+use crate::math::{Ray, Vec3};
+#[cfg(target_arch = "x86_64")]
+use crate::shape::{Hits4, LANES, watertight4};
+use crate::shape::{RayShear, ShapeHit, watertight};
+
+/// What an entry's number names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub(super) enum EntryKind {
+    /// A triangle whose corners are in the entry: tested right there.
+    Triangle,
+    /// A primitive tested through the world's tables (a shape).
+    Primitive,
+    /// A mesh instance, tested through its mesh's own structure.
+    Instance,
+}
+
+/// One position of a structure's index array: a number (a primitive's, a
+/// triangle's in its mesh, or an instance's, as `kind` says) and, for a
+/// triangle, its corners. The number shares the corners' 80 bytes, so a hit
+/// reads it from the cache line its test read (docs/performance.md, four-
+/// at-once triangle test, has the figures for this layout).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Entry {
+    /// What the entry names, by `kind`.
+    pub(super) number: u32,
+    /// How to test it.
+    pub(super) kind: EntryKind,
+    /// The triangle's corners; zero for other entries.
+    pub(super) corners: [Vec3; 3],
+}
+
+const _: () = assert!(size_of::<Entry>() == 80);
+
+impl Entry {
+    /// A triangle with these corners, reported as `number`.
+    pub(super) fn triangle(number: u32, corners: [Vec3; 3]) -> Self {
+        Self {
+            number,
+            kind: EntryKind::Triangle,
+            corners,
+        }
+    }
+
+    /// An entry tested through the world's tables.
+    pub(super) fn other(number: u32, kind: EntryKind) -> Self {
+        Self {
+            number,
+            kind,
+            corners: [Vec3::ZERO; 3],
+        }
+    }
+
+    /// The corners, if the entry is a triangle.
+    #[inline(always)]
+    pub(super) fn corners(&self) -> Option<&[Vec3; 3]> {
+        (self.kind == EntryKind::Triangle).then_some(&self.corners)
+    }
+}
+
+/// A ray with what the triangle test needs of it, computed once per query
+/// when the structure holds triangles (a world of other shapes does not pay
+/// for it).
+pub(super) struct Query<'r> {
+    /// The ray, in the space of the structure's entries.
+    pub(super) ray: &'r Ray,
+    shear: Option<RayShear>,
+}
+
+impl<'r> Query<'r> {
+    /// A query for `ray`, with the shear precomputed if `triangles`.
+    #[inline]
+    pub(super) fn new(ray: &'r Ray, triangles: bool) -> Self {
+        Self {
+            ray,
+            shear: triangles.then(|| RayShear::new(ray)),
+        }
+    }
+
+    /// The ray's shear for the triangle test.
+    #[inline]
+    pub(super) fn shear(&self) -> RayShear {
+        self.shear.unwrap_or_else(|| RayShear::new(self.ray))
+    }
+}
+
+/// The triangle with these corners hit by the query's ray, closer than
+/// `t_max`.
+#[inline(always)]
+pub(super) fn intersect_triangle(
+    [p0, p1, p2]: &[Vec3; 3],
+    query: &Query,
+    t_max: f64,
+) -> Option<ShapeHit> {
+    let mut ray = *query.ray;
+    ray.t_max = t_max;
+    watertight(*p0, *p1, *p2, &ray, &query.shear())
+}
+
+/// The closest of `entries[range]` hit by the query's ray closer than
+/// `t_max`: triangles here, other entries by `other(entry, t_max)`, which
+/// returns the hit's `t` and the number to report. `found(number, hit)` is
+/// told of each nearer hit; returns the closest `t`. One entry at a time:
+/// tried testing runs of triangles four at a time as [`leaf_occludes`]
+/// does: slower, see docs/performance.md (four-at-once triangle test).
+#[inline(always)]
+pub(super) fn leaf_hit(
+    entries: &[Entry],
+    range: Range<u32>,
+    query: &Query,
+    mut t_max: f64,
+    mut other: impl FnMut(&Entry, f64) -> Option<(u32, ShapeHit)>,
+    mut found: impl FnMut(u32, ShapeHit),
+) -> Option<f64> {
+    let mut closest = None;
+    for entry in range {
+        let e = &entries[entry as usize];
+        let hit = match e.corners() {
+            Some(corners) => intersect_triangle(corners, query, t_max).map(|h| (e.number, h)),
+            None => other(e, t_max),
+        };
+        if let Some((number, h)) = hit {
+            found(number, h);
+            t_max = h.t;
+            closest = Some(h.t);
+        }
+    }
+    closest
+}
+
+/// True when an entry of `entries[range]` lies in the query's ray
+/// interval: triangles here, other entries when `other(entry)` says so.
+/// Where `wide` (the processor has AVX), runs of two to four triangles are
+/// tested at once, with the same answers as one by one.
+#[inline(always)]
+pub(super) fn leaf_occludes(
+    entries: &[Entry],
+    range: Range<u32>,
+    query: &Query,
+    wide: bool,
+    mut other: impl FnMut(&Entry) -> bool,
+) -> bool {
+    let mut entry = range.start;
+    while entry < range.end {
+        #[cfg(target_arch = "x86_64")]
+        if wide && let Some((run, hits)) = triangle_run(entries, entry, range.end, query) {
+            if hits.mask != 0 {
+                return true;
+            }
+            entry += run;
+            continue;
+        }
+        let e = &entries[entry as usize];
+        let occludes = match e.corners() {
+            Some(corners) => intersect_triangle(corners, query, query.ray.t_max).is_some(),
+            None => other(e),
+        };
+        if occludes {
+            return true;
+        }
+        entry += 1;
+    }
+    let _ = wide;
+    false
+}
+
+/// The run of two to [`LANES`] triangles that starts at `entry` (and ends
+/// before `end`), tested at once against the query's ray: its length and
+/// the hits, lane `i` for entry `entry + i`. `None` without such a run.
+/// Only called where the processor has AVX.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn triangle_run(entries: &[Entry], entry: u32, end: u32, query: &Query) -> Option<(u32, Hits4)> {
+    let available = (end - entry).min(LANES as u32) as usize;
+    let entries = &entries[entry as usize..entry as usize + available];
+    let run = entries
+        .iter()
+        .take_while(|e| e.kind == EntryKind::Triangle)
+        .count();
+    if run < 2 {
+        return None;
+    }
+    // Lanes past the run repeat the first triangle; their answers are
+    // masked out.
+    let lane = |i: usize| &entries[if i < run { i } else { 0 }].corners;
+    // SAFETY: callers pass `wide` only where the processor has AVX.
+    let hits = unsafe {
+        watertight4(
+            [lane(0), lane(1), lane(2), lane(3)],
+            query.ray,
+            &query.shear(),
+            query.ray.t_max,
+        )
+    };
+    let mask = hits.mask & ((1 << run) - 1);
+    Some((run as u32, Hits4 { mask, ..hits }))
+}
