@@ -22,9 +22,11 @@ mod entry;
 mod hit;
 mod instance;
 mod objects;
+mod packet;
 
 pub use hit::{Hit, Surface};
 pub use objects::{MaterialId, MeshId, MeshInstance, Objects, Primitive, TransformId};
+pub use packet::{PACKET_SIZE, PacketHits, RayPacket};
 
 use crate::accel::{
     AccelKind, AccelerationStructure, Accelerator, KdTree, KdTreeBuildParams, QueryContext,
@@ -436,6 +438,27 @@ impl<'a> World<'a> {
         occluded
     }
 
+    /// The closest hit of each active ray of `packet`, as
+    /// [`Self::intersect_with`] finds it (rays are traced one at a time for
+    /// now, so the answers are the single-ray ones).
+    pub fn intersect_packet(&self, packet: &RayPacket, ctx: &mut QueryContext) -> PacketHits {
+        let mut out = PacketHits::default();
+        for lane in packet.lanes() {
+            out.hits[lane] = self.intersect_with(&packet.ray(lane), ctx);
+            out.mask |= u32::from(out.hits[lane].is_some()) << lane;
+        }
+        out
+    }
+
+    /// The active rays of `packet` with something in their interval, as a
+    /// mask (bit `i` for lane `i`), as [`Self::occluded_with`] answers each.
+    pub fn occluded_packet(&self, packet: &RayPacket, ctx: &mut QueryContext) -> u32 {
+        packet
+            .lanes()
+            .filter(|&lane| self.occluded_with(&packet.ray(lane), ctx))
+            .fold(0, |mask, lane| mask | 1 << lane)
+    }
+
     /// The world-space surface at a hit returned for `ray`.
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> Surface {
         let (local, shading_normal, material, transform) = match self.primitive_ref(hit.primitive) {
@@ -759,5 +782,41 @@ mod tests {
             }
             assert!(hits > 60, "{kind:?}: {hits} hits");
         }
+    }
+
+    #[test]
+    fn packets_give_every_lane_the_single_ray_answer() {
+        let mut rng = Rng::new(40);
+        let mut objects = Objects::default();
+        for _ in 0..60 {
+            let centre = rng.point_in(Vec3::splat(-3.0), Vec3::splat(3.0));
+            let sphere = Sphere::new(centre, rng.range(0.1, 0.6)).unwrap();
+            objects.add_primitive(Shape::Sphere(sphere), MaterialId(0), Transform::IDENTITY);
+        }
+        let world = World::new(&objects);
+        let mut hits = 0;
+        for round in 0..200 {
+            let count = round % (PACKET_SIZE + 1);
+            let rays: Vec<Ray> = (0..count)
+                .map(|_| {
+                    let origin = rng.point_in(Vec3::splat(-5.0), Vec3::splat(5.0));
+                    Ray::segment(origin, rng.unit_vector(), rng.range(1.0, 8.0))
+                })
+                .collect();
+            let packet = RayPacket::new(&rays);
+            let mut ctx = QueryContext::default();
+            let found = world.intersect_packet(&packet, &mut ctx);
+            let occluded = world.occluded_packet(&packet, &mut ctx);
+            for (lane, ray) in rays.iter().enumerate() {
+                let single = world.intersect(ray);
+                assert_eq!(found.hits[lane], single);
+                assert_eq!(found.mask >> lane & 1 == 1, single.is_some());
+                assert_eq!(occluded >> lane & 1 == 1, world.occluded(ray));
+                hits += usize::from(single.is_some());
+            }
+            assert_eq!(found.mask >> count, 0);
+            assert_eq!(occluded >> count, 0);
+        }
+        assert!(hits > 50, "{hits}");
     }
 }
