@@ -225,7 +225,7 @@ mod tests {
         let geometry = crate::world::World::new(&scene.objects);
         assert_eq!(geometry.len(), 2);
         let ray = crate::math::Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z);
-        assert_eq!(geometry.intersect(&ray).unwrap().primitive, 1);
+        assert_eq!(geometry.intersect(&ray).unwrap().primitive.0, 1);
     }
 
     #[test]

@@ -41,7 +41,7 @@ pub fn trace_all(geometry: &World, set: &RaySet) -> (TraceResults, TraversalCoun
                 .map(|r| {
                     geometry
                         .intersect_with(r, &mut ctx)
-                        .map(|h| (h.t(), h.primitive))
+                        .map(|h| (h.t(), h.primitive.0))
                 })
                 .collect(),
         )
@@ -53,10 +53,8 @@ pub fn trace_all(geometry: &World, set: &RaySet) -> (TraceResults, TraversalCoun
 /// the ray set on a pool of `threads` threads.
 ///
 /// Each thread takes the next 256 rays from a shared counter until
-/// none are left, as the anchor harness hands out its tiles. Rayon's
-/// `par_chunks` (halving the set and stealing) made the bunny's diffuse rays
-/// scale 1.84x on two threads against 1.98x this way (median of eight
-/// interleaved runs; primary and shadow rays within noise).
+/// none are left, as the anchor harness hands out its tiles (tried rayon's
+/// `par_chunks`: scaled worse, see docs/performance.md).
 pub fn time_set(
     geometry: &World,
     set: &RaySet,

@@ -270,7 +270,7 @@ fn render_tile(
                         data.extend_from_slice(&[n.x as f32, n.y as f32, n.z as f32]);
                     }
                     (Aov::Normal, None) => data.extend_from_slice(&[0.0; 3]),
-                    (Aov::Id, Some((hit, _))) => data.push(hit.primitive as f32),
+                    (Aov::Id, Some((hit, _))) => data.push(hit.primitive.0 as f32),
                     (Aov::Id, None) => data.push(-1.0),
                     (Aov::Cost, _) => {
                         let counters = integrator.traversal_cost(&ray);

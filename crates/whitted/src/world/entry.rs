@@ -29,8 +29,8 @@ pub(super) enum EntryKind {
 /// One position of a structure's index array: a number (a primitive's, a
 /// triangle's in its mesh, or an instance's, as `kind` says) and, for a
 /// triangle, its corners. The number shares the corners' 80 bytes, so a hit
-/// reads it from the cache line its test read (docs/performance.md, four-
-/// at-once triangle test, has the figures for this layout).
+/// reads it from the cache line its test read (docs/performance.md, world
+/// entries and preparation, has the figures for this layout).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Entry {
     /// What the entry names, by `kind`.

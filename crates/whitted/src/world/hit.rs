@@ -4,13 +4,13 @@
 
 use crate::math::{DVec2, Vec3};
 use crate::shape::{LocalSurface, ShapeHit};
-use crate::world::MaterialId;
+use crate::world::{MaterialId, PrimitiveId};
 
 /// The closest hit found by [`crate::world::World::intersect`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
-    /// The primitive's number in the whole scene (see the module doc).
-    pub primitive: u32,
+    /// The primitive's number in the whole world.
+    pub primitive: PrimitiveId,
     /// What the shape recorded (its `t` is the ray parameter).
     pub shape_hit: ShapeHit,
 }

@@ -25,7 +25,7 @@ mod objects;
 mod packet;
 
 pub use hit::{Hit, Surface};
-pub use objects::{MaterialId, MeshId, MeshInstance, Objects, Primitive, TransformId};
+pub use objects::{MaterialId, MeshId, MeshInstance, Objects, Primitive, PrimitiveId, TransformId};
 pub use packet::{PACKET_SIZE, PacketHits, RayPacket};
 
 use crate::accel::{
@@ -141,9 +141,8 @@ impl<'a> World<'a> {
             }
         }
         // The first slot of each directly placed mesh's run of triangles,
-        // and its instance. A mesh's triangles are prepared in parallel: on
-        // the bunny this loop, and the fresh memory it touches, took a
-        // fifth of the BVH build's time.
+        // and its instance. A mesh's triangles are prepared in parallel (a
+        // fifth of the bunny's build time otherwise).
         let mut run_first = Vec::new();
         let mut run_instance = Vec::new();
         for (k, m) in objects.mesh_instances.iter().enumerate() {
@@ -180,9 +179,8 @@ impl<'a> World<'a> {
         // What structure slot `slot` names. A triangle shape without a
         // transform takes the mesh triangles' path: the same watertight
         // test on the same corners. A mesh triangle is found from its
-        // slot's offset in its run: going through tables of slots, two more
-        // random reads per slot, made the gather below take 60 instead of
-        // 37 ms on the dragon.
+        // slot's offset in its run (tried tables of slots: slower, see
+        // docs/performance.md, world entries and preparation).
         let shape_slots = slot_shapes.len() as u32;
         let slot_entry = |slot: u32| {
             if slot < shape_slots {
@@ -224,8 +222,8 @@ impl<'a> World<'a> {
             _ => Accelerator::build(kind, &boxes),
         };
         // Gathered straight from the objects, in parallel, in the order the
-        // queries name them (copying them in slot order first, then to this
-        // order, made the dragon's BVH build 5% slower).
+        // queries name them (tried copying them in slot order first: slower,
+        // see docs/performance.md).
         let order = accel.leaf_order();
         let count = order.map_or(boxes.len(), <[u32]>::len);
         let entries: Vec<Entry> = (0..count)
@@ -384,7 +382,7 @@ impl<'a> World<'a> {
             if let Some(h) = self.intersect_shape(i, &query, t_max) {
                 t_max = h.t;
                 best = Some(Hit {
-                    primitive: i,
+                    primitive: PrimitiveId(i),
                     shape_hit: h,
                 });
             }
@@ -402,7 +400,7 @@ impl<'a> World<'a> {
                     |e, t_max| self.intersect_other(e, &query, t_max, &mut inner),
                     |primitive, shape_hit| {
                         best = Some(Hit {
-                            primitive,
+                            primitive: PrimitiveId(primitive),
                             shape_hit,
                         })
                     },
@@ -461,7 +459,8 @@ impl<'a> World<'a> {
 
     /// The world-space surface at a hit returned for `ray`.
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> Surface {
-        let (local, shading_normal, material, transform) = match self.primitive_ref(hit.primitive) {
+        let (local, shading_normal, material, transform) = match self.primitive_ref(hit.primitive.0)
+        {
             PrimitiveRef::Shape(i) => {
                 let p = &self.objects.primitives[i as usize];
                 let transform = self.transform(p.transform);
@@ -693,7 +692,7 @@ mod tests {
                     );
                 }
                 // Primitive 42 is the plane, which every downward ray meets.
-                hits += usize::from(expected.is_some_and(|h| h.primitive != 42));
+                hits += usize::from(expected.is_some_and(|h| h.primitive != PrimitiveId(42)));
             }
             assert!(hits > rays.len() / 4, "{kind:?}: {hits} hits");
         }
@@ -766,7 +765,7 @@ mod tests {
                         }
                     }
                 }
-                let actual = world.intersect(&ray).map(|h| (h.t(), h.primitive));
+                let actual = world.intersect(&ray).map(|h| (h.t(), h.primitive.0));
                 assert_eq!(
                     actual.map(|a| a.0),
                     expected.map(|e| e.0),
@@ -774,7 +773,7 @@ mod tests {
                 );
                 assert_eq!(world.occluded(&ray), expected.is_some(), "{kind:?}");
                 if let (Some(hit), Some((_, primitive))) = (world.intersect(&ray), expected) {
-                    assert_eq!(hit.primitive, primitive, "{kind:?}");
+                    assert_eq!(hit.primitive, PrimitiveId(primitive), "{kind:?}");
                     let point = world.surface(&ray, &hit).point;
                     assert!((point - ray.at(hit.t())).length() < 1e-9);
                 }

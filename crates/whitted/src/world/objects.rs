@@ -12,6 +12,12 @@ use crate::shape::Shape;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct MaterialId(pub u32);
 
+/// A primitive's number in the whole world: the shapes of
+/// [`Objects::primitives`] first, then each mesh instance's triangles, in
+/// order. What a hit reports and the `id` AOV shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct PrimitiveId(pub u32);
+
 /// Index of a transform in [`Objects::transforms`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct TransformId(pub u32);
