@@ -1,7 +1,8 @@
 //! How surfaces and lights look: colours, materials (Phong coefficients,
 //! mirror and glass, with textures, bump and normal maps), light sources,
 //! and the optics of smooth surfaces (reflection, refraction, Fresnel) with
-//! the media a refracted ray is inside.
+//! the media a refracted ray is inside. Materials can be evaluated for one
+//! light and sampled for the ray or photon they scatter ([`scatter`]).
 
 pub mod bump;
 mod color;
@@ -9,6 +10,7 @@ pub mod light;
 pub mod material;
 pub mod medium;
 pub mod optics;
+pub mod scatter;
 pub mod tangent_frame;
 pub mod texture;
 
@@ -17,4 +19,5 @@ pub use color::Color;
 pub use light::{Attenuation, Light, LightSample};
 pub use material::Material;
 pub use medium::{Crossing, MediumStack};
+pub use scatter::{Lobes, ScatterKind, ScatterSample};
 pub use texture::Texture;
