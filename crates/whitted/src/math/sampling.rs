@@ -1,9 +1,20 @@
-//! Where the samples of a pixel go: correlated multi-jittered sampling
-//! (Kensler, "Correlated Multi-Jittered Sampling", Pixar technical memo
-//! 13-01, 2013). Any number of samples is stratified in both dimensions, the
-//! pattern is chosen by a seed, and one sample is exactly the pixel centre.
+//! Turning numbers in `[0, 1)` into samples.
+//!
+//! - Where the samples of a pixel go: correlated multi-jittered sampling
+//!   (Kensler, "Correlated Multi-Jittered Sampling", Pixar technical memo
+//!   13-01, 2013). Any number of samples is stratified in both dimensions,
+//!   the pattern is chosen by a seed, and one sample is exactly the pixel
+//!   centre.
+//! - Directions and points for scattering rays and emitting photons: the
+//!   uniform sphere, the cosine-weighted hemisphere (a Lambertian surface),
+//!   a cone weighted by a power of the cosine (a Warn spot light), and the
+//!   uniform disk. Each takes its numbers as an array, so the caller decides
+//!   where they come from (a seeded [`crate::math::random::Rng`], a
+//!   stratified pattern), and each says its density.
 
-use crate::math::DVec2;
+use std::f64::consts::{FRAC_1_PI, TAU};
+
+use crate::math::{DVec2, Vec3};
 
 /// A pseudo-random permutation of `0..len` indexed by `i`, chosen by
 /// `pattern` (Kensler's hash with cycle walking).
@@ -79,9 +90,86 @@ pub fn pixel_sample(index: u32, count: u32, pattern: u32) -> DVec2 {
     )
 }
 
+/// A uniform point on the unit disk (polar mapping, `r = √u₀`): the
+/// origin of a parallel ray from a disk of light. Density `1 / π`.
+pub fn uniform_disk(u: [f64; 2]) -> DVec2 {
+    let r = u[0].sqrt();
+    let phi = TAU * u[1];
+    DVec2::new(r * phi.cos(), r * phi.sin())
+}
+
+/// A uniformly distributed unit vector: the direction of a photon leaving
+/// a point light. Density `1 / 4π` per steradian.
+pub fn uniform_sphere(u: [f64; 2]) -> Vec3 {
+    let z = 1.0 - 2.0 * u[0];
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = TAU * u[1];
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// A unit vector in the hemisphere around +z with density
+/// [`cosine_hemisphere_pdf`] `= cos θ / π` (Malley's method: a uniform
+/// point on the disk lifted onto the hemisphere). Sampling a Lambertian
+/// surface this way makes the weight of a scattered ray its albedo. Place
+/// it around a normal with [`about_axis`].
+pub fn cosine_hemisphere(u: [f64; 2]) -> Vec3 {
+    let d = uniform_disk(u);
+    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
+    Vec3::new(d.x, d.y, z)
+}
+
+/// The density per steradian of [`cosine_hemisphere`] for a direction at
+/// `cos_theta` from the axis: `cos θ / π`, and zero below the horizon.
+pub fn cosine_hemisphere_pdf(cos_theta: f64) -> f64 {
+    if cos_theta > 0.0 {
+        cos_theta * FRAC_1_PI
+    } else {
+        0.0
+    }
+}
+
+/// A unit vector around +z inside the cone `cos θ ≥ cos_max`, with density
+/// proportional to `cos^exponent θ` (the intensity of a Warn spot light):
+/// `cos^exponent θ / power_cosine_cone_integral(cos_max, exponent)`.
+///
+/// Needs `exponent ≥ 0`, and `cos_max ≥ 0` unless `exponent` is 0 (a
+/// power of a negative cosine is not defined); `cos_max` 1 gives the axis.
+pub fn power_cosine_cone(u: [f64; 2], cos_max: f64, exponent: f64) -> Vec3 {
+    let k = exponent + 1.0;
+    let low = cos_max.powf(k);
+    // The inverse of the cumulative distribution of cos θ on [cos_max, 1],
+    // (c^k - low) / (1 - low).
+    let cos = (low + u[0] * (1.0 - low)).powf(1.0 / k).clamp(-1.0, 1.0);
+    let sin = (1.0 - cos * cos).max(0.0).sqrt();
+    let phi = TAU * u[1];
+    Vec3::new(sin * phi.cos(), sin * phi.sin(), cos)
+}
+
+/// The integral of `cos^exponent θ` over the solid angle of the cone
+/// `cos θ ≥ cos_max`: `2π (1 - cos_max^(exponent+1)) / (exponent + 1)`.
+/// Times a spot light's axial intensity, it is the light's flux. Same
+/// domain as [`power_cosine_cone`].
+pub fn power_cosine_cone_integral(cos_max: f64, exponent: f64) -> f64 {
+    let k = exponent + 1.0;
+    TAU * (1.0 - cos_max.powf(k)) / k
+}
+
+/// `local`, given in a frame whose +z is `axis` (unit), turned into world
+/// coordinates; the frame's x and y are an arbitrary orthonormal pair
+/// around the axis (fine for samples that are symmetric about it).
+pub fn about_axis(local: Vec3, axis: Vec3) -> Vec3 {
+    let (x, y) = axis.any_orthonormal_pair();
+    local.x * x + local.y * y + local.z * axis
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::random::Rng;
+
+    fn uniform_pair(rng: &mut Rng) -> [f64; 2] {
+        [rng.uniform(), rng.uniform()]
+    }
 
     #[test]
     fn permute_is_a_permutation() {
@@ -156,5 +244,117 @@ mod tests {
     #[test]
     fn patterns_differ() {
         assert_ne!(pixel_sample(0, 16, 1), pixel_sample(0, 16, 2));
+    }
+
+    #[test]
+    fn disk_points_are_inside_and_uniform_by_area() {
+        let mut rng = Rng::new(11);
+        let n = 100_000;
+        let mut inner = 0;
+        let mut mean = DVec2::ZERO;
+        for _ in 0..n {
+            let p = uniform_disk(uniform_pair(&mut rng));
+            assert!(p.length() <= 1.0);
+            inner += usize::from(p.length() < 0.5);
+            mean += p;
+        }
+        // The disk of radius 1/2 holds a quarter of the area.
+        let fraction = inner as f64 / n as f64;
+        assert!((fraction - 0.25).abs() < 0.01, "{fraction}");
+        assert!((mean / n as f64).length() < 0.01);
+    }
+
+    #[test]
+    fn sphere_directions_are_unit_and_uniform() {
+        let mut rng = Rng::new(12);
+        let n = 100_000;
+        let (mut mean, mut z2, mut upper) = (Vec3::ZERO, 0.0, 0);
+        for _ in 0..n {
+            let d = uniform_sphere(uniform_pair(&mut rng));
+            assert!((d.length() - 1.0).abs() < 1e-12);
+            mean += d;
+            z2 += d.z * d.z;
+            upper += usize::from(d.z > 0.5);
+        }
+        let n = n as f64;
+        assert!((mean / n).length() < 0.01);
+        // Uniform on the sphere: E[z²] = 1/3, and z is uniform on [-1, 1].
+        assert!((z2 / n - 1.0 / 3.0).abs() < 0.01);
+        assert!((upper as f64 / n - 0.25).abs() < 0.01);
+    }
+
+    #[test]
+    fn cosine_hemisphere_has_the_lambertian_moments() {
+        let mut rng = Rng::new(13);
+        let n = 100_000;
+        let (mut cos, mut cos2, mut xy) = (0.0, 0.0, DVec2::ZERO);
+        for _ in 0..n {
+            let d = cosine_hemisphere(uniform_pair(&mut rng));
+            assert!((d.length() - 1.0).abs() < 1e-12 && d.z >= 0.0);
+            cos += d.z;
+            cos2 += d.z * d.z;
+            xy += DVec2::new(d.x, d.y);
+        }
+        let n = n as f64;
+        // With density cos θ / π: E[cos θ] = 2/3 and E[cos² θ] = 1/2.
+        assert!((cos / n - 2.0 / 3.0).abs() < 0.005, "{}", cos / n);
+        assert!((cos2 / n - 0.5).abs() < 0.005, "{}", cos2 / n);
+        assert!((xy / n).length() < 0.01);
+        assert_eq!(cosine_hemisphere_pdf(-0.1), 0.0);
+        assert!((cosine_hemisphere_pdf(1.0) - 1.0 / std::f64::consts::PI).abs() < 1e-15);
+    }
+
+    #[test]
+    fn power_cosine_cone_stays_in_its_cone_with_the_right_distribution() {
+        let mut rng = Rng::new(14);
+        for (cos_max, exponent) in [(0.5, 0.0), (0.0, 1.0), (0.8, 5.0), (0.3, 20.0)] {
+            let n = 100_000;
+            // Check the fraction inside the narrower cone cos θ ≥ c.
+            let c = (1.0 + cos_max) / 2.0;
+            let mut inside = 0;
+            for _ in 0..n {
+                let d = power_cosine_cone(uniform_pair(&mut rng), cos_max, exponent);
+                assert!((d.length() - 1.0).abs() < 1e-12);
+                assert!(d.z >= cos_max - 1e-12, "{d:?} outside cos {cos_max}");
+                inside += usize::from(d.z >= c);
+            }
+            let expected = power_cosine_cone_integral(c, exponent)
+                / power_cosine_cone_integral(cos_max, exponent);
+            let fraction = inside as f64 / n as f64;
+            assert!(
+                (fraction - expected).abs() < 0.01,
+                "cos_max {cos_max}, exponent {exponent}: {fraction} vs {expected}"
+            );
+        }
+        assert_eq!(power_cosine_cone([0.3, 0.7], 1.0, 3.0), Vec3::Z);
+    }
+
+    #[test]
+    fn power_cosine_cone_integral_matches_quadrature() {
+        for (cos_max, exponent) in [(0.0, 0.0), (-1.0, 0.0), (0.5, 2.0), (0.9, 7.5)] {
+            // Midpoint rule over cos θ: ∫ cos^e dω = 2π ∫ μ^e dμ.
+            let steps = 100_000;
+            let h = (1.0 - cos_max) / steps as f64;
+            let sum: f64 = (0..steps)
+                .map(|i| (cos_max + (i as f64 + 0.5) * h).powf(exponent) * h)
+                .sum();
+            let exact = power_cosine_cone_integral(cos_max, exponent);
+            assert!(
+                (TAU * sum - exact).abs() < 1e-6 * exact,
+                "{cos_max} {exponent}"
+            );
+        }
+        let hemisphere = power_cosine_cone_integral(0.0, 0.0);
+        assert!((hemisphere - TAU).abs() < 1e-12);
+    }
+
+    #[test]
+    fn about_axis_puts_z_on_the_axis_and_keeps_lengths_and_angles() {
+        let axis = Vec3::new(0.3, -0.5, 0.8).normalize();
+        assert!((about_axis(Vec3::Z, axis) - axis).length() < 1e-12);
+        let local = Vec3::new(0.6, 0.0, 0.8);
+        let world = about_axis(local, axis);
+        assert!((world.length() - 1.0).abs() < 1e-12);
+        assert!((world.dot(axis) - 0.8).abs() < 1e-12);
     }
 }

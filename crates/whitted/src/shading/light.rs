@@ -4,6 +4,18 @@
 //! (not clamped: `[1, 0, 0]`, the default, means no fall-off). A spot light
 //! (Warn's model) scales its intensity by `cos(α)^falloff` for directions at
 //! angle `α` from its axis, and is dark beyond its cut-off angle.
+//!
+//! A light is used two ways: towards a point ([`Light::sample`],
+//! [`Light::sample_towards`]: the light arriving there, for direct lighting
+//! and shadow rays) and from the light ([`Light::power`], [`Light::emit`] in
+//! [`crate::shading::emission`]: its flux and the rays it sends out, for
+//! photon tracing).
+//!
+//! Area lights are not here yet. One will be a new variant (an emitting
+//! shape with a radiance); [`Light::sample_towards`] will pick a point on
+//! it from its two numbers, [`Light::emit`] a point and a cosine-weighted
+//! direction from its four, and shadow rays will aim at the sampled point
+//! rather than at a fixed position.
 
 use crate::shading::Color;
 
@@ -147,6 +159,21 @@ impl Light {
     }
 }
 
+impl Light {
+    /// The light arriving at `p` from one point of the light chosen by `u`
+    /// (two numbers in `[0, 1)`), or `None` when none can arrive.
+    ///
+    /// Point, directional and spot lights are single points or directions,
+    /// so `u` is not used and this is [`Light::sample`]; the sample is here
+    /// so that an area light can choose its point (and divide by that
+    /// choice's density) behind the same call.
+    #[inline]
+    pub fn sample_towards(&self, p: Vec3, u: [f64; 2]) -> Option<LightSample> {
+        let _ = u;
+        self.sample(p)
+    }
+}
+
 fn direction_to(position: Vec3, p: Vec3) -> Option<(Vec3, f64)> {
     let delta = position - p;
     let distance = delta.length();
@@ -211,5 +238,48 @@ mod tests {
             quadratic: 0.0,
         };
         assert_eq!(a.factor(3.0), 0.0);
+    }
+
+    #[test]
+    fn sampling_towards_a_point_is_the_plain_sample_for_singular_lights() {
+        let lights = [
+            Light::Point {
+                position: Vec3::new(1.0, 2.0, 3.0),
+                intensity: Color::new(1.0, 0.5, 0.25),
+                attenuation: Attenuation {
+                    constant: 0.5,
+                    linear: 0.1,
+                    quadratic: 0.2,
+                },
+            },
+            Light::Directional {
+                direction: Vec3::new(0.0, -0.6, -0.8),
+                intensity: Color::ONE,
+            },
+            Light::Spot {
+                position: Vec3::new(0.0, 4.0, 0.0),
+                direction: -Vec3::Y,
+                intensity: Color::splat(3.0),
+                cos_cutoff: 0.7,
+                falloff: 2.5,
+                attenuation: Attenuation::NONE,
+            },
+        ];
+        let points = [
+            Vec3::ZERO,
+            Vec3::new(0.5, -1.0, 0.2),
+            Vec3::new(5.0, 0.0, 0.0),
+        ];
+        let mut lit = 0;
+        for light in &lights {
+            for p in points {
+                for u in [[0.0, 0.0], [0.25, 0.75], [0.999, 0.5]] {
+                    assert_eq!(light.sample_towards(p, u), light.sample(p));
+                }
+                lit += usize::from(light.sample(p).is_some());
+            }
+        }
+        // Some points are lit and one is outside the spot's cone.
+        assert_eq!(lit, 8);
     }
 }
