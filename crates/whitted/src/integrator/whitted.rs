@@ -5,9 +5,14 @@
 //! shadow ray), and the mirror-reflected and refracted rays, recursively.
 //! See [`crate::shading::material`] for the formula and the Fresnel option.
 //!
+//! The direct light is [`crate::shading::phong`] and the weights of the
+//! secondary rays are [`Material::lobes`]: the shading layer's own answers,
+//! which photon mapping will share.
+//!
 //! - Shading is two-sided: the normal is turned to face the incoming ray.
-//!   A material's bump or normal map tilts it (see [`crate::shading::bump`]); a
-//!   light behind the geometric surface then lights nothing.
+//!   A material's bump or normal map tilts it (see
+//!   [`crate::shading::bump`]); a light behind the geometric surface then
+//!   lights nothing.
 //! - Shadow rays pass through transmissive and dissolved surfaces, each
 //!   crossing scaling the light by what that surface lets through
 //!   (`α kt + 1 - α`); an opaque surface blocks it.
@@ -19,8 +24,8 @@
 
 use crate::integrator::{PrimarySample, RayCounts, RayKind, Shading};
 use crate::math::{Ray, Vec3, offset_ray_origin};
-use crate::shading::optics::{reflect, refract, schlick_reflectance};
-use crate::shading::{Color, Crossing, Light, Material, MediumStack, shading_normal};
+use crate::shading::optics::reflect;
+use crate::shading::{Color, Crossing, Light, Lobes, Material, MediumStack, phong, shading_normal};
 use crate::world::{Surface, World};
 
 /// Longest chain of transmissive surfaces one shadow ray passes through.
@@ -144,11 +149,7 @@ impl<'a> Whitted<'a> {
                 if shadow == Color::ZERO {
                     continue;
                 }
-                let mut direct = diffuse * n_dot_l;
-                let r_dot_v = reflect(-sample.to_light, n).dot(view);
-                if r_dot_v > 0.0 && specular != Color::ZERO {
-                    direct += specular * r_dot_v.powf(m.shininess);
-                }
+                let direct = phong(diffuse, specular, m.shininess, n, sample.to_light, view);
                 local += shadow * sample.intensity * direct;
             }
         }
@@ -168,24 +169,12 @@ impl<'a> Whitted<'a> {
             n_to,
             after: inside_after,
         } = media.cross(s.material, m.ior, entering);
-        let cos_i = view.dot(n).clamp(0.0, 1.0);
-        let (reflected, transmitted) = if m.fresnel && kt != Color::ZERO {
-            let f = schlick_reflectance(cos_i, n_from, n_to);
-            (kr + kt * f, kt * (1.0 - f))
-        } else {
-            (kr, kt)
-        };
-        let mut reflected_weight = alpha * reflected;
-        let mut transmitted_weight = alpha * transmitted + (Color::ONE - alpha);
-        let refracted = if transmitted_weight == Color::ZERO {
-            None
-        } else {
-            refract(incident, n, n_from / n_to)
-        };
-        if refracted.is_none() {
-            reflected_weight += transmitted_weight;
-            transmitted_weight = Color::ZERO;
-        }
+        let Lobes {
+            mirror: reflected_weight,
+            refraction: transmitted_weight,
+            refracted,
+            ..
+        } = m.lobes(s.uv, incident, n, n_from, n_to);
 
         let child = weight * reflected_weight.max_element();
         if child >= self.limits.min_weight && reflected_weight != Color::ZERO {
@@ -199,7 +188,6 @@ impl<'a> Whitted<'a> {
             let child = weight * transmitted_weight.max_element();
             if child >= self.limits.min_weight {
                 counts[RayKind::Refracted] += 1;
-                let dir = dir.normalize();
                 let origin = offset_ray_origin(s.point, s.point_error, s.normal, dir);
                 let c = self.trace(
                     &Ray::new(origin, dir),
