@@ -8,10 +8,9 @@
 
 use rayon::prelude::*;
 
+use super::build_structure;
 use super::entry::{Entry, Query, leaf_hit, leaf_occludes};
-use crate::accel::{
-    AccelKind, AccelerationStructure, Accelerator, KdTree, KdTreeBuildParams, QueryContext,
-};
+use crate::accel::{AccelKind, AccelerationStructure, Accelerator, QueryContext};
 use crate::math::{Aabb, Ray};
 use crate::mesh::TriangleMesh;
 use crate::shape::{ShapeHit, clipped_triangle_bounds};
@@ -41,17 +40,9 @@ impl MeshStructure {
             .map(|t| mesh.triangle_bounds(t))
             .collect();
         let bounds = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(b));
-        let accel = match kind {
-            AccelKind::KdTree => {
-                let clip = |t: u32, cell: &Aabb| clipped_triangle_bounds(mesh.corners(t), cell);
-                Accelerator::KdTree(KdTree::build_clipped(
-                    &boxes,
-                    &KdTreeBuildParams::default(),
-                    &clip,
-                ))
-            }
-            _ => Accelerator::build(kind, &boxes),
-        };
+        let accel = build_structure(kind, &boxes, &|t, cell| {
+            clipped_triangle_bounds(mesh.corners(t), cell)
+        });
         let order = accel.leaf_order();
         let count = order.map_or(boxes.len(), <[u32]>::len);
         let entries = (0..count)

@@ -29,7 +29,7 @@ pub use objects::{MaterialId, MeshId, MeshInstance, Objects, Primitive, Primitiv
 pub use packet::{PACKET_SIZE, PacketHits, RayPacket};
 
 use crate::accel::{
-    AccelKind, AccelerationStructure, Accelerator, KdTree, KdTreeBuildParams, QueryContext,
+    AccelKind, AccelerationStructure, Accelerator, Clipper, KdTree, KdTreeBuildParams, QueryContext,
 };
 use crate::math::{Aabb, Ray, Transform};
 use crate::shape::{Shape, ShapeHit, clipped_triangle_bounds};
@@ -40,6 +40,20 @@ use rayon::prelude::*;
 /// Triangles per parallel task when preparing meshes: fewer are prepared
 /// on the calling thread.
 const PARALLEL_CHUNK: usize = 4096;
+
+/// A structure of `kind` over `boxes`. A kd-tree makes perfect splits: it
+/// clips each primitive to its cells with `clip`; the other structures have
+/// no use for it.
+fn build_structure(kind: AccelKind, boxes: &[Aabb], clip: Clipper) -> Accelerator {
+    match kind {
+        AccelKind::KdTree => Accelerator::KdTree(KdTree::build_clipped(
+            boxes,
+            &KdTreeBuildParams::default(),
+            clip,
+        )),
+        _ => Accelerator::build(kind, boxes),
+    }
+}
 
 /// What a primitive number stands for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -204,23 +218,16 @@ impl<'a> World<'a> {
             let triangle = slot - run_first[run];
             Entry::triangle(instance_first[k] + triangle, mesh.corners(triangle))
         };
-        // Perfect splits for the kd-tree: a triangle's bounds in a cell are
-        // those of its part inside the cell; other entries keep their box ∩
-        // the cell. The other structures have no use for a clipper.
-        let accel = match kind {
-            AccelKind::KdTree => {
-                let clip = |slot: u32, cell: &Aabb| match slot_entry(slot).corners() {
-                    Some(c) => clipped_triangle_bounds(*c, cell),
-                    None => boxes[slot as usize].intersection(cell),
-                };
-                Accelerator::KdTree(KdTree::build_clipped(
-                    &boxes,
-                    &KdTreeBuildParams::default(),
-                    &clip,
-                ))
-            }
-            _ => Accelerator::build(kind, &boxes),
-        };
+        // A triangle's bounds in a kd-tree cell are those of its part
+        // inside the cell; other entries keep their box ∩ the cell.
+        let accel = build_structure(
+            kind,
+            &boxes,
+            &|slot, cell| match slot_entry(slot).corners() {
+                Some(c) => clipped_triangle_bounds(*c, cell),
+                None => boxes[slot as usize].intersection(cell),
+            },
+        );
         // Gathered straight from the objects, in parallel, in the order the
         // queries name them (tried copying them in slot order first: slower,
         // see docs/performance.md).
@@ -425,6 +432,16 @@ impl<'a> World<'a> {
             .any(|&i| self.shape_occludes(i, &query))
         {
             return true;
+        }
+        if self.instance_count == 0 {
+            // One level: no instance walk to count apart (the kitchen's
+            // shadow rays were 2% slower without this path, see
+            // docs/performance.md, world entries and preparation).
+            return self.accel.occluded_in_leaf_order(ray, ctx, |range| {
+                leaf_occludes(&self.entries, range, &query, self.wide_triangles, |e| {
+                    self.shape_occludes(e.number, &query)
+                })
+            });
         }
         let mut inner = QueryContext::new(ctx.coherence);
         let occluded = self.accel.occluded_in_leaf_order(ray, ctx, |range| {
