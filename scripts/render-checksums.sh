@@ -32,11 +32,21 @@ for scene in scenes/*.toml; do
       -o "$out/$name.$accel.pfm"
   done
 done
+absent=()
 for scene in "$shared"/spd/*.nff; do
   name=$(basename "$scene" .nff)
-  if [ -f "$scene" ]; then render "spd-$name" "$scene" --width 200 --height 200; fi
+  if [ -f "$scene" ]; then
+    render "spd-$name" "$scene" --width 200 --height 200
+  else
+    absent+=("$scene")
+  fi
 done
 kitchen=$shared/models/kitchen/kitchen.obj
-if [ -f "$kitchen" ]; then render kitchen "$kitchen" --width 160 --height 120; fi
+if [ -f "$kitchen" ]; then
+  render kitchen "$kitchen" --width 160 --height 120
+else
+  absent+=("$kitchen")
+fi
 cd "$out"
 sha256sum -- * | sort -k2
+for file in "${absent[@]}"; do echo "absent: $file"; done

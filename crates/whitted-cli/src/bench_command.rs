@@ -160,8 +160,8 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         }
         None => {
             status.set("generating rays".to_string());
-            let geometry = World::new(&scene.objects);
-            let sets = scene_ray_sets(&scene, &geometry, args.width, args.height);
+            let world = World::new(&scene.objects);
+            let sets = scene_ray_sets(&scene, &world, args.width, args.height);
             let none = sets.iter().map(|_| None).collect();
             (sets, none)
         }
@@ -182,8 +182,8 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
             continue;
         }
         status.set(format!("building {}", kind.name()));
-        let (geometry, build_seconds) = time_build(&scene, kind, args.runs);
-        let stats = geometry.accelerator().stats();
+        let (world, build_seconds) = time_build(&scene, kind, args.runs);
+        let stats = world.accelerator().stats();
         let mut kind_reports = Vec::new();
         for (set, reference) in sets.iter().zip(&references) {
             status.set(format!(
@@ -191,20 +191,20 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
                 kind.name(),
                 set.kind.name()
             ));
-            let (results, counters) = trace_all(&geometry, set);
+            let (results, counters) = trace_all(&world, set);
             let per_ray = |n: u64| n as f64 / set.rays.len().max(1) as f64;
             status.set(format!(
                 "{}: {} rays, 1 thread",
                 kind.name(),
                 set.kind.name()
             ));
-            let seconds_one = time_set(&geometry, set, 1, args.runs)?;
+            let seconds_one = time_set(&world, set, 1, args.runs)?;
             status.set(format!(
                 "{}: {} rays, {all_threads} threads",
                 kind.name(),
                 set.kind.name()
             ));
-            let seconds_all = time_set(&geometry, set, all_threads, args.runs)?;
+            let seconds_all = time_set(&world, set, all_threads, args.runs)?;
             kind_reports.push(KindReport {
                 kind: set.kind,
                 rays: set.rays.len(),
@@ -239,17 +239,17 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
 fn time_build(scene: &Scene, kind: AccelKind, runs: usize) -> (World<'_>, f64) {
     let build = || {
         let start = Instant::now();
-        let geometry = World::build(&scene.objects, kind);
-        (geometry, start.elapsed().as_secs_f64())
+        let world = World::build(&scene.objects, kind);
+        (world, start.elapsed().as_secs_f64())
     };
-    let (mut geometry, mut best) = build();
+    let (mut world, mut best) = build();
     for _ in 1..runs {
         // The previous structure goes first, as Embree's scene does.
-        drop(geometry);
+        drop(world);
         let (rebuilt, seconds) = build();
-        (geometry, best) = (rebuilt, best.min(seconds));
+        (world, best) = (rebuilt, best.min(seconds));
     }
-    (geometry, best)
+    (world, best)
 }
 
 fn mrays(rays: usize, seconds: f64) -> f64 {

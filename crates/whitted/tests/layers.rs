@@ -47,9 +47,10 @@ fn rust_files(folder: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// The file's code without comments and without its trailing test module.
+/// The file's code without comments and without its inline test module
+/// (`#[cfg(test)] mod tests { ... }`, at the end of a file).
 fn code_of(text: &str) -> String {
-    let end = text.find("#[cfg(test)]\nmod tests").unwrap_or(text.len());
+    let end = text.find("#[cfg(test)]\nmod tests {").unwrap_or(text.len());
     text[..end]
         .lines()
         .filter(|line| !line.trim_start().starts_with("//"))
@@ -57,18 +58,100 @@ fn code_of(text: &str) -> String {
         .join("\n")
 }
 
-/// Every top-level module named as `crate::name` in `code`.
-fn named_modules(code: &str) -> Vec<String> {
-    let mut names = Vec::new();
-    let mut rest = code;
-    while let Some(at) = rest.find("crate::") {
-        rest = &rest[at + "crate::".len()..];
-        let name: String = rest
-            .chars()
-            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
-            .collect();
-        names.push(name);
+/// How deep the module of `relative` (a path under `src/`) sits below the
+/// crate root: `lib.rs` 0, `world/mod.rs` 1, `world/entry.rs` 2.
+fn module_depth(relative: &Path) -> usize {
+    let parts = relative.components().count();
+    if relative
+        .file_name()
+        .is_some_and(|f| f == "mod.rs" || f == "lib.rs")
+    {
+        parts - 1
+    } else {
+        parts
     }
+}
+
+/// The identifier at the start of `text`.
+fn identifier(text: &str) -> String {
+    text.chars()
+        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+        .collect()
+}
+
+/// The first path segment of each item of the `{...}` group `text` starts
+/// with (`{a::X, b::{Y, Z}}` gives `a` and `b`).
+fn group_heads(text: &str) -> Vec<String> {
+    let mut heads = Vec::new();
+    let mut depth = 0;
+    let mut at_item = true;
+    for (i, c) in text.char_indices() {
+        match c {
+            '{' => {
+                depth += 1;
+                at_item = depth == 1;
+            }
+            '}' => {
+                depth -= 1;
+                if depth == 0 {
+                    break;
+                }
+            }
+            ',' if depth == 1 => at_item = true,
+            c if at_item && !c.is_whitespace() => {
+                heads.push(identifier(&text[i..]));
+                at_item = false;
+            }
+            _ => {}
+        }
+    }
+    heads
+}
+
+/// The top-level modules named at the start of `rest` (just past a path
+/// that leads to the crate root): one identifier, or the heads of a group.
+fn heads_at(rest: &str) -> Vec<String> {
+    let rest = rest.trim_start();
+    if rest.starts_with('{') {
+        group_heads(rest)
+    } else {
+        vec![identifier(rest)]
+    }
+}
+
+/// Every top-level module that `code`, the code of a module `depth` levels
+/// below the crate root, names: through `crate::`, and through as many
+/// `super::` as lead to the root.
+fn named_modules(code: &str, depth: usize) -> Vec<String> {
+    let compact: String = code.split_whitespace().collect::<Vec<_>>().join(" ");
+    let compact = compact.replace(" ::", "::").replace(":: ", "::");
+    let mut names = Vec::new();
+    let bytes = compact.as_bytes();
+    let mut i = 0;
+    while i < compact.len() {
+        let starts_word = i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'_');
+        let rest = &compact[i..];
+        if starts_word && rest.starts_with("crate::") {
+            names.extend(heads_at(&rest["crate::".len()..]));
+            i += "crate::".len();
+            continue;
+        }
+        if starts_word && rest.starts_with("super::") {
+            let mut k = 0;
+            let mut tail = rest;
+            while let Some(next) = tail.strip_prefix("super::") {
+                k += 1;
+                tail = next;
+            }
+            if k == depth {
+                names.extend(heads_at(tail));
+            }
+            i += k * "super::".len();
+            continue;
+        }
+        i += rest.chars().next().map_or(1, char::len_utf8);
+    }
+    names.retain(|n| !n.is_empty() && n != "self");
     names
 }
 
@@ -100,8 +183,8 @@ fn violations() -> Vec<String> {
         };
         let only = ONLY.iter().find(|(m, _)| *m == module).map(|(_, o)| *o);
         let code = code_of(&std::fs::read_to_string(&file).unwrap());
-        for target in named_modules(&code) {
-            if target == module || target.is_empty() {
+        for target in named_modules(&code, module_depth(relative)) {
+            if target == module {
                 continue;
             }
             let allowed = match (only, layer_of(&target)) {
@@ -150,5 +233,38 @@ fn the_check_sees_an_upward_import_and_ignores_comments_and_tests() {
         "use crate::math::Vec3;\n/// See [`crate::render`].\nfn f() { crate::scene::load(); }\n\
          #[cfg(test)]\nmod tests {\n    use crate::bench::x;\n}\n",
     );
-    assert_eq!(named_modules(&code), ["math", "scene"]);
+    assert_eq!(named_modules(&code, 1), ["math", "scene"]);
+}
+
+#[test]
+fn the_check_sees_grouped_imports_and_paths_through_super() {
+    let code = "use crate::{render::Scene, shading::{Color, Light}};\n\
+                use super::super::integrator::Whitted;\n\
+                use super::entry::Entry;\n\
+                fn f() { crate :: image::Film::new(); }\n";
+    // Two levels down, `super::super` is the crate root and `super` is not;
+    // one level down, `super` is.
+    assert_eq!(
+        named_modules(code, 2),
+        ["render", "shading", "integrator", "image"]
+    );
+    assert_eq!(
+        named_modules(code, 1),
+        ["render", "shading", "entry", "image"]
+    );
+}
+
+#[test]
+fn a_test_module_declared_in_another_file_does_not_hide_the_code_after_it() {
+    let code = code_of("#[cfg(test)]\nmod tests;\n\nuse crate::render::Scene;\n");
+    assert_eq!(named_modules(&code, 1), ["render"]);
+}
+
+#[test]
+fn module_depth_counts_from_the_crate_root() {
+    assert_eq!(module_depth(Path::new("lib.rs")), 0);
+    assert_eq!(module_depth(Path::new("world/mod.rs")), 1);
+    assert_eq!(module_depth(Path::new("math.rs")), 1);
+    assert_eq!(module_depth(Path::new("world/entry.rs")), 2);
+    assert_eq!(module_depth(Path::new("accel/kdtree/mod.rs")), 2);
 }

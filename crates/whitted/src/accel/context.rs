@@ -47,9 +47,10 @@ impl std::ops::AddAssign for TraversalCounters {
     }
 }
 
-/// The context of a query: the caller's hint in, the work done out. One
-/// per thread of queries (a tile, a benchmark's chunk of rays); the
-/// counters add up over the queries made with it.
+/// The context of a query: the caller's hint in, the work done out. A
+/// caller may keep one per thread of queries (`whitted bench` does) or make
+/// a default one per query; the counters add up over the queries made with
+/// it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct QueryContext {
     /// How the rays of the queries made with this context relate.

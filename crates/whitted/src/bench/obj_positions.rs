@@ -222,10 +222,10 @@ mod tests {
         let soup = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 4\nf 1 2 3\n").unwrap();
         let camera = Camera::framing(&soup.bounds(), 1.0, 50.0).unwrap();
         let scene = soup.to_scene(camera).unwrap();
-        let geometry = crate::world::World::new(&scene.objects);
-        assert_eq!(geometry.len(), 2);
+        let world = crate::world::World::new(&scene.objects);
+        assert_eq!(world.len(), 2);
         let ray = crate::math::Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z);
-        assert_eq!(geometry.intersect(&ray).unwrap().primitive.0, 1);
+        assert_eq!(world.intersect(&ray).unwrap().primitive.0, 1);
     }
 
     #[test]

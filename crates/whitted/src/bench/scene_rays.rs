@@ -13,7 +13,7 @@ use crate::world::World;
 /// rays go towards the scene's first light (or, without lights, a point
 /// above the scene's bounds) and are cast only where it is above the
 /// surface. Diffuse directions are seeded by the pixel index.
-pub fn scene_ray_sets(scene: &Scene, geometry: &World, width: u32, height: u32) -> Vec<RaySet> {
+pub fn scene_ray_sets(scene: &Scene, world: &World, width: u32, height: u32) -> Vec<RaySet> {
     let mut primary = Vec::with_capacity(width as usize * height as usize);
     for y in 0..height {
         for x in 0..width {
@@ -25,14 +25,14 @@ pub fn scene_ray_sets(scene: &Scene, geometry: &World, width: u32, height: u32) 
         .lights
         .first()
         .cloned()
-        .unwrap_or_else(|| default_light(geometry.bounds()));
+        .unwrap_or_else(|| default_light(world.bounds()));
     let mut shadow = Vec::new();
     let mut diffuse = Vec::new();
     for (index, ray) in primary.iter().enumerate() {
-        let Some(hit) = geometry.intersect(ray) else {
+        let Some(hit) = world.intersect(ray) else {
             continue;
         };
-        let s = geometry.surface(ray, &hit);
+        let s = world.surface(ray, &hit);
         let n = if ray.dir.dot(s.normal) < 0.0 {
             s.normal
         } else {
@@ -117,8 +117,8 @@ mod tests {
     #[test]
     fn default_scene_gives_every_kind_of_ray() {
         let scene = crate::scene::default_scene();
-        let geometry = World::new(&scene.objects);
-        let sets = scene_ray_sets(&scene, &geometry, 32, 24);
+        let world = World::new(&scene.objects);
+        let sets = scene_ray_sets(&scene, &world, 32, 24);
         assert_eq!(sets[0].rays.len(), 32 * 24);
         assert!(!sets[1].rays.is_empty() && !sets[2].rays.is_empty());
         assert!(sets[1].rays.len() <= sets[2].rays.len());

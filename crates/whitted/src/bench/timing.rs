@@ -25,13 +25,13 @@ pub enum TraceResults {
 /// Traces every ray once on this thread, keeping each result, and counts the
 /// traversal work of all of them. Here and in [`time_set`] the queries are
 /// told how the set's rays relate ([`super::RayKind::coherence`]).
-pub fn trace_all(geometry: &World, set: &RaySet) -> (TraceResults, TraversalCounters) {
+pub fn trace_all(world: &World, set: &RaySet) -> (TraceResults, TraversalCounters) {
     let mut ctx = QueryContext::new(set.kind.coherence());
     let results = if set.kind.is_any_hit() {
         TraceResults::Occluded(
             set.rays
                 .iter()
-                .map(|r| geometry.occluded_with(r, &mut ctx))
+                .map(|r| world.occluded_with(r, &mut ctx))
                 .collect(),
         )
     } else {
@@ -39,7 +39,7 @@ pub fn trace_all(geometry: &World, set: &RaySet) -> (TraceResults, TraversalCoun
             set.rays
                 .iter()
                 .map(|r| {
-                    geometry
+                    world
                         .intersect_with(r, &mut ctx)
                         .map(|h| (h.t(), h.primitive.0))
                 })
@@ -55,12 +55,7 @@ pub fn trace_all(geometry: &World, set: &RaySet) -> (TraceResults, TraversalCoun
 /// Each thread takes the next 256 rays from a shared counter until
 /// none are left, as the anchor harness hands out its tiles (tried rayon's
 /// `par_chunks`: scaled worse, see docs/performance.md).
-pub fn time_set(
-    geometry: &World,
-    set: &RaySet,
-    threads: usize,
-    runs: usize,
-) -> Result<f64, String> {
+pub fn time_set(world: &World, set: &RaySet, threads: usize, runs: usize) -> Result<f64, String> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -70,9 +65,9 @@ pub fn time_set(
     let trace = |chunk: &[Ray], ctx: &mut QueryContext| {
         let found = |r: &&Ray| {
             if set.kind.is_any_hit() {
-                geometry.occluded_with(r, ctx)
+                world.occluded_with(r, ctx)
             } else {
-                geometry.intersect_with(r, ctx).is_some()
+                world.intersect_with(r, ctx).is_some()
             }
         };
         chunk.iter().filter(found).count()

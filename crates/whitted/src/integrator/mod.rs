@@ -12,7 +12,7 @@ mod ray_counts;
 mod whitted;
 
 pub use ray_counts::{RayCounts, RayKind};
-pub use whitted::{Whitted, WhittedLimits};
+pub use whitted::Whitted;
 
 use crate::accel::{QueryContext, TraversalCounters};
 use crate::math::Ray;
@@ -32,24 +32,22 @@ pub struct Shading<'a> {
     pub ambient: Color,
 }
 
+/// How deep an integrator's recursion may go.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RecursionLimits {
+    /// Deepest reflection/refraction recursion; 0 traces primary rays only.
+    pub max_depth: u32,
+    /// A branch whose weight on the pixel falls below this stops early
+    /// (adaptive depth control, Hall and Greenberg 1983).
+    pub min_weight: f64,
+}
+
 /// Which integrator to use.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum IntegratorKind {
     /// Whitted's recursive ray tracing ([`Whitted`]).
     #[default]
     Whitted,
-}
-
-impl IntegratorKind {
-    /// Every kind.
-    pub const ALL: [IntegratorKind; 1] = [IntegratorKind::Whitted];
-
-    /// The name used on the command line and in scene files.
-    pub fn name(&self) -> &'static str {
-        match self {
-            IntegratorKind::Whitted => "whitted",
-        }
-    }
 }
 
 /// The result of tracing one camera ray.
@@ -75,7 +73,7 @@ impl<'a> Integrator<'a> {
         kind: IntegratorKind,
         world: &'a World<'a>,
         shading: Shading<'a>,
-        limits: WhittedLimits,
+        limits: RecursionLimits,
     ) -> Self {
         match kind {
             IntegratorKind::Whitted => Integrator::Whitted(Whitted::new(world, shading, limits)),

@@ -22,7 +22,7 @@
 //! - Recursion stops at `max_depth`, and earlier when a branch's weight on
 //!   the pixel falls below `min_weight` (adaptive depth control).
 
-use crate::integrator::{PrimarySample, RayCounts, RayKind, Shading};
+use crate::integrator::{PrimarySample, RayCounts, RayKind, RecursionLimits, Shading};
 use crate::math::{Ray, Vec3, offset_ray_origin};
 use crate::shading::optics::reflect;
 use crate::shading::{Color, Crossing, Light, Lobes, Material, MediumStack, phong, shading_normal};
@@ -31,22 +31,12 @@ use crate::world::{Surface, World};
 /// Longest chain of transmissive surfaces one shadow ray passes through.
 const MAX_SHADOW_CROSSINGS: usize = 64;
 
-/// How deep the recursion may go.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct WhittedLimits {
-    /// Deepest reflection/refraction recursion; 0 traces primary rays only.
-    pub max_depth: u32,
-    /// A branch whose weight on the pixel falls below this stops early
-    /// (adaptive depth control, Hall and Greenberg 1983).
-    pub min_weight: f64,
-}
-
 /// Whitted's recursive ray tracer over a prepared world.
 #[derive(Debug)]
 pub struct Whitted<'a> {
     world: &'a World<'a>,
     shading: Shading<'a>,
-    limits: WhittedLimits,
+    limits: RecursionLimits,
     any_transmissive: bool,
 }
 
@@ -56,7 +46,7 @@ impl<'a> Whitted<'a> {
 
     /// Prepares to trace in `world`, shading with `shading`, within
     /// `limits`.
-    pub fn new(world: &'a World<'a>, shading: Shading<'a>, limits: WhittedLimits) -> Self {
+    pub fn new(world: &'a World<'a>, shading: Shading<'a>, limits: RecursionLimits) -> Self {
         Self {
             world,
             shading,

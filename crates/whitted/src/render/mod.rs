@@ -15,11 +15,11 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use rayon::prelude::*;
 
 use crate::image::Film;
-use crate::integrator::{Integrator, RayCounts, RayKind, Shading, WhittedLimits};
+use crate::integrator::{Integrator, RayCounts, RayKind, RecursionLimits, Shading};
 use crate::math::random::hash64;
 use crate::math::sampling::pixel_sample;
 use crate::shading::Color;
-use crate::world::World;
+use crate::world::{MAX_PRIMITIVES, World};
 
 /// Side of the square tiles the image is cut into, in pixels.
 const TILE_SIZE: u32 = 16;
@@ -80,6 +80,12 @@ pub enum RenderError {
         /// Requested height.
         height: u32,
     },
+    /// More primitives (every placement of a mesh counted) than a world
+    /// numbers.
+    #[error(
+        "the scene has {0} primitives (every placement of a mesh counted): at most {MAX_PRIMITIVES} are allowed"
+    )]
+    TooManyPrimitives(usize),
     /// The thread pool could not be created.
     #[error("could not start {threads} worker threads: {message}")]
     Threads {
@@ -122,6 +128,10 @@ pub fn render(
     if u64::from(width) * u64::from(height) > MAX_PIXELS {
         return Err(RenderError::TooManyPixels { width, height });
     }
+    let primitives = scene.objects.primitive_count();
+    if primitives > MAX_PRIMITIVES {
+        return Err(RenderError::TooManyPrimitives(primitives));
+    }
     let mut pool =
         rayon::ThreadPoolBuilder::new().stack_size(worker_stack_bytes(settings.max_depth));
     if let Some(threads) = settings.threads {
@@ -139,7 +149,7 @@ pub fn render(
         background: scene.background,
         ambient: scene.ambient,
     };
-    let limits = WhittedLimits {
+    let limits = RecursionLimits {
         max_depth: settings.max_depth,
         min_weight: settings.min_weight,
     };

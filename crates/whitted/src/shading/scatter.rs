@@ -558,7 +558,7 @@ mod tests {
         assert_eq!(lobes.refracted, Some(incident));
         let clear = Material {
             opacity: Color::ZERO.into(),
-            ..half
+            ..half.clone()
         };
         let mut rng = Rng::new(10);
         for _ in 0..1000 {
@@ -568,6 +568,26 @@ mod tests {
             assert_eq!(s.kind, ScatterKind::Refract);
             assert_eq!((s.direction, s.weight), (incident, Color::ONE));
         }
+        // Half dissolved: half the photons go straight on, a fifth are
+        // mirrored (α kr), the rest are absorbed.
+        let samples = 20_000;
+        let (mut through, mut mirrored) = (0, 0);
+        for _ in 0..samples {
+            match half.sample(DVec2::ZERO, incident, Vec3::Z, 1.0, 1.0, three(&mut rng)) {
+                Some(s) if s.kind == ScatterKind::Refract => {
+                    assert_eq!(s.direction, incident);
+                    through += 1;
+                }
+                Some(s) => {
+                    assert_eq!(s.kind, ScatterKind::Mirror);
+                    mirrored += 1;
+                }
+                None => {}
+            }
+        }
+        let fraction = |n: i32| f64::from(n) / f64::from(samples);
+        assert!((fraction(through) - 0.5).abs() < 0.02, "{through}");
+        assert!((fraction(mirrored) - 0.2).abs() < 0.02, "{mirrored}");
     }
 
     #[test]

@@ -110,7 +110,7 @@ pub(super) fn intersect_triangle(
 
 /// The closest of `entries[range]` hit by the query's ray closer than
 /// `t_max`: triangles here, other entries by `other(entry, t_max)`, which
-/// returns the hit's `t` and the number to report. `found(number, hit)` is
+/// returns the number to report and the hit. `found(number, hit)` is
 /// told of each nearer hit; returns the closest `t`. One entry at a time:
 /// tried testing runs of triangles four at a time as [`leaf_occludes`]
 /// does: slower, see docs/performance.md (four-at-once triangle test).

@@ -8,15 +8,12 @@
 
 use rayon::prelude::*;
 
-use super::build_structure;
 use super::entry::{Entry, Query, leaf_hit, leaf_occludes};
+use super::{PARALLEL_CHUNK, build_structure};
 use crate::accel::{AccelKind, AccelerationStructure, Accelerator, QueryContext};
 use crate::math::{Aabb, Ray};
 use crate::mesh::TriangleMesh;
 use crate::shape::{ShapeHit, clipped_triangle_bounds};
-
-/// Triangles per parallel task when preparing a mesh.
-const PARALLEL_CHUNK: usize = 4096;
 
 /// A mesh's triangles under their own acceleration structure, in mesh
 /// space.

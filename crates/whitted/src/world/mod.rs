@@ -41,6 +41,9 @@ use rayon::prelude::*;
 /// on the calling thread.
 const PARALLEL_CHUNK: usize = 4096;
 
+/// The most primitives a world numbers: a [`PrimitiveId`] is 32 bits.
+pub const MAX_PRIMITIVES: usize = u32::MAX as usize;
+
 /// A structure of `kind` over `boxes`. A kd-tree makes perfect splits: it
 /// clips each primitive to its cells with `clip`; the other structures have
 /// no use for it.
@@ -106,7 +109,18 @@ impl<'a> World<'a> {
     }
 
     /// Prepares the objects with the structure `kind`, at both levels.
+    ///
+    /// # Panics
+    ///
+    /// When the objects have more than [`MAX_PRIMITIVES`] primitives
+    /// (placements counted): [`crate::render::render`] refuses such a scene
+    /// with an error before building its world.
     pub fn build(objects: &'a Objects, kind: AccelKind) -> Self {
+        let n = objects.primitive_count();
+        assert!(
+            n <= MAX_PRIMITIVES,
+            "{n} primitives: a world numbers at most {MAX_PRIMITIVES}"
+        );
         let to_world =
             |transform: Option<TransformId>, local: Aabb| match objects.transform(transform) {
                 Some(t) => t.bounds_to_world(&local),
@@ -141,8 +155,17 @@ impl<'a> World<'a> {
 
         // The structure's slots: bounded shapes, then the triangles of each
         // mesh placed directly, then the instances.
-        let n = objects.primitive_count();
-        let mut boxes = Vec::with_capacity(n);
+        // One box per bounded shape, per triangle of a mesh placed
+        // directly, per instance: not per triangle of every placement.
+        let placed_directly: usize = objects
+            .mesh_instances
+            .iter()
+            .filter(|m| !instanced(m))
+            .map(|m| objects.meshes[m.mesh.0 as usize].len())
+            .sum();
+        let mut boxes = Vec::with_capacity(
+            objects.primitives.len() + placed_directly + objects.mesh_instances.len(),
+        );
         let mut slot_shapes = Vec::new();
         let mut unbounded = Vec::new();
         for (i, p) in objects.primitives.iter().enumerate() {
@@ -155,8 +178,7 @@ impl<'a> World<'a> {
             }
         }
         // The first slot of each directly placed mesh's run of triangles,
-        // and its instance. A mesh's triangles are prepared in parallel (a
-        // fifth of the bunny's build time otherwise).
+        // and its instance. A mesh's triangles are prepared in parallel.
         let mut run_first = Vec::new();
         let mut run_instance = Vec::new();
         for (k, m) in objects.mesh_instances.iter().enumerate() {
@@ -176,8 +198,10 @@ impl<'a> World<'a> {
         let first_instance_slot = boxes.len() as u32;
         let mut slot_instances = Vec::new();
         for (k, m) in objects.mesh_instances.iter().enumerate() {
+            // An instance of an empty mesh has nothing to hit.
             if let Some(structure) = &mesh_structures[m.mesh.0 as usize]
                 && instanced(m)
+                && !structure.bounds().is_empty()
             {
                 boxes.push(to_world(m.transform, structure.bounds()));
                 slot_instances.push(k as u32);
@@ -434,9 +458,8 @@ impl<'a> World<'a> {
             return true;
         }
         if self.instance_count == 0 {
-            // One level: no instance walk to count apart (the kitchen's
-            // shadow rays were 2% slower without this path, see
-            // docs/performance.md, world entries and preparation).
+            // One level, no instance walk to count apart (tried one path for
+            // both: slower, see docs/performance.md).
             return self.accel.occluded_in_leaf_order(ray, ctx, |range| {
                 leaf_occludes(&self.entries, range, &query, self.wide_triangles, |e| {
                     self.shape_occludes(e.number, &query)
@@ -679,6 +702,14 @@ mod tests {
             .unwrap()
             .then_after(&Transform::scale(Vec3::new(0.5, 1.5, 1.0)).unwrap());
         scene.add_mesh_instance(mesh, m, moved);
+        // A second soup, placed once where it was modelled: its triangles
+        // go into the top level beside the shapes and the two instances.
+        let positions: Vec<Vec3> = (0..300)
+            .map(|_| rng.point_in(Vec3::splat(-4.0), Vec3::splat(4.0)))
+            .collect();
+        let triangles: Vec<[u32; 3]> = (0..100).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        let direct = scene.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
+        scene.add_mesh_instance(direct, m, Transform::IDENTITY);
         let plane = Plane::new(Vec3::new(0.0, -6.0, 0.0), Vec3::Y).unwrap();
         scene.add_primitive(Shape::Plane(plane), m, Transform::IDENTITY);
 
@@ -696,6 +727,8 @@ mod tests {
             .collect();
         for kind in AccelKind::ALL {
             let world = World::build(&scene, kind);
+            assert_eq!(world.instance_count(), 2);
+            assert_eq!(world.len(), 43 + 2 * 200 + 100);
             let mut hits = 0;
             for ray in &rays {
                 let expected = oracle.intersect(ray);
@@ -809,7 +842,17 @@ mod tests {
             let sphere = Sphere::new(centre, rng.range(0.1, 0.6)).unwrap();
             objects.add_primitive(Shape::Sphere(sphere), MaterialId(0), Transform::IDENTITY);
         }
+        let positions: Vec<Vec3> = (0..90)
+            .map(|_| rng.point_in(Vec3::splat(-3.0), Vec3::splat(3.0)))
+            .collect();
+        let triangles: Vec<[u32; 3]> = (0..30).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        let soup = objects.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
+        objects.add_mesh_instance(soup, MaterialId(0), Transform::IDENTITY);
+        let moved = Transform::translate(Vec3::new(1.0, 0.5, -1.0)).unwrap();
+        let other = objects.add_mesh(objects.meshes[0].clone());
+        objects.add_mesh_instance(other, MaterialId(0), moved);
         let world = World::new(&objects);
+        assert_eq!(world.instance_count(), 1);
         let mut hits = 0;
         for round in 0..200 {
             let count = round % (PACKET_SIZE + 1);

@@ -217,8 +217,8 @@ fn run_ray_files(workspace: &Workspace, parts: &[Vec<u8>], accel: AccelKind) -> 
         static SCENE: Scene = ray_target_scene();
     }
     SCENE.with(|scene| {
-        let geometry = World::build(&scene.objects, accel);
-        let _ = trace_all(&geometry, &file.set);
+        let world = World::build(&scene.objects, accel);
+        let _ = trace_all(&world, &file.set);
     });
     true
 }
