@@ -6,7 +6,7 @@
 //! See [`crate::shading::material`] for the formula and the Fresnel option.
 //!
 //! The direct light is [`crate::shading::phong`] and the weights of the
-//! secondary rays are [`Material::lobes`]: the shading layer's own answers,
+//! secondary rays are [`Lobes::new`]: the shading layer's own answers,
 //! which photon mapping will share.
 //!
 //! - Shading is two-sided: the normal is turned to face the incoming ray.
@@ -25,7 +25,9 @@
 use crate::integrator::{PrimarySample, RayCounts, RayKind, RecursionLimits, Shading};
 use crate::math::{Ray, Vec3, offset_ray_origin};
 use crate::shading::optics::reflect;
-use crate::shading::{Color, Crossing, Light, Lobes, Material, MediumStack, phong, shading_normal};
+use crate::shading::{
+    Color, Crossing, Light, Lobes, Material, MediumStack, Weights, phong, shading_normal,
+};
 use crate::world::{Surface, World};
 
 /// Longest chain of transmissive surfaces one shadow ray passes through.
@@ -164,7 +166,19 @@ impl<'a> Whitted<'a> {
             refraction: transmitted_weight,
             refracted,
             ..
-        } = m.lobes(s.uv, incident, n, n_from, n_to);
+        } = Lobes::new(
+            Weights {
+                opacity: alpha,
+                diffuse,
+                reflection: kr,
+                transmission: kt,
+            },
+            m.fresnel,
+            incident,
+            n,
+            n_from,
+            n_to,
+        );
 
         let child = weight * reflected_weight.max_element();
         if child >= self.limits.min_weight && reflected_weight != Color::ZERO {

@@ -22,5 +22,5 @@ pub use emission::EmittedRay;
 pub use light::{Attenuation, Light, LightSample};
 pub use material::Material;
 pub use medium::{Crossing, MediumStack};
-pub use scatter::{Lobes, ScatterKind, ScatterSample, phong};
+pub use scatter::{Lobes, ScatterKind, ScatterSample, Weights, phong};
 pub use texture::Texture;

@@ -107,6 +107,69 @@ pub struct ScatterSample {
     pub probability: f64,
 }
 
+/// A surface point's coefficients, looked up from its material's textures
+/// at one (u, v).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Weights {
+    /// `α`, the opacity.
+    pub opacity: Color,
+    /// `kd`.
+    pub diffuse: Color,
+    /// `kr`.
+    pub reflection: Color,
+    /// `kt`.
+    pub transmission: Color,
+}
+
+impl Lobes {
+    /// The lobes of a point with coefficients `weights` (the transmission
+    /// split by Schlick's term when `fresnel`), for light arriving along
+    /// `incident` through the shading normal `n` between media of indices
+    /// `n_from` and `n_to`. [`Material::lobes`] looks the coefficients up
+    /// first; a caller that has them already (the Whitted integrator)
+    /// passes them.
+    #[inline]
+    pub fn new(
+        weights: Weights,
+        fresnel: bool,
+        incident: Vec3,
+        n: Vec3,
+        n_from: f64,
+        n_to: f64,
+    ) -> Self {
+        let Weights {
+            opacity: alpha,
+            diffuse: kd,
+            reflection: kr,
+            transmission: kt,
+        } = weights;
+        let cos_i = (-incident).dot(n).clamp(0.0, 1.0);
+        let (reflected, transmitted) = if fresnel && kt != Color::ZERO {
+            let f = schlick_reflectance(cos_i, n_from, n_to);
+            (kr + kt * f, kt * (1.0 - f))
+        } else {
+            (kr, kt)
+        };
+        let mut mirror = alpha * reflected;
+        let mut refraction = alpha * transmitted + (Color::ONE - alpha);
+        let refracted = if refraction == Color::ZERO {
+            None
+        } else {
+            refract(incident, n, n_from / n_to)
+        };
+        if refracted.is_none() {
+            mirror += refraction;
+            refraction = Color::ZERO;
+        }
+        Lobes {
+            diffuse: alpha * kd,
+            mirror,
+            refraction,
+            refracted: refracted.map(Vec3::normalize),
+        }
+    }
+}
+
 impl Lobes {
     /// The fraction of the arriving light the surface scatters, per
     /// channel: the sum of the three lobes.
@@ -188,33 +251,13 @@ impl Material {
     /// operations, as the Whitted integrator's reflected and refracted rays
     /// (module documentation).
     pub fn lobes(&self, uv: DVec2, incident: Vec3, n: Vec3, n_from: f64, n_to: f64) -> Lobes {
-        let alpha = self.opacity.at(uv);
-        let kr = self.reflection.at(uv);
-        let kt = self.transmission.at(uv);
-        let cos_i = (-incident).dot(n).clamp(0.0, 1.0);
-        let (reflected, transmitted) = if self.fresnel && kt != Color::ZERO {
-            let f = schlick_reflectance(cos_i, n_from, n_to);
-            (kr + kt * f, kt * (1.0 - f))
-        } else {
-            (kr, kt)
+        let weights = Weights {
+            opacity: self.opacity.at(uv),
+            diffuse: self.diffuse.at(uv),
+            reflection: self.reflection.at(uv),
+            transmission: self.transmission.at(uv),
         };
-        let mut mirror = alpha * reflected;
-        let mut refraction = alpha * transmitted + (Color::ONE - alpha);
-        let refracted = if refraction == Color::ZERO {
-            None
-        } else {
-            refract(incident, n, n_from / n_to)
-        };
-        if refracted.is_none() {
-            mirror += refraction;
-            refraction = Color::ZERO;
-        }
-        Lobes {
-            diffuse: alpha * self.diffuse.at(uv),
-            mirror,
-            refraction,
-            refracted: refracted.map(Vec3::normalize),
-        }
+        Lobes::new(weights, self.fresnel, incident, n, n_from, n_to)
     }
 
     /// Draws the ray (or photon) the surface at `uv` scatters when light

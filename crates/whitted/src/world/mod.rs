@@ -76,6 +76,9 @@ enum PrimitiveRef {
 #[derive(Debug)]
 pub struct World<'a> {
     objects: &'a Objects,
+    /// The shapes, also reachable through `objects`: kept at hand, one
+    /// load nearer, for the leaf loop.
+    shapes: &'a [Primitive],
     /// The first primitive number of each mesh instance's triangles.
     instance_first: Vec<u32>,
     /// The structure of each mesh placed as an instance (several times,
@@ -269,6 +272,7 @@ impl<'a> World<'a> {
         let wide_triangles = false;
         Self {
             objects,
+            shapes: &objects.primitives,
             instance_first,
             mesh_structures,
             accel,
@@ -306,7 +310,7 @@ impl<'a> World<'a> {
     fn intersect_shape(&self, index: u32, query: &Query, t_max: f64) -> Option<ShapeHit> {
         let mut ray = *query.ray;
         ray.t_max = t_max;
-        let p = &self.objects.primitives[index as usize];
+        let p = &self.shapes[index as usize];
         match self.transform(p.transform) {
             Some(t) => p.shape.intersect(&t.ray_to_object(&ray)),
             None => p.shape.intersect(&ray),
@@ -316,7 +320,7 @@ impl<'a> World<'a> {
     /// True when shape `index` lies in the query's ray interval.
     #[inline]
     fn shape_occludes(&self, index: u32, query: &Query) -> bool {
-        let p = &self.objects.primitives[index as usize];
+        let p = &self.shapes[index as usize];
         match self.transform(p.transform) {
             Some(t) => p.shape.occluded(&t.ray_to_object(query.ray)),
             None => p.shape.occluded(query.ray),
