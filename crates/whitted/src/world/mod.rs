@@ -116,7 +116,7 @@ impl<'a> World<'a> {
     /// # Panics
     ///
     /// When the objects have more than [`MAX_PRIMITIVES`] primitives
-    /// (placements counted): [`crate::render::render`] refuses such a scene
+    /// (placements counted): the renderer refuses such a scene
     /// with an error before building its world.
     pub fn build(objects: &'a Objects, kind: AccelKind) -> Self {
         let n = objects.primitive_count();
