@@ -12,15 +12,17 @@
 //! turns each run of patches of one material into a triangle mesh whose
 //! vertex normals are the patches' normals, so a patch is shaded smoothly: at
 //! a vertex the shading normal is that vertex's normal. A patch of more than
-//! three vertices is split into a fan of triangles; a zero-area one is kept
-//! and never hit.
+//! three vertices is cut into triangles by ear clipping in its plane, as an
+//! OBJ face is ([`crate::mesh::triangulate`]), so a concave patch covers
+//! what a `p` polygon with the same vertices covers; a zero-area one is
+//! kept and never hit.
 
 use std::ops::Range;
 
 use super::reader::{Parsed, Reader};
 use super::shapes::vertex_count;
 use crate::math::Vec3;
-use crate::mesh::TriangleMesh;
+use crate::mesh::{TriangleMesh, triangulate};
 use crate::world::MaterialId;
 
 /// One `pp` entity.
@@ -85,9 +87,11 @@ pub(super) fn patches_to_meshes(set: &PatchSet) -> Vec<(TriangleMesh, MaterialId
                 let first = positions.len() as u32;
                 positions.extend_from_slice(&patch.positions);
                 normals.extend(patch.normals.iter().map(|n| n.normalize_or_zero()));
-                for k in 1..patch.positions.len().saturating_sub(1) as u32 {
-                    triangles.push([first, first + k, first + k + 1]);
-                }
+                triangles.extend(
+                    triangulate(&patch.positions)
+                        .into_iter()
+                        .map(|t| t.map(|k| first + k as u32)),
+                );
             }
             // Positions and normals were checked finite as they were read,
             // and every index is in range by construction.
@@ -140,7 +144,9 @@ mod tests {
         let (mesh, material) = &meshes[0];
         assert_eq!(*material, MaterialId(2));
         assert_eq!(mesh.len(), 3);
-        assert_eq!(mesh.triangles(), [[0, 1, 2], [3, 4, 5], [3, 5, 6]]);
+        // The square is cut by ear clipping into two triangles over its
+        // corners 3..7.
+        assert_eq!(mesh.triangles(), [[0, 1, 2], [6, 3, 4], [4, 5, 6]]);
         assert_eq!(meshes[1].1, MaterialId(5));
     }
 

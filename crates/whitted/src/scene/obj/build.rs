@@ -6,8 +6,8 @@
 use std::collections::HashMap;
 
 use super::reader::{Corner, NONE, ObjData};
-use super::triangulate::triangulate;
 use crate::math::{DVec2, Vec3};
+use crate::mesh::triangulate;
 use crate::mesh::{MeshError, TriangleMesh};
 
 /// How a vertex gets its normal; part of what makes two corners the same

@@ -22,7 +22,6 @@ mod maps;
 mod mtl;
 mod reader;
 mod text;
-mod triangulate;
 
 use std::collections::HashMap;
 use std::path::Path;

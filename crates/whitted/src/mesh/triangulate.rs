@@ -6,7 +6,7 @@ use crate::math::{DVec2, Vec3};
 
 /// The polygon's normal by Newell's method (not unit; zero when the
 /// polygon has no area). Robust for concave and slightly non-planar faces.
-pub(super) fn newell_normal(points: &[Vec3]) -> Vec3 {
+pub fn newell_normal(points: &[Vec3]) -> Vec3 {
     let mut normal = Vec3::ZERO;
     for (i, p) in points.iter().enumerate() {
         let q = points[(i + 1) % points.len()];
@@ -30,7 +30,7 @@ pub(super) fn newell_normal(points: &[Vec3]) -> Vec3 {
 /// about `n` times its count of reflex corners, not `n³`. A face that is
 /// not simple can make every search fail; after [`EAR_TESTS`] corner tests
 /// the rest of such a face is clipped as a fan.
-pub(super) fn triangulate(points: &[Vec3]) -> Vec<[usize; 3]> {
+pub fn triangulate(points: &[Vec3]) -> Vec<[usize; 3]> {
     let n = points.len();
     if n < 3 {
         return Vec::new();
