@@ -1,7 +1,8 @@
 //! NFF polygons cover the area inside their outline, whether written as
 //! `p` (a polygon) or as `pp` (a patch, with vertex normals): random
-//! star-shaped and x-monotone concave polygons at random orientations,
-//! checked on random rays against an even-odd point-in-polygon oracle.
+//! star-shaped and x-monotone concave polygons, and outlines that cross
+//! themselves, at random orientations, checked on random rays against an
+//! even-odd point-in-polygon oracle.
 
 use std::fmt::Write;
 use std::path::Path;
@@ -50,6 +51,17 @@ fn monotone(rng: &mut Rng, n: usize) -> Vec<DVec2> {
             .map(|&x| DVec2::new(x, -rng.range(0.02, 1.0))),
     );
     points
+}
+
+/// An outline through `n` random points of the unit disk in random order:
+/// it crosses itself in general.
+fn tangle(rng: &mut Rng, n: usize) -> Vec<DVec2> {
+    (0..n)
+        .map(|_| {
+            let angle = rng.range(0.0, std::f64::consts::TAU);
+            rng.range(0.1, 1.0) * DVec2::new(angle.cos(), angle.sin())
+        })
+        .collect()
 }
 
 /// Even-odd point in polygon.
@@ -108,12 +120,12 @@ fn p_and_pp_polygons_cover_exactly_the_inside_of_their_outline() {
     let mut rng = Rng::new(22);
     let mut checked = 0;
     let mut hits = 0;
-    for case in 0..120 {
+    for case in 0..180 {
         let n = 3 + (case % 38);
-        let outline = if case % 2 == 0 {
-            star(&mut rng, n)
-        } else {
-            monotone(&mut rng, n.max(4))
+        let outline = match case % 3 {
+            0 => star(&mut rng, n),
+            1 => monotone(&mut rng, n.max(4)),
+            _ => tangle(&mut rng, 4 + case % 9),
         };
         let (origin, u, v) = frame(&mut rng);
         let points: Vec<Vec3> = outline.iter().map(|q| origin + q.x * u + q.y * v).collect();

@@ -95,7 +95,7 @@ const EAR_TESTS: usize = 100_000_000;
 
 /// The points in 2D, dropping the normal's largest axis and keeping the
 /// winding counter-clockwise.
-fn project(points: &[Vec3], normal: Vec3) -> Vec<DVec2> {
+pub(super) fn project(points: &[Vec3], normal: Vec3) -> Vec<DVec2> {
     let a = normal.abs();
     let (x, y, sign) = if a.x >= a.y && a.x >= a.z {
         (1, 2, normal.x)

@@ -12,17 +12,18 @@
 //! turns each run of patches of one material into a triangle mesh whose
 //! vertex normals are the patches' normals, so a patch is shaded smoothly: at
 //! a vertex the shading normal is that vertex's normal. A patch of more than
-//! three vertices is cut into triangles by ear clipping in its plane, as an
-//! OBJ face is ([`crate::mesh::triangulate`]), so a concave patch covers
-//! what a `p` polygon with the same vertices covers; a zero-area one is
-//! kept and never hit.
+//! three vertices is cut into triangles that cover it by the even-odd rule
+//! ([`crate::mesh::triangulate_even_odd`]: ear clipping for a simple
+//! outline, as for OBJ faces), so a patch covers exactly what a `p` polygon
+//! with the same vertices covers, concave or crossing itself; a zero-area
+//! one is kept and never hit.
 
 use std::ops::Range;
 
 use super::reader::{Parsed, Reader};
 use super::shapes::vertex_count;
 use crate::math::Vec3;
-use crate::mesh::{TriangleMesh, triangulate};
+use crate::mesh::{Corner, TriangleMesh, triangulate_even_odd};
 use crate::world::MaterialId;
 
 /// One `pp` entity.
@@ -85,13 +86,25 @@ pub(super) fn patches_to_meshes(set: &PatchSet) -> Vec<(TriangleMesh, MaterialId
             let mut triangles = Vec::new();
             for patch in run {
                 let first = positions.len() as u32;
+                let unit: Vec<Vec3> = patch
+                    .normals
+                    .iter()
+                    .map(|n| n.normalize_or_zero())
+                    .collect();
                 positions.extend_from_slice(&patch.positions);
-                normals.extend(patch.normals.iter().map(|n| n.normalize_or_zero()));
-                triangles.extend(
-                    triangulate(&patch.positions)
-                        .into_iter()
-                        .map(|t| t.map(|k| first + k as u32)),
-                );
+                normals.extend_from_slice(&unit);
+                for triangle in triangulate_even_odd(&patch.positions) {
+                    triangles.push(triangle.map(|corner| match corner {
+                        Corner::Vertex(i) => first + i as u32,
+                        // A corner on an edge (where the outline crosses
+                        // itself) gets the edge's normals interpolated.
+                        Corner::OnEdge { .. } => {
+                            positions.push(corner.lerp(&patch.positions));
+                            normals.push(corner.lerp(&unit).normalize_or_zero());
+                            positions.len() as u32 - 1
+                        }
+                    }));
+                }
             }
             // Positions and normals were checked finite as they were read,
             // and every index is in range by construction.
