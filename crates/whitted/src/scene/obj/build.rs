@@ -1,14 +1,15 @@
 //! Faces to meshes: one [`TriangleMesh`] per material, each vertex (a
 //! distinct position / texture coordinate / normal combination) stored
-//! once, polygons triangulated by ear clipping, and missing normals
-//! computed per smoothing group.
+//! once, polygons covered by triangles by the even-odd rule (ear clipping
+//! for a simple face; a face that crosses itself gets vertices on its
+//! edges, their attributes interpolated along the edge), and missing
+//! normals computed per smoothing group.
 
 use std::collections::HashMap;
 
 use super::reader::{Corner, NONE, ObjData};
 use crate::math::{DVec2, Vec3};
-use crate::mesh::triangulate;
-use crate::mesh::{MeshError, TriangleMesh};
+use crate::mesh::{self, MeshError, TriangleMesh, triangulate_even_odd};
 
 /// How a vertex gets its normal; part of what makes two corners the same
 /// vertex.
@@ -22,24 +23,62 @@ enum NormalSource {
     Flat(u32),
 }
 
+/// A face corner with how its vertex gets its normal.
+type Source = (Corner, NormalSource);
+
+/// A vertex of a mesh: a face corner, or a point at `t` along the edge
+/// between two (where a face crosses itself).
+#[derive(Clone, Copy)]
+struct Vertex {
+    from: Source,
+    to: Source,
+    t: f64,
+}
+
+impl Vertex {
+    /// `values[from]` to `values[to]` at `t`: exactly the first for a face
+    /// corner.
+    fn lerp<T>(&self, value: impl Fn(&Source) -> T) -> T
+    where
+        T: std::ops::Mul<f64, Output = T> + std::ops::Add<Output = T>,
+    {
+        if self.t == 0.0 {
+            value(&self.from)
+        } else {
+            value(&self.from) * (1.0 - self.t) + value(&self.to) * self.t
+        }
+    }
+}
+
 /// A mesh being collected.
 #[derive(Default)]
 struct MeshBuilder {
     vertices: HashMap<(u32, u32, NormalSource), u32>,
-    corners: Vec<(Corner, NormalSource)>,
+    corners: Vec<Vertex>,
     triangles: Vec<[u32; 3]>,
 }
 
 impl MeshBuilder {
+    /// The vertex of a face corner, shared with every corner like it.
     fn vertex(&mut self, corner: Corner, source: NormalSource) -> u32 {
         let next = self.corners.len() as u32;
         *self
             .vertices
             .entry((corner.position, corner.uv, source))
             .or_insert_with(|| {
-                self.corners.push((corner, source));
+                self.corners.push(Vertex {
+                    from: (corner, source),
+                    to: (corner, source),
+                    t: 0.0,
+                });
                 next
             })
+    }
+
+    /// A new vertex at `t` along the edge from `from` to `to`.
+    fn between(&mut self, from: Source, to: Source, t: f64) -> u32 {
+        self.corners.push(Vertex { from, to, t });
+        self.corners.len() as u32 - 1
     }
 }
 
@@ -63,7 +102,7 @@ pub(super) fn build_meshes(data: &ObjData) -> Result<Vec<(u32, TriangleMesh)>, M
         } else {
             1
         };
-        let indices: Vec<u32> = corners
+        let sources: Vec<Source> = corners
             .iter()
             .map(|&c| {
                 let source = if c.normal != NONE {
@@ -73,13 +112,24 @@ pub(super) fn build_meshes(data: &ObjData) -> Result<Vec<(u32, TriangleMesh)>, M
                 } else {
                     NormalSource::Flat(face_index as u32)
                 };
-                builder.vertex(c, source)
+                (c, source)
             })
+            .collect();
+        let indices: Vec<u32> = sources
+            .iter()
+            .map(|&(c, source)| builder.vertex(c, source))
             .collect();
         points.clear();
         points.extend(corners.iter().map(|c| data.positions[c.position as usize]));
-        for [a, b, c] in triangulate(&points) {
-            builder.triangles.push([indices[a], indices[b], indices[c]]);
+        for triangle in triangulate_even_odd(&points) {
+            let triangle = triangle.map(|corner| match corner {
+                mesh::Corner::Vertex(i) => indices[i],
+                mesh::Corner::OnEdge { edge, t } => {
+                    let next = (edge + 1) % sources.len();
+                    builder.between(sources[edge], sources[next], t)
+                }
+            });
+            builder.triangles.push(triangle);
         }
     }
     builders
@@ -94,12 +144,12 @@ fn finish(data: &ObjData, builder: MeshBuilder) -> Result<TriangleMesh, MeshErro
     let corners = builder.corners;
     let positions: Vec<Vec3> = corners
         .iter()
-        .map(|(c, _)| data.positions[c.position as usize])
+        .map(|v| v.lerp(|(c, _)| data.positions[c.position as usize]))
         .collect();
-    let any_uv = corners.iter().any(|(c, _)| c.uv != NONE);
+    let any_uv = corners.iter().any(|v| v.from.0.uv != NONE);
     let any_normal = corners
         .iter()
-        .any(|(_, source)| !matches!(source, NormalSource::Flat(_)));
+        .any(|v| !matches!(v.from.1, NormalSource::Flat(_)));
     let normals =
         any_normal.then(|| vertex_normals(data, &corners, &positions, &builder.triangles));
     let mut mesh = TriangleMesh::new(positions, builder.triangles)?;
@@ -109,7 +159,7 @@ fn finish(data: &ObjData, builder: MeshBuilder) -> Result<TriangleMesh, MeshErro
     if any_uv {
         let uvs = corners
             .iter()
-            .map(|(c, _)| data.uvs.get(c.uv as usize).copied().unwrap_or(DVec2::ZERO))
+            .map(|v| v.lerp(|(c, _)| data.uvs.get(c.uv as usize).copied().unwrap_or(DVec2::ZERO)))
             .collect();
         mesh = mesh.with_uvs(uvs)?;
     }
@@ -121,7 +171,7 @@ fn finish(data: &ObjData, builder: MeshBuilder) -> Result<TriangleMesh, MeshErro
 /// polygon split into many triangles counts as much as one).
 fn vertex_normals(
     data: &ObjData,
-    corners: &[(Corner, NormalSource)],
+    corners: &[Vertex],
     positions: &[Vec3],
     triangles: &[[u32; 3]],
 ) -> Vec<Vec3> {
@@ -140,11 +190,20 @@ fn vertex_normals(
             }
         }
     }
+    let given = |(_, source): &Source| match source {
+        NormalSource::Given(n) => Some(data.normals[*n as usize]),
+        _ => None,
+    };
     corners
         .iter()
         .zip(sums)
-        .map(|((_, source), sum)| match source {
-            NormalSource::Given(n) => data.normals[*n as usize],
+        .map(|(v, sum)| match (given(&v.from), given(&v.to)) {
+            (Some(n), _) if v.t == 0.0 => n,
+            // A vertex on a self-crossing face's edge between two given
+            // normals takes their blend.
+            (Some(a), Some(b)) => (a * (1.0 - v.t) + b * v.t)
+                .try_normalize()
+                .unwrap_or(Vec3::ZERO),
             _ => sum.try_normalize().unwrap_or(Vec3::ZERO),
         })
         .collect()

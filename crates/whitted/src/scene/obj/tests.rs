@@ -54,3 +54,43 @@ fn a_file_without_s_is_smoothed_and_given_normals_are_kept() {
     assert!((surface.local.point - ridge).length() < 1e-9);
     assert!((surface.shading_normal - Vec3::Y).length() < 1e-9);
 }
+
+#[test]
+fn a_face_that_crosses_itself_covers_its_wings_with_attributes_interpolated_along_its_edges() {
+    // A bow tie of two wings meeting at (1.2, 1.2), texture coordinates
+    // a third of the position: a vertex made on an edge, where the face
+    // crosses itself, must carry the edge's blend, which is that too.
+    let scene = parse(
+        "v 0 0 0\nv 3 3 0\nv 3 0 0\nv 0 2 0\n\
+         vt 0 0\nvt 1 1\nvt 1 0\nvt 0 0.6666666666666666\n\
+         f 1/1 2/2 3/3 4/4\n",
+    )
+    .scene;
+    assert!(scene.objects.meshes[0].positions().len() > 4);
+    let world = crate::world::World::new(&scene.objects);
+    let down = |x: f64, y: f64| crate::math::Ray::new(Vec3::new(x, y, 5.0), -Vec3::Z);
+    let mut hits = 0;
+    for i in 0..30 {
+        for j in 0..30 {
+            let (x, y) = (0.05 + 0.1 * f64::from(i), 0.05 + 0.1 * f64::from(j));
+            let ray = down(x, y);
+            // Inside the left wing (below y = 2 - 2x/3, above y = x) or the
+            // right one (between the same lines the other way round).
+            let (a, b) = (y - x, y - (2.0 - 2.0 * x / 3.0));
+            if a.abs() < 1e-9 || b.abs() < 1e-9 {
+                continue;
+            }
+            let inside = a * b < 0.0 && x < 3.0;
+            match world.intersect(&ray) {
+                Some(hit) => {
+                    assert!(inside, "({x}, {y}) is outside the bow tie");
+                    let uv = world.surface(&ray, &hit).uv;
+                    assert!((uv.x - x / 3.0).abs() < 1e-9 && (uv.y - y / 3.0).abs() < 1e-9);
+                    hits += 1;
+                }
+                None => assert!(!inside, "({x}, {y}) is inside the bow tie"),
+            }
+        }
+    }
+    assert!(hits > 300, "{hits}");
+}

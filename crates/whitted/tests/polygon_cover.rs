@@ -1,5 +1,6 @@
-//! NFF polygons cover the area inside their outline, whether written as
-//! `p` (a polygon) or as `pp` (a patch, with vertex normals): random
+//! Polygons cover the area inside their outline, whether written as NFF
+//! `p` (a polygon), NFF `pp` (a patch, with vertex normals) or an OBJ face
+//! (with texture coordinates, so vertices on edges get theirs): random
 //! star-shaped and x-monotone concave polygons, and outlines that cross
 //! themselves, at random orientations, checked on random rays against an
 //! even-odd point-in-polygon oracle.
@@ -9,7 +10,7 @@ use std::path::Path;
 
 use whitted::math::random::Rng;
 use whitted::math::{DVec2, Ray, Vec3};
-use whitted::scene::parse_nff;
+use whitted::scene::{parse_nff, parse_obj};
 use whitted::world::World;
 
 const VIEW: &str = "v\nfrom 0 0 10\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.001\nresolution 8 8\n\
@@ -115,8 +116,42 @@ fn nff(points: &[Vec3], patch: bool, rng: &mut Rng) -> String {
     text
 }
 
+/// The OBJ text of the polygon as one face with texture coordinates.
+fn obj(points: &[Vec3]) -> String {
+    let mut text = String::new();
+    for (i, p) in points.iter().enumerate() {
+        writeln!(text, "v {:?} {:?} {:?}", p.x, p.y, p.z).unwrap();
+        writeln!(text, "vt {} 0.5", i as f64 / points.len() as f64).unwrap();
+    }
+    text.push('f');
+    for i in 1..=points.len() {
+        write!(text, " {i}/{i}").unwrap();
+    }
+    text.push('\n');
+    text
+}
+
+/// The objects of the polygon in each form: `p`, `pp` and an OBJ face.
+fn forms(points: &[Vec3], rng: &mut Rng) -> Vec<(&'static str, whitted::Scene, String)> {
+    let mut out = Vec::new();
+    for (name, text) in [
+        ("p", nff(points, false, rng)),
+        ("pp", nff(points, true, rng)),
+    ] {
+        let scene = parse_nff(&text, Path::new("polygon.nff"))
+            .unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
+        out.push((name, scene, text));
+    }
+    let text = obj(points);
+    let loaded =
+        parse_obj(&text, Path::new("polygon.obj")).unwrap_or_else(|e| panic!("obj: {e}\n{text}"));
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    out.push(("obj", loaded.scene, text));
+    out
+}
+
 #[test]
-fn p_and_pp_polygons_cover_exactly_the_inside_of_their_outline() {
+fn p_pp_and_obj_polygons_cover_exactly_the_inside_of_their_outline() {
     let mut rng = Rng::new(22);
     let mut checked = 0;
     let mut hits = 0;
@@ -129,10 +164,7 @@ fn p_and_pp_polygons_cover_exactly_the_inside_of_their_outline() {
         };
         let (origin, u, v) = frame(&mut rng);
         let points: Vec<Vec3> = outline.iter().map(|q| origin + q.x * u + q.y * v).collect();
-        for patch in [false, true] {
-            let text = nff(&points, patch, &mut rng);
-            let scene = parse_nff(&text, Path::new("polygon.nff"))
-                .unwrap_or_else(|e| panic!("case {case}: {e}\n{text}"));
+        for (form, scene, text) in forms(&points, &mut rng) {
             let world = World::new(&scene.objects);
             for _ in 0..200 {
                 let target = rng.range(-1.1, 1.1) * u + rng.range(-1.1, 1.1) * v + origin;
@@ -151,8 +183,7 @@ fn p_and_pp_polygons_cover_exactly_the_inside_of_their_outline() {
                 assert_eq!(
                     hit.is_some(),
                     expected,
-                    "case {case} ({}), {} corners, point {p} at distance {} from the outline\n{text}",
-                    if patch { "pp" } else { "p" },
+                    "case {case} ({form}), {} corners, point {p} at distance {} from the outline\n{text}",
                     outline.len(),
                     distance_to_outline(&outline, p)
                 );
