@@ -3,7 +3,7 @@
 //! that crosses itself.
 //!
 //! A simple outline (no two edges meet but neighbours at their shared
-//! corner) is ear-clipped over its own corners ([`super::triangulate`]).
+//! corner) is ear-clipped over its own corners ([`fn@super::triangulate`]).
 //! One that crosses itself is cut, in its plane, into vertical slabs at
 //! every corner and every crossing: inside a slab no two edges cross, so
 //! the edges spanning it, sorted bottom to top, bound the inside in pairs
@@ -11,6 +11,11 @@
 //! triangles. Their corners lie on the polygon's edges ([`Corner::OnEdge`]),
 //! so a caller interpolates whatever the corners carry (normals, texture
 //! coordinates) along the edge a triangle corner lies on.
+//!
+//! Hostile input stays cheap: an outline of more than [`MAX_CHECKED`]
+//! corners is taken as simple, and one that crosses itself so often that
+//! the slabs would cost more than [`MAX_SLAB_WORK`] steps is ear-clipped;
+//! both then cover their overlaps once.
 
 use super::triangulate::{newell_normal, project, triangulate};
 use crate::math::{DVec2, Vec3};
@@ -57,18 +62,26 @@ pub fn triangulate_even_odd(points: &[Vec3]) -> Vec<[Corner; 3]> {
     }
     let normal = newell_normal(points);
     let flat = project(points, normal);
-    if n == 3 || !crosses_itself(&flat) {
-        return triangulate(points)
+    let ear_clipped = || {
+        triangulate(points)
             .into_iter()
             .map(|t| t.map(Corner::Vertex))
-            .collect();
+            .collect()
+    };
+    if n == 3 || !crosses_itself(&flat) {
+        return ear_clipped();
     }
-    slabs(&flat)
+    slabs(&flat).unwrap_or_else(ear_clipped)
 }
+
+/// The most slab-edge pairs the slab cover may visit (a second or so): an
+/// outline that crosses itself more than that is ear-clipped instead, its
+/// overlaps covered once.
+pub const MAX_SLAB_WORK: usize = 20_000_000;
 
 /// The most corners an outline may have for the check that it crosses
 /// itself (which costs `n²`); a longer one is taken as simple.
-const MAX_CHECKED: usize = 4096;
+pub const MAX_CHECKED: usize = 4096;
 
 /// True when two edges that are not neighbours meet, or two neighbours
 /// overlap beyond their shared corner.
@@ -114,8 +127,9 @@ fn segments_meet(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
     on(c, d, a) || on(c, d, b) || on(a, b, c) || on(a, b, d)
 }
 
-/// The even-odd cover of a self-crossing outline by vertical slabs.
-fn slabs(flat: &[DVec2]) -> Vec<[Corner; 3]> {
+/// The even-odd cover of a self-crossing outline by vertical slabs; `None`
+/// past [`MAX_SLAB_WORK`].
+fn slabs(flat: &[DVec2]) -> Option<Vec<[Corner; 3]>> {
     let n = flat.len();
     let edge = |i: usize| (flat[i], flat[(i + 1) % n]);
     // Slab boundaries: every corner's x and every crossing's.
@@ -132,11 +146,17 @@ fn slabs(flat: &[DVec2]) -> Vec<[Corner; 3]> {
             let u = (c - a).perp_dot(b - a) / denominator;
             if (0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&u) {
                 xs.push(a.x + s * (b.x - a.x));
+                if xs.len().saturating_mul(n) > MAX_SLAB_WORK {
+                    return None;
+                }
             }
         }
     }
     xs.sort_by(f64::total_cmp);
     xs.dedup();
+    if xs.len().saturating_mul(n) > MAX_SLAB_WORK {
+        return None;
+    }
     let mut triangles = Vec::new();
     for pair in xs.windows(2) {
         let (x0, x1) = (pair[0], pair[1]);
@@ -182,7 +202,7 @@ fn slabs(flat: &[DVec2]) -> Vec<[Corner; 3]> {
             }
         }
     }
-    triangles
+    Some(triangles)
 }
 
 #[cfg(test)]
@@ -283,5 +303,22 @@ mod tests {
                 .all(|c| matches!(c, Corner::Vertex(_)))
         );
         assert!((area(&l, &triangles) - 3.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn an_outline_crossing_itself_millions_of_times_is_ear_clipped_in_bounded_time() {
+        let mut rng = crate::math::random::Rng::new(3);
+        let n = 3000;
+        let tangle: Vec<Vec3> = (0..n)
+            .map(|_| Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), 0.0))
+            .collect();
+        let triangles = triangulate_even_odd(&tangle);
+        assert_eq!(triangles.len(), n - 2);
+        assert!(
+            triangles
+                .iter()
+                .flatten()
+                .all(|c| matches!(c, Corner::Vertex(_)))
+        );
     }
 }

@@ -91,7 +91,7 @@ pub fn triangulate(points: &[Vec3]) -> Vec<[usize; 3]> {
 }
 
 /// The most corner-in-ear tests spent on one face (a fraction of a second).
-const EAR_TESTS: usize = 100_000_000;
+pub const EAR_TESTS: usize = 100_000_000;
 
 /// The points in 2D, dropping the normal's largest axis and keeping the
 /// winding counter-clockwise.
