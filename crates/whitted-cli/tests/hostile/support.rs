@@ -13,7 +13,9 @@ pub struct Probe {
     pub stdout: String,
     /// Everything it printed on standard error.
     pub stderr: String,
-    /// Its peak resident memory in bytes (from `wait4`'s resource usage).
+    /// Its peak resident memory in bytes (from `wait4`'s resource usage):
+    /// an upper bound, as the count starts from the test process's own
+    /// size when the child is spawned (a few MiB).
     pub peak_bytes: u64,
 }
 

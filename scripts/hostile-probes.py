@@ -1,0 +1,347 @@
+#!/usr/bin/env python3
+"""Runs the worst probe of each defect class of the hostile-input audit
+(issue 23) against one `whitted` binary and prints a table: exit code, wall
+time, peak resident memory and the first line of what it said.
+
+    python3 scripts/hostile-probes.py target/release/whitted
+
+Each probe runs in a fresh temporary folder, killed after --timeout seconds
+(default 60) and limited to --max-gib GiB of address space (default 16), so
+that an old binary's runaway cases end instead of taking the machine. The
+hostile test suite (crates/whitted-cli/tests/hostile) asserts the outcomes;
+this script only measures them, for the figures in the issue's note.
+"""
+
+import argparse
+import os
+import resource
+import signal
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+import zlib
+
+GLASS_IN_MIRRORS = """
+[render]
+width = 32
+height = 24
+[camera]
+eye = [0, 0, -0.9]
+look_at = [0, 0, 0]
+fov = 60
+[materials.mirror]
+diffuse = 0.1
+reflection = 1
+[materials.glass]
+diffuse = 0.0
+reflection = 1
+transmission = 1
+ior = 1.5
+[[lights]]
+type = "point"
+position = [0, 0.5, -0.5]
+intensity = 1
+[[objects]]
+shape = "box"
+min = [-1, -1, -1]
+max = [1, 1, 1]
+material = "mirror"
+[[objects]]
+shape = "sphere"
+center = [0, 0, 0]
+radius = 0.5
+material = "glass"
+"""
+
+SCENE_HEAD = """
+[camera]
+eye = [0, 0, -5]
+look_at = [0, 0, 0]
+[materials.m]
+diffuse = 0.5
+[[lights]]
+type = "point"
+position = [0, 5, -5]
+intensity = 1
+"""
+
+
+def big_png(width, height):
+    """A PNG of width x height black RGB pixels, whole and valid: its
+    deflated rows are about a thousandth of their size. Built once and
+    kept in the temporary folder (about 5 MB for 40000 x 40000)."""
+    cache = os.path.join(tempfile.gettempdir(), f"whitted-probe-{width}x{height}.png")
+    if os.path.exists(cache):
+        with open(cache, "rb") as f:
+            return f.read()
+
+    def chunk(kind, data):
+        body = kind + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body))
+
+    deflate = zlib.compressobj(9)
+    row = b"\0" * (1 + 3 * width)
+    rows_per_piece = max(1, (1 << 24) // len(row))
+    pieces = []
+    for start in range(0, height, rows_per_piece):
+        pieces.append(deflate.compress(row * min(rows_per_piece, height - start)))
+    pieces.append(deflate.flush())
+    data = (
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
+        + chunk(b"IDAT", b"".join(pieces))
+        + chunk(b"IEND", b"")
+    )
+    with open(cache, "wb") as f:
+        f.write(data)
+    return data
+
+
+def write(folder, name, data):
+    path = os.path.join(folder, name)
+    mode = "wb" if isinstance(data, bytes) else "w"
+    with open(path, mode) as f:
+        f.write(data)
+    return path
+
+
+def setup_texture(d):
+    write(d, "big.png", big_png(40000, 40000))
+    write(
+        d,
+        "t.toml",
+        SCENE_HEAD.replace('diffuse = 0.5', 'diffuse = { image = "big.png" }')
+        + '[[objects]]\nshape = "sphere"\ncenter = [0,0,0]\nradius = 1\nmaterial = "m"\n',
+    )
+
+
+def setup_zero(d):
+    os.symlink("/dev/zero", os.path.join(d, "zero.obj"))
+
+
+def setup_mirrors(d):
+    write(d, "m.toml", GLASS_IN_MIRRORS)
+
+
+def setup_usemtl(d):
+    lines = ["v 0 0 0", "v 1 0 0", "v 0 1 0"]
+    for i in range(200000):
+        lines.append(f"usemtl m{i}")
+        lines.append("f 1 2 3")
+    write(d, "many.obj", "\n".join(lines) + "\n")
+
+
+def setup_flat(d):
+    write(d, "flat.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n")
+
+
+def setup_bom(d):
+    write(d, "bom.obj", b"\xef\xbb\xbfv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+
+
+def setup_kd(d):
+    write(d, "k.mtl", "newmtl m\nKd -1 -1 -1\n")
+    write(d, "k.obj", "mtllib k.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n")
+
+
+def setup_light(d):
+    write(
+        d,
+        "l.toml",
+        SCENE_HEAD.replace("intensity = 1", "intensity = 1e39")
+        + '[[objects]]\nshape = "sphere"\ncenter = [0,0,0]\nradius = 1\nmaterial = "m"\n',
+    )
+
+
+def setup_huge_sphere(d):
+    write(
+        d,
+        "s.toml",
+        SCENE_HEAD.replace("[0, 0, -5]", "[0, 0, -1e155]")
+        + '[[objects]]\nshape = "sphere"\ncenter = [0,0,0]\nradius = 2e154\nmaterial = "m"\n',
+    )
+
+
+def setup_bow_tie(d):
+    write(
+        d,
+        "b.toml",
+        SCENE_HEAD
+        + '[[objects]]\nshape = "polygon"\nvertices = [[-1,-1,0],[1,1,0],[1,-1,0],[-1,1,0]]\n'
+        'material = "m"\n',
+    )
+
+
+def setup_scale(d):
+    write(
+        d,
+        "sc.toml",
+        SCENE_HEAD
+        + '[[objects]]\nshape = "sphere"\ncenter = [0,0,0]\nradius = 1\nmaterial = "m"\n'
+        "transform = [{ scale = 1e103 }]\n",
+    )
+
+
+def setup_big_obj(d):
+    n = 1000
+    lines = []
+    for j in range(n + 1):
+        for i in range(n + 1):
+            lines.append(f"v {i} {j} {(i * j) % 7}")
+    for j in range(n):
+        for i in range(n):
+            a = j * (n + 1) + i + 1
+            lines.append(f"f {a} {a + 1} {a + n + 2}")
+            lines.append(f"f {a} {a + n + 2} {a + n + 1}")
+    write(d, "big.obj", "\n".join(lines) + "\n")
+
+
+def setup_nan_rays(d):
+    os.mkdir(os.path.join(d, "rays"))
+    write(d, "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    # 32-byte records: u32 pixel, origin, direction, t_far; a NaN origin.
+    rays = struct.pack("<I7f", 0, float("nan"), 0, 0, 0, 0, 1, float("inf"))
+    for kind in ("primary", "diffuse"):
+        write(d, f"rays/{kind}.rays", rays)
+        write(d, f"rays/{kind}.hits", struct.pack("<fI", -1.0, 0xFFFFFFFF))
+    write(d, "rays/shadow.rays", rays)
+    write(d, "rays/shadow.hits", b"\0")
+
+
+def setup_triangle(d):
+    write(d, "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+
+
+def setup_outputs(d):
+    write(d, "a.pfm", "old")
+
+
+PROBES = [
+    # (item, what, setup, args, special)
+    ("1", "render to a closed pipe", None, ["render", "-o", "y.png", "--width", "64", "--height", "48"], "closed-pipe"),
+    ("2", "bench 70000x70000", setup_triangle, ["bench", "tri.obj", "--width", "70000", "--height", "70000"], None),
+    ("3", "40000² PNG texture", setup_texture, ["render", "t.toml", "--width", "32", "--height", "24"], None),
+    ("4", "scene -> /dev/zero", setup_zero, ["render", "zero.obj"], None),
+    ("5", "16384² with 4 AOVs", None, ["render", "--width", "16384", "--height", "16384", "--aov", "depth=d.exr",
+                                        "--aov", "normal=n.exr", "--aov", "id=i.exr", "--aov", "cost=c.exr"], None),
+    ("6", "--threads 100000", None, ["render", "--width", "64", "--height", "48", "--threads", "100000"], None),
+    ("7", "glass in mirrors, depth 40", setup_mirrors, ["render", "m.toml", "--max-depth", "40"], None),
+    ("8", "200000 usemtl, --quiet", setup_usemtl, ["render", "many.obj", "--quiet", "--width", "32", "--height", "24"], None),
+    ("10", "-o a.pfm --aov depth=./a.pfm", setup_outputs, ["render", "-o", "a.pfm", "--aov", "depth=./a.pfm"], None),
+    ("11", "SIGINT while writing", None, ["render", "--width", "2000", "--height", "2000", "-o", "x.exr"], "sigint"),
+    ("12", "unwritable folder", None, ["render", "-o", "/proc/x.png"], None),
+    ("13", "flat OBJ quad", setup_flat, ["render", "flat.obj", "-o", "f.pfm", "--width", "32", "--height", "24"], None),
+    ("14", "BOM in OBJ", setup_bom, ["render", "bom.obj", "--width", "32", "--height", "24"], None),
+    ("15", "MTL Kd -1", setup_kd, ["render", "k.obj", "--width", "32", "--height", "24"], None),
+    ("16", "light intensity 1e39", setup_light, ["render", "l.toml", "-o", "l.pfm", "--width", "32", "--height", "24"], None),
+    ("17", "sphere radius 2e154", setup_huge_sphere, ["render", "s.toml", "--width", "32", "--height", "24"], None),
+    ("18", "bow-tie polygon", setup_bow_tie, ["render", "b.toml", "--width", "32", "--height", "24"], None),
+    ("19", "scale = 1e103", setup_scale, ["render", "sc.toml"], None),
+    ("19", "--width -1", None, ["render", "--width", "-1"], None),
+    ("20", "--width 0 with a big OBJ", setup_big_obj, ["render", "big.obj", "--width", "0"], None),
+    ("21", "NaN rays", setup_nan_rays, ["bench", "tri.obj", "--rays", "rays", "--runs", "1"], None),
+    ("21", "--eye 3e38,3e38,3e38", None, ["render", "--eye", "3e38,3e38,3e38", "--width", "64", "--height", "48"], None),
+    ("also", "samples 4294967295 on 1x1", None, ["render", "--width", "1", "--height", "1", "--spp", "4294967295"], None),
+]
+
+
+def build_in_child(setup, folder):
+    """Runs `setup` in a forked child, so that this process stays small: a
+    child's peak memory (ru_maxrss) starts at its parent's size when forked."""
+    pid = os.fork()
+    if pid == 0:
+        try:
+            setup(folder)
+        finally:
+            os._exit(0)
+    os.waitpid(pid, 0)
+
+
+def limit(max_bytes):
+    def apply():
+        resource.setrlimit(resource.RLIMIT_AS, (max_bytes, max_bytes))
+        os.setsid()
+
+    return apply
+
+
+def run(binary, folder, args, special, timeout, max_bytes):
+    before = set(os.listdir(folder))
+    start = time.monotonic()
+    err_path = os.path.join(folder, ".stderr")
+    with open(err_path, "wb") as err:
+        if special == "closed-pipe":
+            reader, writer = os.pipe()
+            os.close(reader)
+            proc = subprocess.Popen([binary] + args, cwd=folder, stdout=writer, stderr=writer,
+                                    stdin=subprocess.DEVNULL, preexec_fn=limit(max_bytes))
+            os.close(writer)
+        else:
+            proc = subprocess.Popen([binary] + args, cwd=folder, stdout=err, stderr=err,
+                                    stdin=subprocess.DEVNULL, preexec_fn=limit(max_bytes))
+    killed = False
+    signalled = False
+    while True:
+        pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
+        if pid:
+            break
+        elapsed = time.monotonic() - start
+        writing = special == "sigint" and any(n.endswith(".partial") for n in os.listdir(folder))
+        if special == "sigint" and not signalled and (writing or elapsed > 20):
+            os.kill(proc.pid, signal.SIGINT)
+            signalled = True
+        if elapsed > timeout and not killed:
+            os.killpg(proc.pid, signal.SIGKILL)
+            killed = True
+        time.sleep(0.01)
+    seconds = time.monotonic() - start
+    if os.WIFEXITED(status):
+        outcome = f"exit {os.WEXITSTATUS(status)}"
+    else:
+        outcome = f"signal {os.WTERMSIG(status)}"
+    if killed:
+        outcome += f" (killed at {timeout} s)"
+    with open(err_path, "rb") as f:
+        said = f.read().decode("utf-8", "replace")
+    lines = [line for line in said.splitlines() if line.strip()]
+    first = lines[0] if lines else ""
+    if len(first) > 110:
+        first = first[:107] + "..."
+    if special == "sigint" and not signalled:
+        outcome += " (ended before the signal)"
+    partials = [n for n in os.listdir(folder) if n.endswith(".partial")]
+    if partials:
+        outcome += f", {len(partials)} .partial left"
+    written = sorted(set(os.listdir(folder)) - before - {".stderr"})
+    return outcome, seconds, usage.ru_maxrss / 1024, first, len(said), ", ".join(written)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("binary")
+    parser.add_argument("--timeout", type=float, default=60)
+    parser.add_argument("--max-gib", type=float, default=16)
+    options = parser.parse_args()
+    binary = os.path.realpath(options.binary)
+    max_bytes = int(options.max_gib * (1 << 30))
+    print("| item | probe | outcome | time | peak | new files | stderr bytes | first line said |")
+    print("|---|---|---|---|---|---|---|---|")
+    for item, what, setup, args, special in PROBES:
+        with tempfile.TemporaryDirectory() as folder:
+            if setup:
+                build_in_child(setup, folder)
+            outcome, seconds, peak_mib, first, said, written = run(
+                binary, folder, args, special, options.timeout, max_bytes
+            )
+        first = first.replace("|", "\\|")
+        print(
+            f"| {item} | {what} | {outcome} | {seconds:.2f} s | {peak_mib:.0f} MiB | {written} "
+            f"| {said} | `{first}` |"
+        )
+        sys.stdout.flush()
+
+
+if __name__ == "__main__":
+    main()
