@@ -149,7 +149,10 @@ fn check_destinations(output: &Path, aovs: &[(Aov, PathBuf)]) -> Result<(), Stri
     for (aov, path) in aovs {
         let destination = check_destination(path).map_err(|e| e.to_string())?;
         let option = format!("--aov {}={}", aov.name(), path.display());
-        if let Some((other, _)) = checked.iter().find(|(_, d)| d.is_same_file_as(&destination)) {
+        if let Some((other, _)) = checked
+            .iter()
+            .find(|(_, d)| d.is_same_file_as(&destination))
+        {
             return Err(format!(
                 "{option}: that file is already an output of this render ({other})"
             ));

@@ -45,7 +45,11 @@ impl ReportStream {
             return;
         }
         let text = format!("{line}\n");
-        if out.write_all(text.as_bytes()).and_then(|()| out.flush()).is_err() {
+        if out
+            .write_all(text.as_bytes())
+            .and_then(|()| out.flush())
+            .is_err()
+        {
             self.failed.store(true, Ordering::Relaxed);
         }
     }

@@ -60,7 +60,11 @@ pub fn check_destination(path: &Path) -> Result<Destination, ImageError> {
     drop(PartialFile::create_in(folder, &IN_FLIGHT).map_err(|e| {
         refused(
             path,
-            format!("cannot create a file in {}: {}", describe_folder(folder), os_message(&e)),
+            format!(
+                "cannot create a file in {}: {}",
+                describe_folder(folder),
+                os_message(&e)
+            ),
         )
     })?);
     let canonical = match existing {
@@ -185,7 +189,10 @@ pub(crate) fn resolve(path: &Path) -> Result<(PathBuf, Option<ExistingFile>), Im
 
 /// The file at `target` (the destination `path` with its links followed),
 /// if it is there: it must be a regular file the user may write.
-pub(crate) fn existing_file(path: &Path, target: &Path) -> Result<Option<ExistingFile>, ImageError> {
+pub(crate) fn existing_file(
+    path: &Path,
+    target: &Path,
+) -> Result<Option<ExistingFile>, ImageError> {
     match std::fs::symlink_metadata(target) {
         Ok(m) => writable_file(path, target, &m).map(Some),
         Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(None),
@@ -199,7 +206,10 @@ pub(crate) fn existing_file(path: &Path, target: &Path) -> Result<Option<Existin
 fn writable_file(path: &Path, target: &Path, m: &Metadata) -> Result<ExistingFile, ImageError> {
     let kind = m.file_type();
     if kind.is_dir() {
-        return Err(refused(path, "this is a folder, not a file name".to_string()));
+        return Err(refused(
+            path,
+            "this is a folder, not a file name".to_string(),
+        ));
     }
     if !kind.is_file() {
         return Err(refused(
@@ -253,7 +263,11 @@ fn check_folder(path: &Path, folder: &Path) -> Result<(), ImageError> {
         }
         Err(e) => Err(refused(
             path,
-            format!("cannot look into {}: {}", describe_folder(folder), os_message(&e)),
+            format!(
+                "cannot look into {}: {}",
+                describe_folder(folder),
+                os_message(&e)
+            ),
         )),
     }
 }
@@ -432,7 +446,11 @@ mod tests {
             let path = dir.path().join(below);
             assert_eq!(
                 message(&path),
-                format!("{}: {} is a file, not a folder", path.display(), file.display())
+                format!(
+                    "{}: {} is a file, not a folder",
+                    path.display(),
+                    file.display()
+                )
             );
         }
         let folder = dir.path().join("folder.png");
@@ -448,8 +466,12 @@ mod tests {
     fn special_files_are_not_replaced() {
         let dir = tempfile::tempdir().unwrap();
         let fifo = dir.path().join("pipe.png");
-        rustix::fs::mkfifoat(rustix::fs::CWD, &fifo, rustix::fs::Mode::from_raw_mode(0o644))
-            .unwrap();
+        rustix::fs::mkfifoat(
+            rustix::fs::CWD,
+            &fifo,
+            rustix::fs::Mode::from_raw_mode(0o644),
+        )
+        .unwrap();
         assert_eq!(
             message(&fifo),
             format!(
@@ -485,7 +507,10 @@ mod tests {
         let b = dir.path().join("b.pfm");
         std::fs::write(&a, b"old").unwrap();
         std::fs::hard_link(&a, &b).unwrap();
-        let (da, db) = (check_destination(&a).unwrap(), check_destination(&b).unwrap());
+        let (da, db) = (
+            check_destination(&a).unwrap(),
+            check_destination(&b).unwrap(),
+        );
         assert!(da.is_same_file_as(&db));
         let notes = da.notes();
         assert!(

@@ -478,13 +478,18 @@ mod tests {
     fn names_that_are_no_file_or_an_extension_alone_say_so() {
         for (name, says) in [
             (".png", "`.png` is a hidden file's name with no extension"),
-            ("out/.EXR", "`.EXR` is a hidden file's name with no extension"),
+            (
+                "out/.EXR",
+                "`.EXR` is a hidden file's name with no extension",
+            ),
             ("", "this names no file"),
             ("out/..", "this names no file"),
             ("x.png/", "the name ends with /, so it names a folder"),
             (".gif", "unknown image format"),
         ] {
-            let error = ImageFormat::from_path(Path::new(name)).unwrap_err().to_string();
+            let error = ImageFormat::from_path(Path::new(name))
+                .unwrap_err()
+                .to_string();
             assert!(error.contains(says), "{name}: {error}");
         }
     }
@@ -505,7 +510,12 @@ mod tests {
         std::os::unix::fs::symlink("private.pfm", &link).unwrap();
         std::fs::write(&private, b"old").unwrap();
         gradient().write(&link).unwrap();
-        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
         assert!(std::fs::read(&private).unwrap().starts_with(b"PF\n"));
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
     }
