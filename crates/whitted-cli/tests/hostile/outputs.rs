@@ -321,7 +321,7 @@ fn send(child: &std::process::Child, signal: libc::c_int) {
 #[test]
 fn sigint_while_encoding_removes_the_partial_files_and_exits_130() {
     let dir = tempfile::tempdir().unwrap();
-    let mut child = start_big_render(dir.path(), "900");
+    let mut child = start_big_render(dir.path(), "1500");
     // Wait until an image is being encoded: a partial file with bytes in
     // it (the empty one made when the folder is checked does not count).
     let deadline = Instant::now() + Duration::from_secs(60);
@@ -350,7 +350,7 @@ fn sigint_while_encoding_removes_the_partial_files_and_exits_130() {
 #[test]
 fn sigterm_while_rendering_exits_143_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let mut child = start_big_render(dir.path(), "900");
+    let mut child = start_big_render(dir.path(), "1500");
     // The scene has been read when it says so; the render follows.
     let mut stderr = BufReader::new(child.stderr.take().unwrap());
     let mut line = String::new();
@@ -361,4 +361,35 @@ fn sigterm_while_rendering_exits_143_and_writes_nothing() {
     assert_eq!(status.code(), Some(143), "{status:?}");
     assert_eq!(partial_files(dir.path()), Vec::<String>::new());
     assert!(!dir.path().join("big.exr").exists());
+}
+
+#[test]
+fn a_signal_ignored_at_the_start_stays_ignored() {
+    // As under `nohup`: a hangup must not end the render.
+    let dir = tempfile::tempdir().unwrap();
+    fs::write(dir.path().join("empty.toml"), EMPTY_SCENE).unwrap();
+    let mut command = whitted(
+        &["render", "empty.toml", "--width", "600", "--height", "600"],
+        dir.path(),
+    );
+    // SAFETY: signal() is async-signal-safe, as pre_exec requires.
+    unsafe {
+        command.pre_exec(|| {
+            libc::signal(libc::SIGHUP, libc::SIG_IGN);
+            Ok(())
+        });
+    }
+    let mut child = command
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stderr = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    stderr.read_line(&mut line).unwrap();
+    assert!(line.contains("empty.toml: read in"), "{line}");
+    send(&child, libc::SIGHUP);
+    assert_eq!(child.wait().unwrap().code(), Some(0));
+    assert!(dir.path().join("whitted.png").is_file());
 }
