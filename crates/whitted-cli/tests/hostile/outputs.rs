@@ -393,3 +393,31 @@ fn a_signal_ignored_at_the_start_stays_ignored() {
     assert_eq!(child.wait().unwrap().code(), Some(0));
     assert!(dir.path().join("whitted.png").is_file());
 }
+
+#[test]
+fn another_users_file_in_a_sticky_folder_is_refused_before_the_render() {
+    // Writable by all, but in a sticky folder only its owner may rename
+    // over it: the rename would fail after the render.
+    let dir = tempfile::tempdir().unwrap();
+    let sticky = dir.path().join("sticky");
+    fs::create_dir(&sticky).unwrap();
+    fs::set_permissions(&sticky, fs::Permissions::from_mode(0o1777)).unwrap();
+    let theirs = sticky.join("theirs.png");
+    fs::write(&theirs, b"theirs").unwrap();
+    fs::set_permissions(&theirs, fs::Permissions::from_mode(0o666)).unwrap();
+    if !is_root() {
+        // The tests' user owns both: nothing to refuse, and no other user
+        // to be. Said, not passed silently.
+        eprintln!("skipped: needs root to run as another user than the file's owner");
+        return;
+    }
+    let args = ["render", "missing.toml", "-o", "sticky/theirs.png"];
+    let p = run(unprivileged(&args, dir.path()));
+    assert_eq!(p.code(), Some(1), "{}", p.stderr);
+    assert_eq!(
+        p.stderr,
+        "error: sticky/theirs.png: the file belongs to user 0 in the folder sticky, where only \
+         a file's owner may replace it (a sticky folder, like /tmp)\n"
+    );
+    assert_eq!(fs::read(&theirs).unwrap(), b"theirs");
+}

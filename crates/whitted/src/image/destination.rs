@@ -12,7 +12,8 @@
 //! - A file with several names (hard links) gets a new file under this name
 //!   only: a note says the other names keep the old image.
 //! - The folder must exist and take a new file: a partial file is created
-//!   and removed there to be sure.
+//!   and removed there to be sure. In a sticky folder (like `/tmp`) only
+//!   the file's owner (or the folder's, or root) may replace it.
 //! - Two destinations are the same file when their canonical paths are
 //!   equal or they are one existing file (same device and inode).
 
@@ -228,7 +229,36 @@ fn writable_file(path: &Path, target: &Path, m: &Metadata) -> Result<ExistingFil
         ),
         _ => refused(path, format!("cannot write this file: {}", os_message(&e))),
     })?;
-    Ok(facts(m))
+    let existing = facts(m);
+    if let Some(owner) = sticky_folder_owner(folder_of(target))
+        && let Some(user) = user_id()
+        && ![0, owner, existing.owner].contains(&user)
+    {
+        return Err(refused(
+            path,
+            format!(
+                "the file belongs to user {} in {}, where only a file's owner may replace it \
+                 (a sticky folder, like /tmp)",
+                existing.owner,
+                describe_folder(folder_of(target))
+            ),
+        ));
+    }
+    Ok(existing)
+}
+
+/// The owner of `folder` if it is sticky (its files may be renamed over
+/// only by their owner, the folder's owner or root).
+#[cfg(unix)]
+fn sticky_folder_owner(folder: &Path) -> Option<u32> {
+    use std::os::unix::fs::MetadataExt;
+    let m = std::fs::metadata(folder).ok()?;
+    (m.mode() & 0o1000 != 0).then(|| m.uid())
+}
+
+#[cfg(not(unix))]
+fn sticky_folder_owner(_: &Path) -> Option<u32> {
+    None
 }
 
 /// Checks that `folder` exists and is a folder, naming the true cause when
