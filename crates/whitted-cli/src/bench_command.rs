@@ -19,6 +19,7 @@ use whitted::scene::load_any;
 use whitted::world::World;
 
 use crate::progress::Status;
+use crate::report::{self, note};
 
 /// Brute force is skipped in `--accel all` above this many primitive tests
 /// (primitives × rays): it would take minutes. Ask for it by name instead.
@@ -174,7 +175,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         let work = primitives as f64 * total_rays as f64;
         if kind == AccelKind::Linear && args.accel == "all" && work > LINEAR_BUDGET {
             if !args.quiet && !args.json {
-                eprintln!(
+                note!(
                     "linear skipped: {primitives} primitives x {total_rays} rays is too much \
                      brute force; use --accel linear to run it anyway"
                 );
@@ -224,12 +225,12 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
     }
     status.finish();
 
-    if args.json {
-        println!("{}", to_json(args, primitives, all_threads, &reports));
+    let results = if args.json {
+        format!("{}\n", to_json(args, primitives, all_threads, &reports))
     } else {
-        print_table(args, primitives, all_threads, &reports);
-    }
-    Ok(())
+        table(args, primitives, all_threads, &reports)
+    };
+    report::results(&results)
 }
 
 /// The geometry with structure `kind`, built `runs` times (at least once),
@@ -260,20 +261,21 @@ fn mrays(rays: usize, seconds: f64) -> f64 {
     }
 }
 
-fn print_table(args: &BenchArgs, primitives: usize, threads: usize, reports: &[AccelReport]) {
+/// The results as a table, one block of lines per structure.
+fn table(args: &BenchArgs, primitives: usize, threads: usize, reports: &[AccelReport]) -> String {
     let source = match &args.rays {
         Some(dir) => format!("rays from {}", dir.display()),
         None => format!("rays for a {}x{} image", args.width, args.height),
     };
-    println!(
+    let mut lines = vec![format!(
         "{}: {primitives} primitives; {source}; best of {} runs",
         args.scene.display(),
         args.runs
-    );
+    )];
     for r in reports {
         let s = &r.stats;
-        println!();
-        println!(
+        lines.push(String::new());
+        lines.push(format!(
             "{:<7} build {:.1} ms, {:.2} MB, {} nodes, {} leaves, {} references, SAH cost {:.2}, depth {}",
             r.kind.name(),
             r.build_seconds * 1e3,
@@ -283,9 +285,9 @@ fn print_table(args: &BenchArgs, primitives: usize, threads: usize, reports: &[A
             s.references,
             s.sah_cost,
             s.max_depth
-        );
+        ));
         let agree_header = if args.rays.is_some() { "  agree" } else { "" };
-        println!(
+        lines.push(format!(
             "        {:<8} {:>9} {:>11} {:>11} {:>10} {:>10}{agree_header}",
             "rays",
             "count",
@@ -293,13 +295,13 @@ fn print_table(args: &BenchArgs, primitives: usize, threads: usize, reports: &[A
             format!("Mrays/s {threads}T"),
             "nodes/ray",
             "prims/ray"
-        );
+        ));
         for k in &r.kinds {
             let agree = k
                 .agreeing
                 .map(|(a, n)| format!("  {:.4}%", 100.0 * a as f64 / n.max(1) as f64))
                 .unwrap_or_default();
-            println!(
+            lines.push(format!(
                 "        {:<8} {:>9} {:>11.2} {:>11.2} {:>10.1} {:>10.1}{agree}",
                 k.kind.name(),
                 k.rays,
@@ -307,9 +309,10 @@ fn print_table(args: &BenchArgs, primitives: usize, threads: usize, reports: &[A
                 mrays(k.rays, k.seconds_all),
                 k.nodes_per_ray,
                 k.primitives_per_ray
-            );
+            ));
         }
     }
+    lines.iter().map(|line| format!("{line}\n")).collect()
 }
 
 fn to_json(args: &BenchArgs, primitives: usize, threads: usize, reports: &[AccelReport]) -> Value {

@@ -1,12 +1,20 @@
 //! The `whitted` command: renders scenes with the whitted ray tracer.
+//!
+//! It prints only through [`report`], which never panics.
+#![deny(clippy::print_stdout, clippy::print_stderr, clippy::dbg_macro)]
 
 mod bench_command;
 mod progress;
 mod render_command;
+mod report;
+#[cfg(unix)]
+mod signals;
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+
+use crate::report::note;
 
 /// A classic (Whitted-style) ray tracer: exact primitives, Phong shading,
 /// shadows, mirror reflection and refraction.
@@ -29,6 +37,10 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    #[cfg(unix)]
+    if let Err(message) = signals::remove_partial_files_on_signals() {
+        note!("warning: {message}; an interrupted render may leave .partial files behind");
+    }
     let result = match cli.command {
         Command::Render(args) => render_command::run(&args),
         Command::Bench(args) => bench_command::run(&args),
@@ -36,7 +48,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {
-            eprintln!("error: {message}");
+            note!("error: {message}");
             ExitCode::FAILURE
         }
     }

@@ -6,12 +6,13 @@ use std::time::Instant;
 use clap::Args;
 use whitted::accel::AccelKind;
 use whitted::image::heat_map;
-use whitted::image::{ImageFormat, check_destination};
+use whitted::image::{ImageError, ImageFormat, check_destination};
 use whitted::math::Vec3;
 use whitted::render::{Aov, render};
 use whitted::scene::{CameraOverride, LoadOptions, load_any_with};
 
 use crate::progress::ProgressReport;
+use crate::report::note;
 
 /// Render a scene to an image.
 ///
@@ -127,6 +128,7 @@ fn parse_aov(spec: &str) -> Result<(Aov, PathBuf), String> {
         (_, Ok(ImageFormat::Exr | ImageFormat::Pfm)) | (Aov::Cost, Ok(ImageFormat::Png)) => {
             Ok((aov, path))
         }
+        (_, Err(e @ ImageError::Refused { .. })) => Err(format!("--aov {spec}: {e}")),
         (Aov::Cost, _) => Err(format!(
             "--aov {spec}: the cost AOV is written as .png (a heat map) or .pfm/.exr"
         )),
@@ -136,21 +138,31 @@ fn parse_aov(spec: &str) -> Result<(Aov, PathBuf), String> {
     }
 }
 
-/// Refuses, before any work, outputs that cannot be written: unknown
-/// formats, missing folders, and two outputs to the same file.
+/// Refuses, before any work, outputs that cannot be written (see
+/// [`check_destination`]: names that are no image file, missing or
+/// unwritable folders, files the user may not write) and two outputs to
+/// the same file (by canonical path and by file identity); says what the
+/// user should know about the files that will be replaced.
 fn check_destinations(output: &Path, aovs: &[(Aov, PathBuf)]) -> Result<(), String> {
-    let mut seen = vec![output];
-    check_destination(output).map_err(|e| e.to_string())?;
+    let image = check_destination(output).map_err(|e| e.to_string())?;
+    let mut checked = vec![(format!("-o {}", output.display()), image)];
     for (aov, path) in aovs {
-        check_destination(path).map_err(|e| e.to_string())?;
-        if seen.contains(&path.as_path()) {
+        let destination = check_destination(path).map_err(|e| e.to_string())?;
+        let option = format!("--aov {}={}", aov.name(), path.display());
+        if let Some((other, _)) = checked
+            .iter()
+            .find(|(_, d)| d.is_same_file_as(&destination))
+        {
             return Err(format!(
-                "--aov {}={}: that file is already an output of this render",
-                aov.name(),
-                path.display()
+                "{option}: that file is already an output of this render ({other})"
             ));
         }
-        seen.push(path);
+        checked.push((option, destination));
+    }
+    for (_, destination) in &checked {
+        for warning in destination.notes() {
+            note!("warning: {warning}");
+        }
     }
     Ok(())
 }
@@ -177,10 +189,10 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             let start = Instant::now();
             let loaded = load_any_with(path, &options).map_err(|e| e.to_string())?;
             for warning in &loaded.warnings {
-                eprintln!("{warning}\n");
+                note!("{warning}\n");
             }
             if !args.quiet {
-                eprintln!(
+                note!(
                     "{}: read in {:.3} s, {} primitives",
                     path.display(),
                     start.elapsed().as_secs_f64(),
@@ -243,7 +255,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             .map(|&kind| format!("{} {}", rays[kind], kind.name()))
             .collect::<Vec<_>>()
             .join(", ");
-        eprintln!(
+        note!(
             "{}: {}x{}, {} spp in {:.3} s; rays: {by_kind}; {:.2} Mrays/s",
             args.output.display(),
             scene.settings.width,
@@ -286,5 +298,10 @@ mod tests {
             Ok((Aov::Cost, PathBuf::from("c.png")))
         );
         assert!(parse_aov("cost=c.bmp").unwrap_err().contains("heat map"));
+        assert!(
+            parse_aov("depth=.pfm")
+                .unwrap_err()
+                .contains("`.pfm` is a hidden file's name with no extension")
+        );
     }
 }

@@ -3,18 +3,27 @@
 //! as computed: linear light for a linear scene, display values for a
 //! display-referred one).
 //!
-//! Files are written whole or not at all: the bytes go to a temporary file
-//! in the destination folder, which is renamed over the destination only
-//! once complete.
+//! Files are written whole or not at all: the bytes go to a partial file
+//! in the destination folder ([`partial`](self) files, removed on a
+//! signal by [`remove_partial_files`]), which is renamed over the
+//! destination only once complete. What may be replaced, and how, is the
+//! job of [`check_destination`] and its module.
 
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 mod color_space;
+mod destination;
 mod heat_map;
+mod partial;
 
 pub use color_space::{ColorSpace, encode_display8, encode_srgb8};
+pub use destination::{Destination, check_destination};
 pub use heat_map::{heat_map, ramp};
+pub use partial::{PartialFilesRemoved, remove_partial_files};
+
+use destination::{existing_file, folder_of, keep_attributes, resolve};
+use partial::{IN_FLIGHT, PartialFile};
 
 /// A `width` × `height` grid of pixels with `channels` float values each,
 /// row 0 at the top, and what its values mean.
@@ -48,6 +57,14 @@ pub enum ImageError {
         /// The destination.
         path: PathBuf,
     },
+    /// The destination may not be written, or its name names no file.
+    #[error("{path}: {why}")]
+    Refused {
+        /// The destination as given.
+        path: PathBuf,
+        /// Why, in words.
+        why: String,
+    },
     /// The data can't be stored in that format.
     #[error("{path}: {why}")]
     Unsupported {
@@ -67,8 +84,36 @@ pub enum ImageError {
 }
 
 impl ImageFormat {
-    /// The format named by a path's extension (case-insensitive).
+    /// The format named by a path's extension (case-insensitive). A path
+    /// that names no file (empty, ending in `/`, `.` or `..`) or whose
+    /// name is an extension alone (`.png`, a hidden file without one) is
+    /// refused as such.
     pub fn from_path(path: &Path) -> Result<Self, ImageError> {
+        let refused = |why: String| ImageError::Refused {
+            path: path.to_path_buf(),
+            why,
+        };
+        let Some(name) = path.file_name() else {
+            return Err(refused(
+                "this names no file; give a file name such as image.png".to_string(),
+            ));
+        };
+        if path.as_os_str().as_encoded_bytes().ends_with(b"/") {
+            return Err(refused(
+                "the name ends with /, so it names a folder; give a file name such as image.png"
+                    .to_string(),
+            ));
+        }
+        let name = name.to_string_lossy();
+        if path.extension().is_none()
+            && let Some(ext) = name.strip_prefix('.')
+            && ["png", "exr", "pfm"].contains(&ext.to_ascii_lowercase().as_str())
+        {
+            return Err(refused(format!(
+                "`{name}` is a hidden file's name with no extension (a leading dot does not \
+                 start an extension); give the file a name, such as image{name}"
+            )));
+        }
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
@@ -148,9 +193,10 @@ impl Film {
         self.encode(path)?.commit()
     }
 
-    /// Encodes the film into a temporary file beside `path`, to be renamed
-    /// into place by [`PendingImage::commit`]. Nothing at `path` changes
-    /// until then; dropping the result removes the temporary file.
+    /// Encodes the film into a partial file beside `path` (beside its
+    /// target if `path` is a symbolic link), to be renamed into place by
+    /// [`PendingImage::commit`]. Nothing at `path` changes until then;
+    /// dropping the result removes the partial file.
     pub fn encode(&self, path: &Path) -> Result<PendingImage, ImageError> {
         let format = ImageFormat::from_path(path)?;
         if format == ImageFormat::Png && self.channels != 1 && self.channels != 3 {
@@ -159,7 +205,7 @@ impl Film {
                 why: format!("PNG holds 1 or 3 channels, not {}", self.channels),
             });
         }
-        encode_to_temp(path, |out| match format {
+        encode_to_partial(path, |out| match format {
             ImageFormat::Png => self.encode_png(out),
             ImageFormat::Pfm => self.encode_pfm(out),
             ImageFormat::Exr => self.encode_exr(out),
@@ -239,79 +285,53 @@ impl Film {
     }
 }
 
-/// An encoded image waiting in a temporary file beside its destination.
+/// An encoded image waiting in a partial file beside its destination.
 #[derive(Debug)]
 pub struct PendingImage {
-    temp: tempfile::NamedTempFile,
+    partial: PartialFile,
     path: PathBuf,
+    target: PathBuf,
 }
 
 impl PendingImage {
-    /// Renames the finished file over its destination.
+    /// Renames the finished file over its destination, after checking
+    /// again that whatever is there may be replaced; the new file keeps the
+    /// old one's permissions (and owner and group where allowed).
     pub fn commit(self) -> Result<(), ImageError> {
-        let path = self.path;
-        self.temp.persist(&path).map_err(|e| ImageError::Io {
+        let Self {
+            mut partial,
+            path,
+            target,
+        } = self;
+        let io = |source: std::io::Error| ImageError::Io {
             path: path.clone(),
-            source: e.error,
-        })?;
-        Ok(())
+            source,
+        };
+        if let Some(existing) = existing_file(&path, &target)? {
+            keep_attributes(partial.file(), &existing).map_err(io)?;
+        }
+        partial.persist(&target).map_err(io)
     }
 }
 
-/// The folder a file is written in (`.` for a bare file name).
-fn folder_of(path: &Path) -> &Path {
-    match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    }
-}
-
-/// Checks that `path` names a file that can be created: a known image
-/// format in an existing folder. Lets a caller refuse bad destinations
-/// before doing the work.
-pub fn check_destination(path: &Path) -> Result<ImageFormat, ImageError> {
-    let format = ImageFormat::from_path(path)?;
-    let folder = folder_of(path);
-    if !folder.is_dir() {
-        return Err(ImageError::Io {
-            path: path.to_path_buf(),
-            source: std::io::Error::new(
-                std::io::ErrorKind::NotFound,
-                format!("the folder {} does not exist", folder.display()),
-            ),
-        });
-    }
-    if path.is_dir() {
-        return Err(ImageError::Unsupported {
-            path: path.to_path_buf(),
-            why: "this is a folder, not a file name".to_string(),
-        });
-    }
-    Ok(format)
-}
-
-/// Encodes into a new temporary file in `path`'s folder.
-fn encode_to_temp(
+/// Encodes into a new partial file in the folder of `path`'s target.
+fn encode_to_partial(
     path: &Path,
     encode: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
 ) -> Result<PendingImage, ImageError> {
     let io = |source: std::io::Error| ImageError::Io {
         path: path.to_path_buf(),
-        // Drop the temporary file's name that some errors carry.
+        // Drop the partial file's name that some errors carry.
         source: std::io::Error::new(source.kind(), source.kind().to_string()),
     };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".whitted-").suffix(".partial");
-    // Like any new file: readable as the umask allows, not private to the
-    // owner as temporary files are by default.
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let mut temp = builder.tempfile_in(folder_of(path)).map_err(io)?;
-    encode(temp.as_file_mut()).map_err(io)?;
-    temp.as_file().sync_all().map_err(io)?;
+    let (target, _) = resolve(path)?;
+    let mut partial = PartialFile::create_in(folder_of(&target), &IN_FLIGHT).map_err(io)?;
+    encode(partial.file()).map_err(io)?;
+    partial.file().sync_all().map_err(io)?;
     Ok(PendingImage {
-        temp,
+        partial,
         path: path.to_path_buf(),
+        target,
     })
 }
 
@@ -413,7 +433,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("g.png");
         std::fs::write(&path, b"old").unwrap();
-        let failed = encode_to_temp(&path, |out| {
+        let failed = encode_to_partial(&path, |out| {
             out.write_all(b"half an image")?;
             Err(std::io::Error::other("disk full"))
         });
@@ -439,7 +459,9 @@ mod tests {
     fn destinations_are_checked_before_any_work() {
         let dir = tempfile::tempdir().unwrap();
         assert_eq!(
-            check_destination(&dir.path().join("a.exr")).unwrap(),
+            check_destination(&dir.path().join("a.exr"))
+                .unwrap()
+                .format(),
             ImageFormat::Exr
         );
         let missing = check_destination(Path::new("/no/such/folder/a.png")).unwrap_err();
@@ -450,6 +472,52 @@ mod tests {
         );
         assert!(check_destination(dir.path()).is_err());
         assert!(check_destination(Path::new("a.gif")).is_err());
+    }
+
+    #[test]
+    fn names_that_are_no_file_or_an_extension_alone_say_so() {
+        for (name, says) in [
+            (".png", "`.png` is a hidden file's name with no extension"),
+            (
+                "out/.EXR",
+                "`.EXR` is a hidden file's name with no extension",
+            ),
+            ("", "this names no file"),
+            ("out/..", "this names no file"),
+            ("x.png/", "the name ends with /, so it names a folder"),
+            (".gif", "unknown image format"),
+        ] {
+            let error = ImageFormat::from_path(Path::new(name))
+                .unwrap_err()
+                .to_string();
+            assert!(error.contains(says), "{name}: {error}");
+        }
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_replaced_file_keeps_its_mode_and_a_link_is_written_through() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let private = dir.path().join("private.pfm");
+        std::fs::write(&private, b"old").unwrap();
+        std::fs::set_permissions(&private, std::fs::Permissions::from_mode(0o600)).unwrap();
+        gradient().write(&private).unwrap();
+        let mode = std::fs::metadata(&private).unwrap().permissions().mode();
+        assert_eq!(mode & 0o777, 0o600);
+
+        let link = dir.path().join("link.pfm");
+        std::os::unix::fs::symlink("private.pfm", &link).unwrap();
+        std::fs::write(&private, b"old").unwrap();
+        gradient().write(&link).unwrap();
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert!(std::fs::read(&private).unwrap().starts_with(b"PF\n"));
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
     }
 
     #[cfg(unix)]
@@ -470,10 +538,10 @@ mod tests {
         let err = gradient()
             .write(Path::new("/nonexistent-folder/x.png"))
             .unwrap_err();
-        assert!(matches!(err, ImageError::Io { .. }));
+        assert!(matches!(err, ImageError::Refused { .. }));
         assert_eq!(
             err.to_string(),
-            "/nonexistent-folder/x.png: entity not found"
+            "/nonexistent-folder/x.png: the folder /nonexistent-folder does not exist"
         );
     }
 }

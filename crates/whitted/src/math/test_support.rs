@@ -8,6 +8,10 @@ pub(crate) const ALLOW_NO_AVX: &str = "WHITTED_ALLOW_NO_AVX";
 /// run. Without AVX such a test would prove nothing, so this panics (the
 /// test fails) unless [`ALLOW_NO_AVX`] is `1`; then it prints that the test
 /// is skipped and returns false.
+#[allow(
+    clippy::print_stderr,
+    reason = "a skipped test says so in the test harness's output"
+)]
 pub(crate) fn has_avx_or_skip_allowed() -> bool {
     let allowed = std::env::var(ALLOW_NO_AVX).ok();
     match avx_decision(is_x86_feature_detected!("avx"), allowed.as_deref()) {

@@ -1,0 +1,141 @@
+//! Everything the command prints goes through here, and nothing here
+//! panics (`println!` and `eprintln!` panic when the stream fails, and are
+//! denied in this crate).
+//!
+//! - Reports (progress notes, warnings, errors) go to standard error with
+//!   [`note!`]. A report that cannot be written (a closed
+//!   pipe, a full device) ends the reporting, not the work: nothing more is
+//!   tried on standard error, and the exit code is what the work decides.
+//! - Results (`bench`'s table or JSON) go to standard output with
+//!   [`results`]. Results that cannot be written are an error: the command
+//!   says so on standard error if it can and exits with 1, as for any
+//!   other failure.
+
+use std::fmt;
+use std::io::Write;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Writes a line (`format!` arguments) on standard error, if reports can
+/// still be written there.
+macro_rules! note {
+    ($($arg:tt)*) => {
+        $crate::report::note_line(format_args!($($arg)*))
+    };
+}
+
+pub(crate) use note;
+
+/// A stream for reports that gives up at its first failed write.
+pub struct ReportStream {
+    failed: AtomicBool,
+}
+
+impl ReportStream {
+    /// A stream that has not failed.
+    pub const fn new() -> Self {
+        Self {
+            failed: AtomicBool::new(false),
+        }
+    }
+
+    /// Writes `line` and a newline to `out` in one write, unless a write
+    /// failed before; a failure now stops all later lines.
+    pub fn line(&self, out: &mut impl Write, line: fmt::Arguments<'_>) {
+        if self.failed.load(Ordering::Relaxed) {
+            return;
+        }
+        let text = format!("{line}\n");
+        if out
+            .write_all(text.as_bytes())
+            .and_then(|()| out.flush())
+            .is_err()
+        {
+            self.failed.store(true, Ordering::Relaxed);
+        }
+    }
+}
+
+/// Standard error, as a report stream.
+static STDERR: ReportStream = ReportStream::new();
+
+/// Writes a line on standard error (see [`note!`]).
+pub fn note_line(line: fmt::Arguments<'_>) {
+    STDERR.line(&mut std::io::stderr().lock(), line);
+}
+
+/// Writes the command's results on standard output and flushes them; the
+/// error says why they could not be written.
+pub fn results(text: &str) -> Result<(), String> {
+    write_results(&mut std::io::stdout().lock(), text)
+}
+
+fn write_results(out: &mut impl Write, text: &str) -> Result<(), String> {
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(|e| format!("the results could not be written to standard output: {e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A stream that takes `room` bytes and then fails as a full device
+    /// does, counting the writes tried.
+    struct Full {
+        room: usize,
+        written: Vec<u8>,
+        tries: usize,
+    }
+
+    impl Write for Full {
+        fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+            self.tries += 1;
+            let n = buf.len().min(self.room);
+            if n == 0 {
+                return Err(std::io::Error::from_raw_os_error(28));
+            }
+            self.room -= n;
+            self.written.extend_from_slice(&buf[..n]);
+            Ok(n)
+        }
+
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn reports_stop_at_the_first_failed_write_without_panicking() {
+        let stream = ReportStream::new();
+        let mut out = Full {
+            room: 8,
+            written: Vec::new(),
+            tries: 0,
+        };
+        stream.line(&mut out, format_args!("first"));
+        assert_eq!(out.written, b"first\n");
+        stream.line(&mut out, format_args!("second {}", 2));
+        let tries = out.tries;
+        stream.line(&mut out, format_args!("third"));
+        assert_eq!(out.tries, tries, "nothing is tried after a failure");
+        assert_eq!(out.written, b"first\nse");
+    }
+
+    #[test]
+    fn results_that_cannot_be_written_are_an_error_saying_why() {
+        let mut out = Full {
+            room: 3,
+            written: Vec::new(),
+            tries: 0,
+        };
+        let error = write_results(&mut out, "a table\n").unwrap_err();
+        assert_eq!(
+            error,
+            "the results could not be written to standard output: No space left on device \
+             (os error 28)"
+        );
+        let mut fine = Vec::new();
+        write_results(&mut fine, "a table\n").unwrap();
+        assert_eq!(fine, b"a table\n");
+    }
+}

@@ -1,0 +1,177 @@
+//! Partial files: the temporary files (`.whitted-XXXXXX.partial`) an image
+//! is encoded into before it is renamed over its destination, and the
+//! registry of those still in flight, so that a process ending on a signal
+//! can remove them ([`remove_partial_files`]).
+//!
+//! The registry is locked while a partial file is created, renamed or
+//! removed, so at any moment every partial file on disk is either listed or
+//! about to be gone with the lock held by its owner.
+
+use std::fs::File;
+use std::io;
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard, PoisonError};
+
+/// A list of partial files that exist now.
+#[derive(Debug)]
+pub(crate) struct Registry(Mutex<Vec<PathBuf>>);
+
+impl Registry {
+    /// An empty list.
+    pub(crate) const fn new() -> Self {
+        Self(Mutex::new(Vec::new()))
+    }
+
+    fn lock(&self) -> MutexGuard<'_, Vec<PathBuf>> {
+        // The list stays valid whatever panicked while holding it: every
+        // change to it is one push or one removal.
+        self.0.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// Removes every listed file and keeps the list locked.
+    fn remove_all(&self) -> MutexGuard<'_, Vec<PathBuf>> {
+        let mut list = self.lock();
+        for path in list.drain(..) {
+            // Already gone is as good as removed; nothing else can be done
+            // about a file that cannot be removed by a process that is
+            // ending.
+            let _ = std::fs::remove_file(path);
+        }
+        list
+    }
+}
+
+/// The partial files of this process.
+pub(crate) static IN_FLIGHT: Registry = Registry::new();
+
+/// A new temporary file in a folder, listed in the registry until it is
+/// renamed into place or dropped (which removes it).
+#[derive(Debug)]
+pub(crate) struct PartialFile {
+    /// Always `Some` until `persist` or `drop` takes it.
+    temp: Option<tempfile::NamedTempFile>,
+    registry: &'static Registry,
+}
+
+impl PartialFile {
+    /// Creates an empty partial file in `folder`, readable as the umask
+    /// allows like any new file (not private to the owner, as temporary
+    /// files are by default).
+    pub(crate) fn create_in(folder: &Path, registry: &'static Registry) -> io::Result<Self> {
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(".whitted-").suffix(".partial");
+        #[cfg(unix)]
+        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+        let mut list = registry.lock();
+        let temp = builder.tempfile_in(folder)?;
+        list.push(temp.path().to_path_buf());
+        Ok(Self {
+            temp: Some(temp),
+            registry,
+        })
+    }
+
+    /// The open file, to write into.
+    pub(crate) fn file(&mut self) -> &mut File {
+        self.temp
+            .as_mut()
+            .map(tempfile::NamedTempFile::as_file_mut)
+            .expect("a partial file is present until persisted or dropped")
+    }
+
+    /// Renames the file to `target`, replacing what is there.
+    pub(crate) fn persist(mut self, target: &Path) -> io::Result<()> {
+        let mut list = self.registry.lock();
+        let temp = self
+            .temp
+            .take()
+            .expect("a partial file is present until persisted or dropped");
+        let path = temp.path().to_path_buf();
+        // On failure the file comes back with the error and is removed
+        // here, with the registry still locked.
+        let result = temp.persist(target).map(drop).map_err(|e| e.error);
+        list.retain(|p| *p != path);
+        result
+    }
+}
+
+impl Drop for PartialFile {
+    fn drop(&mut self) {
+        if let Some(temp) = self.temp.take() {
+            let mut list = self.registry.lock();
+            let path = temp.path().to_path_buf();
+            drop(temp);
+            list.retain(|p| *p != path);
+        }
+    }
+}
+
+/// Proof that the partial files are gone: while it is held, no partial
+/// file can be created, renamed or removed by another thread.
+#[must_use = "hold it until the process exits, so that no new partial file appears"]
+pub struct PartialFilesRemoved {
+    _list: MutexGuard<'static, Vec<PathBuf>>,
+}
+
+/// Removes every partial file this process has on disk, for a process
+/// about to end on a signal (an image half encoded must not be left
+/// behind). Hold the result until the process exits: it keeps other
+/// threads from starting a new one.
+pub fn remove_partial_files() -> PartialFilesRemoved {
+    PartialFilesRemoved {
+        _list: IN_FLIGHT.remove_all(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The tests' own registry: emptying the process's one would remove
+    /// the files of other tests running at the same time.
+    static TESTS: Registry = Registry::new();
+
+    fn listed() -> Vec<PathBuf> {
+        TESTS.lock().clone()
+    }
+
+    #[test]
+    fn a_partial_file_is_listed_while_it_exists() {
+        let dir = tempfile::tempdir().unwrap();
+        let partial = PartialFile::create_in(dir.path(), &TESTS).unwrap();
+        let path = partial.temp.as_ref().unwrap().path().to_path_buf();
+        assert!(listed().contains(&path));
+        assert!(
+            path.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .ends_with(".partial")
+        );
+        drop(partial);
+        assert!(!path.exists());
+        assert!(!listed().contains(&path));
+
+        let mut partial = PartialFile::create_in(dir.path(), &TESTS).unwrap();
+        let path = partial.temp.as_ref().unwrap().path().to_path_buf();
+        std::io::Write::write_all(partial.file(), b"image").unwrap();
+        let target = dir.path().join("done");
+        partial.persist(&target).unwrap();
+        assert!(!listed().contains(&path));
+        assert_eq!(std::fs::read(&target).unwrap(), b"image");
+    }
+
+    #[test]
+    fn removing_the_partial_files_empties_the_folder_of_them() {
+        let dir = tempfile::tempdir().unwrap();
+        let partial = PartialFile::create_in(dir.path(), &TESTS).unwrap();
+        let path = partial.temp.as_ref().unwrap().path().to_path_buf();
+        {
+            let _removed = TESTS.remove_all();
+        }
+        assert!(!path.exists());
+        // Dropping it afterwards finds nothing to remove and no entry.
+        drop(partial);
+        assert!(!listed().contains(&path));
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+}
