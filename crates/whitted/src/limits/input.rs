@@ -46,7 +46,10 @@ fn read_within(path: &Path, budget: MemoryBudget) -> io::Result<Vec<u8>> {
         let error = budget
             .check("reading the file", needed, "use a smaller file")
             .err()?;
-        Some(io::Error::new(io::ErrorKind::FileTooLarge, error.to_string()))
+        Some(io::Error::new(
+            io::ErrorKind::FileTooLarge,
+            error.to_string(),
+        ))
     };
     if let Some(error) = too_large(metadata.len()) {
         return Err(error);

@@ -150,10 +150,13 @@ impl fmt::Display for MemoryBudget {
 fn usable_memory() -> Option<u64> {
     let read = |path: &str| std::fs::read_to_string(path).ok();
     let total = read("/proc/meminfo").and_then(|text| mem_total(&text));
-    let group = ["/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"]
-        .into_iter()
-        .filter_map(|path| read(path)?.trim().parse::<u64>().ok())
-        .min();
+    let group = [
+        "/sys/fs/cgroup/memory.max",
+        "/sys/fs/cgroup/memory/memory.limit_in_bytes",
+    ]
+    .into_iter()
+    .filter_map(|path| read(path)?.trim().parse::<u64>().ok())
+    .min();
     match (total, group) {
         (Some(t), Some(g)) => Some(t.min(g)),
         (t, g) => t.or(g),
@@ -193,7 +196,9 @@ pub fn format_bytes(bytes: u64) -> String {
 /// without a trailing `B` or `iB`. At least one byte.
 pub fn parse_size(text: &str) -> Result<u64, String> {
     let expected = || {
-        format!("`{text}` is not a size: expected a number of bytes, or one with K, M, G or T, like 512M or 4G")
+        format!(
+            "`{text}` is not a size: expected a number of bytes, or one with K, M, G or T, like 512M or 4G"
+        )
     };
     let lower = text.trim().to_ascii_lowercase();
     let unitless = lower
@@ -211,9 +216,7 @@ pub fn parse_size(text: &str) -> Result<u64, String> {
     let value: f64 = number.trim().parse().map_err(|_| expected())?;
     let bytes = value * (1u64 << shift) as f64;
     if !bytes.is_finite() || bytes < 1.0 || bytes >= u64::MAX as f64 {
-        return Err(format!(
-            "`{text}` is not a size between 1 byte and 16 EiB"
-        ));
+        return Err(format!("`{text}` is not a size between 1 byte and 16 EiB"));
     }
     Ok(bytes as u64)
 }
@@ -226,7 +229,11 @@ mod tests {
     fn a_request_above_the_budget_says_what_it_needs_and_how_to_proceed() {
         let budget = MemoryBudget::from_total(Some(16 << 30));
         assert_eq!(budget.bytes, 12 << 30);
-        assert!(budget.check("a small image", 12 << 30, "render smaller").is_ok());
+        assert!(
+            budget
+                .check("a small image", 12 << 30, "render smaller")
+                .is_ok()
+        );
         let error = budget
             .check("a 16384x16384 image", 13 << 30, "render a smaller image")
             .unwrap_err();
@@ -237,7 +244,12 @@ mod tests {
              budget with --max-memory"
         );
         let given = MemoryBudget::given(1 << 20).check("x", 1 << 21, "less");
-        assert!(given.unwrap_err().to_string().contains("1.0 MiB (as given)"));
+        assert!(
+            given
+                .unwrap_err()
+                .to_string()
+                .contains("1.0 MiB (as given)")
+        );
     }
 
     #[test]
