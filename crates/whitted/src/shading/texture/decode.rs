@@ -276,6 +276,28 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn a_png_header_claiming_more_than_its_data_can_hold_is_refused_before_decoding() {
+        let mut bytes = Vec::new();
+        {
+            let mut encoder = png::Encoder::new(&mut bytes, 40000, 40000);
+            encoder.set_color(png::ColorType::Rgb);
+            let mut writer = encoder.write_header().unwrap();
+            // A zlib stream of one stored empty block: far from 4.8 GB.
+            let idat = [0x78, 0x01, 0x01, 0x00, 0x00, 0xff, 0xff, 0x00, 0x00, 0x00, 0x01];
+            writer.write_chunk(png::chunk::IDAT, &idat).unwrap();
+        }
+        let error = decode_image(&bytes, Decoding::Color).unwrap_err();
+        assert_eq!(
+            error,
+            format!(
+                "the header claims 40000x40000 pixels, far more than {} bytes can hold: the \
+                 file is truncated or corrupt",
+                bytes.len()
+            )
+        );
+    }
+
+    #[test]
     fn eight_bit_samples_are_srgb_decoded() {
         let image = decode_image(
             &png_bytes(2, 1, &[0, 128, 255, 188, 188, 188]),
