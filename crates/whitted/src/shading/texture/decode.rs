@@ -283,7 +283,9 @@ pub(crate) mod tests {
             encoder.set_color(png::ColorType::Rgb);
             let mut writer = encoder.write_header().unwrap();
             // A zlib stream of one stored empty block: far from 4.8 GB.
-            let idat = [0x78, 0x01, 0x01, 0x00, 0x00, 0xff, 0xff, 0x00, 0x00, 0x00, 0x01];
+            let idat = [
+                0x78, 0x01, 0x01, 0x00, 0x00, 0xff, 0xff, 0x00, 0x00, 0x00, 0x01,
+            ];
             writer.write_chunk(png::chunk::IDAT, &idat).unwrap();
         }
         let error = decode_image(&bytes, Decoding::Color).unwrap_err();
