@@ -12,7 +12,10 @@ use serde_json::{Value, json};
 use whitted::accel::{AccelKind, AccelStats, AccelerationStructure};
 use whitted::bench::obj_positions::load_obj_positions;
 use whitted::bench::ray_files::{RayFile, agreement, read_ray_file};
-use whitted::bench::{RayKind, RaySet, TraceResults, scene_ray_sets, time_set, trace_all};
+use whitted::bench::{
+    RayKind, RaySet, TraceResults, check_bench_size, scene_ray_sets, time_set, trace_all,
+};
+use whitted::limits::MemoryBudget;
 use whitted::render::Camera;
 use whitted::render::Scene;
 use whitted::scene::load_any;
@@ -65,6 +68,12 @@ pub struct BenchArgs {
     /// reported).
     #[arg(long, default_value_t = 3, value_name = "N")]
     runs: usize,
+
+    /// The memory budget: the most the rays, an input file or the scene's
+    /// textures may take, like 512M or 8G (default: 3/4 of this machine's
+    /// memory).
+    #[arg(long, value_name = "SIZE", value_parser = whitted::limits::parse_size)]
+    max_memory: Option<u64>,
 
     /// Print JSON instead of a table.
     #[arg(long)]
@@ -140,6 +149,12 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
     let kinds = kinds(&args.accel)?;
     if args.width == 0 || args.height == 0 {
         return Err("--width and --height must be at least 1".to_string());
+    }
+    if let Some(bytes) = args.max_memory {
+        MemoryBudget::given(bytes).set_current();
+    }
+    if args.rays.is_none() {
+        check_bench_size(args.width, args.height).map_err(|e| e.to_string())?;
     }
     let status = Status::new(args.quiet || args.json);
     status.set(format!("loading {}", args.scene.display()));

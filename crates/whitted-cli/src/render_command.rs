@@ -7,6 +7,7 @@ use clap::Args;
 use whitted::accel::AccelKind;
 use whitted::image::heat_map;
 use whitted::image::{ImageError, ImageFormat, check_destination};
+use whitted::limits::MemoryBudget;
 use whitted::math::Vec3;
 use whitted::render::{Aov, render};
 use whitted::scene::{CameraOverride, LoadOptions, load_any_with};
@@ -89,6 +90,11 @@ pub struct RenderArgs {
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     fov: Option<f64>,
 
+    /// The memory budget: the most an image, a texture or an input file
+    /// may take, like 512M or 8G (default: 3/4 of this machine's memory).
+    #[arg(long, value_name = "SIZE", value_parser = whitted::limits::parse_size)]
+    max_memory: Option<u64>,
+
     /// Print nothing but errors.
     #[arg(short, long)]
     quiet: bool,
@@ -169,6 +175,9 @@ fn check_destinations(output: &Path, aovs: &[(Aov, PathBuf)]) -> Result<(), Stri
 
 /// Runs the command.
 pub fn run(args: &RenderArgs) -> Result<(), String> {
+    if let Some(bytes) = args.max_memory {
+        MemoryBudget::given(bytes).set_current();
+    }
     let aov_outputs = args
         .aov
         .iter()
@@ -229,6 +238,16 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     bar.finish();
     let output = output.map_err(|e| e.to_string())?;
     let elapsed = start.elapsed().as_secs_f64();
+    if let Some(clamp) = &output.thread_clamp
+        && !args.quiet
+    {
+        note!("note: {clamp}");
+    }
+    if let Some(cut) = &output.ray_budget_cut
+        && !args.quiet
+    {
+        note!("warning: {cut}");
+    }
 
     // Every file is encoded first and renamed into place only when all
     // are ready: a failure leaves every destination as it was.

@@ -10,6 +10,7 @@
 //!
 //! | layer | what it holds |
 //! |---|---|
+//! | [`limits`] | the memory budget, bounded reading of input files |
 //! | [`math`] | vectors, rays, boxes, transforms, error bounds, random numbers, sample patterns |
 //! | [`shape`] | the primitives, each intersected exactly |
 //! | [`mesh`] | triangle meshes with shared vertices |
@@ -64,6 +65,7 @@ pub mod accel;
 pub mod bench;
 pub mod image;
 pub mod integrator;
+pub mod limits;
 pub mod math;
 pub mod mesh;
 pub mod render;

@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 /// The layers, lowest first; a module may import from its own layer and
 /// the ones before it. `accel` is apart: it knows `math` only.
 const LAYERS: &[&[&str]] = &[
+    &["limits"],
     &["math"],
     &["shape"],
     &["mesh"],

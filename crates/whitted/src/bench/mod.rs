@@ -16,7 +16,27 @@ pub use scene_rays::scene_ray_sets;
 pub use timing::{TraceResults, time_set, trace_all};
 
 use crate::accel::RayCoherence;
+use crate::limits::{MemoryBudget, MemoryError};
 use crate::math::Ray;
+
+/// Bytes `rays` rays of one set take while measured: the rays, and the
+/// results of one structure and of the reference.
+pub fn ray_set_bytes(rays: u64) -> u64 {
+    let per_ray = std::mem::size_of::<Ray>() + 2 * std::mem::size_of::<Option<(f64, u32)>>();
+    rays.saturating_mul(per_ray as u64)
+}
+
+/// Refuses, before any ray is made, a bench image of `width` × `height`
+/// whose three ray sets (one ray per pixel each, at most) would exceed the
+/// memory budget.
+pub fn check_bench_size(width: u32, height: u32) -> Result<(), MemoryError> {
+    let pixels = u64::from(width) * u64::from(height);
+    MemoryBudget::current().check(
+        &format!("benchmarking a {width}x{height} image (3 sets of up to {pixels} rays)"),
+        ray_set_bytes(pixels).saturating_mul(3),
+        "use a smaller --width and --height",
+    )
+}
 
 /// The kinds of rays measured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -48,7 +48,7 @@ impl TriangleSoup {
 
 /// Reads and parses an OBJ file.
 pub fn load_obj_positions(path: &Path) -> Result<TriangleSoup, SceneError> {
-    let source = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+    let source = crate::limits::read_input_text(path).map_err(|source| SceneError::Io {
         path: path.to_path_buf(),
         source,
     })?;

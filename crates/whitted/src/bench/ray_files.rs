@@ -11,7 +11,8 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{RayKind, RaySet, TraceResults};
+use super::{RayKind, RaySet, TraceResults, ray_set_bytes};
+use crate::limits::{MemoryBudget, MemoryError};
 use crate::math::{Ray, Vec3};
 
 /// Size of one ray record.
@@ -33,6 +34,14 @@ pub enum RayFileError {
         /// What the operating system said.
         source: std::io::Error,
     },
+    /// A file holds more rays than the memory budget allows.
+    #[error("{}: {source}", path.display())]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// The request and the budget.
+        source: MemoryError,
+    },
     /// A file's size or contents do not fit the format.
     #[error("{}: {why}", path.display())]
     Malformed {
@@ -53,7 +62,7 @@ pub struct RayFile {
 }
 
 fn read(path: &Path) -> Result<Vec<u8>, RayFileError> {
-    std::fs::read(path).map_err(|source| RayFileError::Io {
+    crate::limits::read_input(path).map_err(|source| RayFileError::Io {
         path: path.to_path_buf(),
         source,
     })
@@ -81,6 +90,17 @@ pub fn read_ray_file(dir: &Path, kind: RayKind) -> Result<RayFile, RayFileError>
             ),
         });
     }
+    let count = (bytes.len() / RAY_RECORD) as u64;
+    MemoryBudget::current()
+        .check(
+            &format!("tracing its {count} rays"),
+            ray_set_bytes(count),
+            "use fewer rays",
+        )
+        .map_err(|source| RayFileError::TooLarge {
+            path: rays_path.clone(),
+            source,
+        })?;
     let rays: Vec<Ray> = bytes
         .chunks_exact(RAY_RECORD)
         .map(|r| {

@@ -17,7 +17,17 @@ pub use whitted::Whitted;
 use crate::accel::{QueryContext, TraversalCounters};
 use crate::math::Ray;
 use crate::shading::{Color, Light, Material};
-use crate::world::{Hit, Surface, World};
+use crate::world::{Hit, MaterialId, Surface, World};
+
+/// The most secondary rays (reflected and refracted) one camera sample
+/// traces. A material that both reflects and refracts strongly doubles the
+/// ray tree at each bounce, and its weights need not decay below
+/// `min_weight` (a glass ball with `reflection = 1, transmission = 1` in a
+/// mirror box): past this many rays the sample's remaining branches stop
+/// with their surfaces' own light. A full binary tree of depth 11 (4094
+/// rays) fits, so a normal scene never meets it. The tree is walked in a
+/// fixed order, so where it is cut does not depend on the threads.
+pub const SECONDARY_RAY_BUDGET: u32 = 4096;
 
 /// What the scene says of light and surfaces, borrowed for shading.
 #[derive(Clone, Copy, Debug)]
@@ -40,6 +50,9 @@ pub struct RecursionLimits {
     /// A branch whose weight on the pixel falls below this stops early
     /// (adaptive depth control, Hall and Greenberg 1983).
     pub min_weight: f64,
+    /// The most secondary rays one camera sample traces (normally
+    /// [`SECONDARY_RAY_BUDGET`]).
+    pub ray_budget: u32,
 }
 
 /// Which integrator to use.
@@ -57,6 +70,10 @@ pub struct PrimarySample {
     pub color: Color,
     /// The first hit, if any, with its world-space surface.
     pub first_hit: Option<(Hit, Surface)>,
+    /// Where the ray budget cut this sample's tree short, if it did: the
+    /// material whose rays were refused (one that both reflects and
+    /// refracts, where one did).
+    pub cut_at: Option<MaterialId>,
 }
 
 /// An integrator ready to trace: the closed set of algorithms.

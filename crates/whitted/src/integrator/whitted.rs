@@ -20,7 +20,10 @@
 //!   in, tracked on a small stack of the media it has entered; total
 //!   internal reflection moves the refracted weight onto the reflected ray.
 //! - Recursion stops at `max_depth`, and earlier when a branch's weight on
-//!   the pixel falls below `min_weight` (adaptive depth control).
+//!   the pixel falls below `min_weight` (adaptive depth control), or when
+//!   the camera sample has traced its budget of secondary rays
+//!   ([`super::SECONDARY_RAY_BUDGET`]); the sample then says at which
+//!   material it was cut.
 
 use crate::integrator::{PrimarySample, RayCounts, RayKind, RecursionLimits, Shading};
 use crate::math::{Ray, Vec3, offset_ray_origin};
@@ -28,10 +31,36 @@ use crate::shading::optics::reflect;
 use crate::shading::{
     Color, Crossing, Light, Lobes, Material, MediumStack, Weights, phong, shading_normal,
 };
-use crate::world::{Surface, World};
+use crate::world::{MaterialId, Surface, World};
 
 /// Longest chain of transmissive surfaces one shadow ray passes through.
 const MAX_SHADOW_CROSSINGS: usize = 64;
+
+/// What one camera sample has traced so far: its rays by kind, the
+/// secondary rays it may still trace, and where it was cut.
+struct SampleTally<'c> {
+    counts: &'c mut RayCounts,
+    rays_left: u32,
+    /// The material at which a secondary ray was first refused, and
+    /// whether that material branches (reflects and refracts); a branching
+    /// one replaces one that does not.
+    cut_at: Option<(MaterialId, bool)>,
+}
+
+impl SampleTally<'_> {
+    /// Takes one secondary ray from the budget, for a surface of
+    /// `material` (which `branches` or not); false when none is left.
+    fn take(&mut self, material: MaterialId, branches: bool) -> bool {
+        if self.rays_left > 0 {
+            self.rays_left -= 1;
+            return true;
+        }
+        if !matches!(self.cut_at, Some((_, true))) && (self.cut_at.is_none() || branches) {
+            self.cut_at = Some((material, branches));
+        }
+        false
+    }
+}
 
 /// Whitted's recursive ray tracer over a prepared world.
 #[derive(Debug)]
@@ -69,13 +98,20 @@ impl<'a> Whitted<'a> {
             None => PrimarySample {
                 color: self.shading.background,
                 first_hit: None,
+                cut_at: None,
             },
             Some(hit) => {
                 let surface = self.world.surface(ray, &hit);
-                let color = self.shade(ray, &surface, 0, 1.0, MediumStack::default(), counts);
+                let mut tally = SampleTally {
+                    counts,
+                    rays_left: self.limits.ray_budget,
+                    cut_at: None,
+                };
+                let color = self.shade(ray, &surface, 0, 1.0, MediumStack::default(), &mut tally);
                 PrimarySample {
                     color,
                     first_hit: Some((hit, surface)),
+                    cut_at: tally.cut_at.map(|(material, _)| material),
                 }
             }
         }
@@ -88,13 +124,13 @@ impl<'a> Whitted<'a> {
         depth: u32,
         weight: f64,
         media: MediumStack,
-        counts: &mut RayCounts,
+        tally: &mut SampleTally<'_>,
     ) -> Color {
         match self.world.intersect(ray) {
             None => self.shading.background,
             Some(hit) => {
                 let surface = self.world.surface(ray, &hit);
-                self.shade(ray, &surface, depth, weight, media, counts)
+                self.shade(ray, &surface, depth, weight, media, tally)
             }
         }
     }
@@ -108,7 +144,7 @@ impl<'a> Whitted<'a> {
         depth: u32,
         weight: f64,
         media: MediumStack,
-        counts: &mut RayCounts,
+        tally: &mut SampleTally<'_>,
     ) -> Color {
         let m = &self.shading.materials[s.material.0 as usize];
         let incident = ray.dir;
@@ -137,7 +173,8 @@ impl<'a> Whitted<'a> {
                 if n_dot_l <= 0.0 || (bumped && facing.dot(sample.to_light) <= 0.0) {
                     continue;
                 }
-                let shadow = self.transmittance(s, light, sample.to_light, sample.distance, counts);
+                let shadow =
+                    self.transmittance(s, light, sample.to_light, sample.distance, tally.counts);
                 if shadow == Color::ZERO {
                     continue;
                 }
@@ -180,25 +217,29 @@ impl<'a> Whitted<'a> {
             n_to,
         );
 
+        let branches = reflected_weight != Color::ZERO && refracted.is_some();
         let child = weight * reflected_weight.max_element();
-        if child >= self.limits.min_weight && reflected_weight != Color::ZERO {
-            counts[RayKind::Reflected] += 1;
+        if child >= self.limits.min_weight
+            && reflected_weight != Color::ZERO
+            && tally.take(s.material, branches)
+        {
+            tally.counts[RayKind::Reflected] += 1;
             let dir = reflect(incident, n);
             let origin = offset_ray_origin(s.point, s.point_error, s.normal, dir);
-            let c = self.trace(&Ray::new(origin, dir), depth + 1, child, media, counts);
+            let c = self.trace(&Ray::new(origin, dir), depth + 1, child, media, tally);
             color += reflected_weight * c;
         }
         if let Some(dir) = refracted {
             let child = weight * transmitted_weight.max_element();
-            if child >= self.limits.min_weight {
-                counts[RayKind::Refracted] += 1;
+            if child >= self.limits.min_weight && tally.take(s.material, branches) {
+                tally.counts[RayKind::Refracted] += 1;
                 let origin = offset_ray_origin(s.point, s.point_error, s.normal, dir);
                 let c = self.trace(
                     &Ray::new(origin, dir),
                     depth + 1,
                     child,
                     inside_after,
-                    counts,
+                    tally,
                 );
                 color += transmitted_weight * c;
             }

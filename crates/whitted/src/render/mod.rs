@@ -3,23 +3,30 @@
 //! picture is identical bit for bit whatever the number of threads.
 
 mod camera;
+mod resources;
 mod scene;
 mod settings;
 
 pub use camera::{Camera, CameraError};
+pub use resources::{RayBudgetCut, ThreadClamp, memory_needed};
 pub use scene::Scene;
 pub use settings::{Aov, MAX_DEPTH, MAX_PIXELS, MAX_SIDE, RenderSettings};
 
+use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, PoisonError};
 
 use rayon::prelude::*;
 
 use crate::image::Film;
-use crate::integrator::{Integrator, RayCounts, RayKind, RecursionLimits, Shading};
+use crate::integrator::{
+    Integrator, RayCounts, RayKind, RecursionLimits, SECONDARY_RAY_BUDGET, Shading,
+};
+use crate::limits::{MemoryBudget, MemoryError};
 use crate::math::random::hash64;
 use crate::math::sampling::pixel_sample;
 use crate::shading::Color;
-use crate::world::{MAX_PRIMITIVES, World};
+use crate::world::{MAX_PRIMITIVES, MaterialId, World};
 
 /// Side of the square tiles the image is cut into, in pixels.
 const TILE_SIZE: u32 = 16;
@@ -51,6 +58,10 @@ pub struct RenderOutput {
     pub rays: RayCounts,
     /// The kinds of rays the integrator traces, in report order.
     pub ray_kinds: &'static [RayKind],
+    /// The thread count asked for, when it was lowered to what helps.
+    pub thread_clamp: Option<ThreadClamp>,
+    /// The camera samples the budget of secondary rays cut short, if any.
+    pub ray_budget_cut: Option<RayBudgetCut>,
 }
 
 /// Why a render could not start.
@@ -86,6 +97,9 @@ pub enum RenderError {
         "the scene has {0} primitives (every placement of a mesh counted): at most {MAX_PRIMITIVES} are allowed"
     )]
     TooManyPrimitives(usize),
+    /// The films would exceed the memory budget.
+    #[error(transparent)]
+    Memory(#[from] MemoryError),
     /// The thread pool could not be created.
     #[error("could not start {threads} worker threads: {message}")]
     Threads {
@@ -105,11 +119,48 @@ struct Tile {
     color: Vec<f32>,
     aovs: Vec<Vec<f32>>,
     rays: RayCounts,
+    /// Samples the ray budget cut short, by the material they were cut at.
+    cuts: HashMap<MaterialId, u64>,
+}
+
+/// The films of a render being filled in as tiles finish.
+struct Films {
+    image: Film,
+    aovs: Vec<(Aov, Film)>,
+    rays: RayCounts,
+    cuts: HashMap<MaterialId, u64>,
+}
+
+impl Films {
+    /// Copies a finished tile in.
+    fn add(&mut self, tile: Tile) {
+        self.rays += tile.rays;
+        for (material, samples) in tile.cuts {
+            *self.cuts.entry(material).or_default() += samples;
+        }
+        for dy in 0..tile.height {
+            for dx in 0..tile.width {
+                let i = (dy * tile.width + dx) as usize;
+                let (x, y) = (tile.x0 + dx, tile.y0 + dy);
+                self.image.set_pixel(x, y, &tile.color[3 * i..3 * i + 3]);
+                for ((aov, film), data) in self.aovs.iter_mut().zip(&tile.aovs) {
+                    let c = aov.channels();
+                    film.set_pixel(x, y, &data[c * i..c * i + c]);
+                }
+            }
+        }
+    }
 }
 
 /// Renders `scene` with its settings: builds its world once, hands it to
 /// the integrator and spreads the tiles over the worker threads.
 /// `progress` is called from worker threads as tiles finish.
+///
+/// Before anything is allocated, the films' memory ([`memory_needed`]) is
+/// checked against the memory budget ([`MemoryBudget::current`]). No more
+/// threads are started than there are tiles, nor than 4 per core
+/// ([`RenderOutput::thread_clamp`] says when a count asked for was
+/// lowered).
 pub fn render(
     scene: &Scene,
     progress: &(dyn Fn(Progress) + Sync),
@@ -132,15 +183,20 @@ pub fn render(
     if primitives > MAX_PRIMITIVES {
         return Err(RenderError::TooManyPrimitives(primitives));
     }
-    let mut pool =
-        rayon::ThreadPoolBuilder::new().stack_size(worker_stack_bytes(settings.max_depth));
-    if let Some(threads) = settings.threads {
-        pool = pool.num_threads(threads);
-    }
-    let pool = pool.build().map_err(|e| RenderError::Threads {
-        threads: settings.threads.unwrap_or(0),
-        message: e.to_string(),
-    })?;
+    resources::check_memory(settings, MemoryBudget::current())?;
+    let tiles_x = width.div_ceil(TILE_SIZE);
+    let tiles_y = height.div_ceil(TILE_SIZE);
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    let (threads, thread_clamp) =
+        resources::useful_threads(settings.threads, (tiles_x * tiles_y) as usize, cores);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .stack_size(worker_stack_bytes(settings.max_depth))
+        .num_threads(threads)
+        .build()
+        .map_err(|e| RenderError::Threads {
+            threads,
+            message: e.to_string(),
+        })?;
 
     let world = World::build(&scene.objects, settings.accel);
     let shading = Shading {
@@ -152,57 +208,67 @@ pub fn render(
     let limits = RecursionLimits {
         max_depth: settings.max_depth,
         min_weight: settings.min_weight,
+        ray_budget: SECONDARY_RAY_BUDGET,
     };
     let integrator = Integrator::new(settings.integrator, &world, shading, limits);
-    let tiles_x = width.div_ceil(TILE_SIZE);
-    let tiles_y = height.div_ceil(TILE_SIZE);
     let total = u64::from(width) * u64::from(height);
     let done = AtomicU64::new(0);
-    let tiles: Vec<Tile> = pool.install(|| {
-        (0..tiles_x * tiles_y)
-            .into_par_iter()
-            .map(|index| {
-                let tile = render_tile(
-                    &integrator,
-                    &scene.camera,
-                    settings,
-                    index % tiles_x,
-                    index / tiles_x,
-                );
-                let pixels = u64::from(tile.width * tile.height);
-                let now = done.fetch_add(pixels, Ordering::Relaxed) + pixels;
-                progress(Progress { done: now, total });
-                tile
-            })
-            .collect()
+    let films = Mutex::new(Films {
+        image: Film::new(width, height, 3).with_color_space(scene.color_space),
+        aovs: settings
+            .aovs
+            .iter()
+            .map(|&a| (a, Film::new(width, height, a.channels())))
+            .collect(),
+        rays: RayCounts::default(),
+        cuts: HashMap::new(),
     });
-
-    let mut image = Film::new(width, height, 3).with_color_space(scene.color_space);
-    let mut aovs: Vec<(Aov, Film)> = settings
-        .aovs
-        .iter()
-        .map(|&a| (a, Film::new(width, height, a.channels())))
-        .collect();
-    let mut rays = RayCounts::default();
-    for tile in &tiles {
-        rays += tile.rays;
-        for dy in 0..tile.height {
-            for dx in 0..tile.width {
-                let i = (dy * tile.width + dx) as usize;
-                let (x, y) = (tile.x0 + dx, tile.y0 + dy);
-                image.set_pixel(x, y, &tile.color[3 * i..3 * i + 3]);
-                for ((aov, film), data) in aovs.iter_mut().zip(&tile.aovs) {
-                    let c = aov.channels();
-                    film.set_pixel(x, y, &data[c * i..c * i + c]);
-                }
-            }
-        }
-    }
+    pool.install(|| {
+        (0..tiles_x * tiles_y).into_par_iter().for_each(|index| {
+            let tile = render_tile(
+                &integrator,
+                &scene.camera,
+                settings,
+                index % tiles_x,
+                index / tiles_x,
+            );
+            let pixels = u64::from(tile.width * tile.height);
+            films
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .add(tile);
+            let now = done.fetch_add(pixels, Ordering::Relaxed) + pixels;
+            progress(Progress { done: now, total });
+        });
+    });
+    let films = films.into_inner().unwrap_or_else(PoisonError::into_inner);
+    let ray_budget_cut = budget_cut(scene, &films.cuts);
     Ok(RenderOutput {
-        image,
-        aovs,
-        rays,
+        image: films.image,
+        aovs: films.aovs,
+        rays: films.rays,
         ray_kinds: integrator.ray_kinds(),
+        thread_clamp,
+        ray_budget_cut,
+    })
+}
+
+/// The report of the samples the ray budget cut short, by the material
+/// they were cut at: the material with the most (the lowest id among
+/// equals, so the report does not depend on the threads).
+fn budget_cut(scene: &Scene, cuts: &HashMap<MaterialId, u64>) -> Option<RayBudgetCut> {
+    let (&material, _) = cuts
+        .iter()
+        .max_by_key(|&(material, &samples)| (samples, std::cmp::Reverse(material.0)))?;
+    let settings = &scene.settings;
+    Some(RayBudgetCut {
+        samples: cuts.values().sum(),
+        total: u64::from(settings.width)
+            * u64::from(settings.height)
+            * u64::from(settings.samples_per_pixel),
+        material,
+        material_name: scene.material_name(material),
+        max_depth: settings.max_depth,
     })
 }
 
@@ -231,6 +297,7 @@ fn render_tile(
             .map(|a| Vec::with_capacity(a.channels() * pixels))
             .collect(),
         rays: RayCounts::default(),
+        cuts: HashMap::new(),
     };
     let spp = settings.samples_per_pixel;
     for y in y0..y0 + height {
@@ -247,6 +314,9 @@ fn render_tile(
                     f64::from(y) + offset.y,
                 );
                 let sample = integrator.trace_primary(&ray, &mut tile.rays);
+                if let Some(material) = sample.cut_at {
+                    *tile.cuts.entry(material).or_default() += 1;
+                }
                 if spp == 1 {
                     centre = Some((ray, sample.first_hit));
                 }
@@ -291,4 +361,89 @@ fn render_tile(
         }
     }
     tile
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A glass ball that reflects and transmits everything, in a mirror
+    /// box: its ray tree grows at every bounce and no weight decays.
+    const GLASS_IN_MIRRORS: &str = r#"
+        [render]
+        width = 4
+        height = 4
+        max_depth = 40
+        [camera]
+        eye = [0, 0, -1.8]
+        look_at = [0, 0, 0]
+        fov = 40
+        [materials.mirror]
+        reflection = 1
+        [materials.glass]
+        reflection = 1
+        transmission = 1
+        ior = 1.5
+        [[lights]]
+        type = "point"
+        position = [0, 1, -1]
+        [[objects]]
+        shape = "box"
+        min = [-2, -2, -2]
+        max = [2, 2, 2]
+        material = "mirror"
+        [[objects]]
+        shape = "sphere"
+        center = [0, 0, 0]
+        radius = 1.5
+        material = "glass"
+    "#;
+
+    fn glass_in_mirrors() -> Scene {
+        crate::scene::parse_scene(GLASS_IN_MIRRORS, std::path::Path::new("box.toml")).unwrap()
+    }
+
+    #[test]
+    fn an_exploding_ray_tree_is_cut_at_the_budget_and_names_its_material() {
+        let scene = glass_in_mirrors();
+        let output = render(&scene, &|_| {}).unwrap();
+        let cut = output.ray_budget_cut.unwrap();
+        assert_eq!((cut.samples, cut.total), (16, 16));
+        assert_eq!(cut.material_name, "`glass`");
+        assert_eq!(cut.max_depth, 40);
+        let secondary = output.rays[RayKind::Reflected] + output.rays[RayKind::Refracted];
+        assert!(
+            secondary <= 16 * u64::from(SECONDARY_RAY_BUDGET),
+            "{secondary}"
+        );
+    }
+
+    #[test]
+    fn where_the_budget_cuts_does_not_depend_on_the_threads() {
+        let mut scene = glass_in_mirrors();
+        scene.settings.threads = Some(1);
+        let one = render(&scene, &|_| {}).unwrap();
+        scene.settings.threads = Some(3);
+        let three = render(&scene, &|_| {}).unwrap();
+        assert_eq!(one.image, three.image);
+        assert_eq!(one.rays, three.rays);
+        assert_eq!(one.ray_budget_cut, three.ray_budget_cut);
+    }
+
+    #[test]
+    fn a_normal_scene_stays_within_the_budget_and_asks_no_clamp() {
+        let mut scene = crate::scene::default_scene();
+        scene.settings.width = 32;
+        scene.settings.height = 24;
+        scene.settings.threads = Some(1);
+        let output = render(&scene, &|_| {}).unwrap();
+        assert_eq!(output.ray_budget_cut, None);
+        assert_eq!(output.thread_clamp, None);
+        scene.settings.threads = Some(1000);
+        let clamped = render(&scene, &|_| {}).unwrap();
+        let clamp = clamped.thread_clamp.unwrap();
+        assert_eq!(clamp.tiles, 4);
+        assert!(clamp.used <= clamp.tiles, "{clamp:?}");
+        assert_eq!(clamped.image, output.image);
+    }
 }

@@ -26,6 +26,9 @@ pub struct Scene {
     pub color_space: ColorSpace,
     /// Materials, indexed by [`MaterialId`].
     pub materials: Vec<Material>,
+    /// The names the scene file gives its materials, by [`MaterialId`]
+    /// (for messages); empty where a format has none.
+    pub material_names: Vec<String>,
     /// Light sources.
     pub lights: Vec<Light>,
     /// The shapes and meshes placed in the world.
@@ -43,6 +46,7 @@ impl Scene {
             ambient: Color::ZERO,
             color_space: ColorSpace::Linear,
             materials: Vec::new(),
+            material_names: Vec::new(),
             lights: Vec::new(),
             objects: Objects::default(),
         }
@@ -52,6 +56,24 @@ impl Scene {
     pub fn add_material(&mut self, material: Material) -> MaterialId {
         self.materials.push(material);
         MaterialId((self.materials.len() - 1) as u32)
+    }
+
+    /// Adds a material called `name` (in messages) and returns its id.
+    pub fn add_named_material(&mut self, name: &str, material: Material) -> MaterialId {
+        let id = self.add_material(material);
+        self.material_names
+            .resize(self.materials.len() - 1, String::new());
+        self.material_names.push(name.to_string());
+        id
+    }
+
+    /// How messages name a material: `` `glass` `` where the scene file
+    /// names it, else by number (`#3`, counting from 0).
+    pub fn material_name(&self, id: MaterialId) -> String {
+        match self.material_names.get(id.0 as usize) {
+            Some(name) if !name.is_empty() => format!("`{name}`"),
+            _ => format!("#{}", id.0),
+        }
     }
 
     /// Adds a shape with a material and an object-to-world transform

@@ -90,7 +90,7 @@ pub fn parse_nff(source: &str, path: &Path) -> Result<Scene, SceneError> {
 
 /// Reads an NFF file.
 pub fn load_nff(path: &Path) -> Result<Scene, SceneError> {
-    let source = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+    let source = crate::limits::read_input_text(path).map_err(|source| SceneError::Io {
         path: path.to_path_buf(),
         source,
     })?;

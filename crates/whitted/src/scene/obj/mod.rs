@@ -54,7 +54,7 @@ pub fn parse_obj(source: &str, path: &Path) -> Result<LoadedScene, SceneError> {
     let mut images = ImageCache::default();
     for (name, span) in &data.libraries {
         let file = path.parent().unwrap_or(Path::new("")).join(name);
-        match std::fs::read_to_string(&file) {
+        match crate::limits::read_input_text(&file) {
             Ok(text) => {
                 let library = read_library(&text, &file, &mut images);
                 diagnostics.extend(library.diagnostics);
@@ -93,7 +93,7 @@ pub fn parse_obj(source: &str, path: &Path) -> Result<LoadedScene, SceneError> {
 
 /// Reads an OBJ file and the material libraries it names.
 pub fn load_obj(path: &Path) -> Result<LoadedScene, SceneError> {
-    let source = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+    let source = crate::limits::read_input_text(path).map_err(|source| SceneError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -147,7 +147,8 @@ fn build_scene(
                 Material::default()
             })
         };
-        let material: MaterialId = scene.add_material(material);
+        let name = data.material_uses.get(slot as usize).map_or("", |(n, _)| n);
+        let material: MaterialId = scene.add_named_material(name, material);
         let mesh = scene.add_mesh(mesh);
         scene.add_mesh_instance(mesh, material, Transform::IDENTITY);
     }

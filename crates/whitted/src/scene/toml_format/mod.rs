@@ -75,7 +75,7 @@ pub fn parse_scene(source: &str, path: &Path) -> Result<Scene, SceneError> {
 
 /// Reads a scene file.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let source = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+    let source = crate::limits::read_input_text(path).map_err(|source| SceneError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -111,8 +111,8 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
     scene.ambient = render.ambient;
     scene.color_space = render.color_space;
     scene.lights = lights?;
-    for material in materials.list? {
-        scene.add_material(material);
+    for (material, name) in materials.list?.into_iter().zip(&materials.names) {
+        scene.add_named_material(name, material);
     }
     let objects = objects?;
     let default_material = MaterialId(scene.materials.len() as u32);

@@ -7,6 +7,11 @@
 //! to linear light; data (normal and height maps) is read as stored, scaled
 //! to [0, 1]; opacity is the alpha channel. A file read two ways is decoded
 //! once per way.
+//!
+//! Before anything is decoded, the size the header declares is checked: a
+//! PNG claiming more data than its compressed bytes can hold, or any image
+//! whose texels would exceed the memory budget
+//! ([`MemoryBudget::current`]), is refused with the reason.
 
 use std::collections::HashMap;
 use std::io::Cursor;
@@ -14,6 +19,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use super::image::ImageData;
+use crate::limits::MemoryBudget;
 
 /// Why an image file gave no texture.
 #[derive(Debug, thiserror::Error)]
@@ -74,7 +80,7 @@ impl ImageCache {
         if let Some(image) = self.images.get(&key) {
             return Ok(Arc::clone(image));
         }
-        let bytes = std::fs::read(&key.0).map_err(io)?;
+        let bytes = crate::limits::read_input(&key.0).map_err(io)?;
         let image =
             Arc::new(
                 decode_image(&bytes, decoding).map_err(|reason| ImageLoadError::Decode {
@@ -125,9 +131,16 @@ fn decode_png(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
     let mut decoder = png::Decoder::new(Cursor::new(bytes));
     decoder.set_transformations(png::Transformations::EXPAND);
     let mut reader = decoder.read_info().map_err(|e| e.to_string())?;
+    let info = reader.info();
+    let (width, height) = (info.width, info.height);
+    let raw = info.raw_bytes() as u64 + u64::from(height);
+    if raw > MAX_DEFLATE_RATIO * bytes.len() as u64 {
+        return Err(claims_too_much(width, height, bytes.len()));
+    }
     let size = reader
         .output_buffer_size()
         .ok_or("the image is too large")?;
+    check_texel_memory(width, height, size as u64)?;
     let mut buffer = vec![0; size];
     let info = reader.next_frame(&mut buffer).map_err(|e| e.to_string())?;
     let channels = match info.color_type {
@@ -137,7 +150,7 @@ fn decode_png(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
         png::ColorType::Rgba => 4,
         png::ColorType::Indexed => return Err("unexpanded palette".to_string()),
     };
-    let (width, height) = (info.width as usize, info.height as usize);
+    let (width, height) = (width as usize, height as usize);
     let wide = info.bit_depth == png::BitDepth::Sixteen;
     let sample_bytes = if wide { 2 } else { 1 };
     let table = eight_bit_table(decoding);
@@ -166,6 +179,34 @@ fn decode_png(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
     ImageData::new(width, height, texels).ok_or_else(|| "the image data is truncated".to_string())
 }
 
+/// The most bytes deflate (PNG's compression) can expand one byte into
+/// (RFC 1951: a 258-byte match in as little as two bits, about 1032 to 1).
+const MAX_DEFLATE_RATIO: u64 = 1032;
+
+/// The message for a header claiming more pixels than the file can hold.
+fn claims_too_much(width: u32, height: u32, file_bytes: usize) -> String {
+    format!(
+        "the header claims {width}x{height} pixels, far more than {file_bytes} bytes can hold: \
+         the file is truncated or corrupt"
+    )
+}
+
+/// Refuses an image of `width` × `height` whose texels, with the
+/// `decoded` bytes the decoder fills first, exceed the memory budget.
+fn check_texel_memory(width: u32, height: u32, decoded: u64) -> Result<(), String> {
+    let texels = u64::from(width) * u64::from(height);
+    let needed = texels
+        .saturating_mul(std::mem::size_of::<[f32; 3]>() as u64)
+        .saturating_add(decoded);
+    MemoryBudget::current()
+        .check(
+            &format!("decoding its {width}x{height} texels"),
+            needed,
+            "use a smaller image",
+        )
+        .map_err(|e| e.to_string())
+}
+
 /// Pixels any JPEG may claim, whatever its length.
 const FREE_PIXELS: u64 = 1 << 20;
 
@@ -187,12 +228,9 @@ fn decode_jpeg(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
     let (width, height) = decoder.dimensions().ok_or("no image size")?;
     let claimed = width as u64 * height as u64;
     if claimed > FREE_PIXELS + MAX_PIXELS_PER_BYTE * bytes.len() as u64 {
-        return Err(format!(
-            "the header claims {width}x{height} pixels, far more than {} bytes can hold: \
-             the file is truncated or corrupt",
-            bytes.len()
-        ));
+        return Err(claims_too_much(width as u32, height as u32, bytes.len()));
     }
+    check_texel_memory(width as u32, height as u32, claimed * 3)?;
     let pixels = decoder.decode().map_err(|e| e.to_string())?;
     let (width, height) = decoder.dimensions().ok_or("no image size")?;
     let table = eight_bit_table(decoding);
@@ -235,6 +273,30 @@ pub(crate) mod tests {
         writer.write_image_data(samples).unwrap();
         writer.finish().unwrap();
         out
+    }
+
+    #[test]
+    fn a_png_header_claiming_more_than_its_data_can_hold_is_refused_before_decoding() {
+        let mut bytes = Vec::new();
+        {
+            let mut encoder = png::Encoder::new(&mut bytes, 40000, 40000);
+            encoder.set_color(png::ColorType::Rgb);
+            let mut writer = encoder.write_header().unwrap();
+            // A zlib stream of one stored empty block: far from 4.8 GB.
+            let idat = [
+                0x78, 0x01, 0x01, 0x00, 0x00, 0xff, 0xff, 0x00, 0x00, 0x00, 0x01,
+            ];
+            writer.write_chunk(png::chunk::IDAT, &idat).unwrap();
+        }
+        let error = decode_image(&bytes, Decoding::Color).unwrap_err();
+        assert_eq!(
+            error,
+            format!(
+                "the header claims 40000x40000 pixels, far more than {} bytes can hold: the \
+                 file is truncated or corrupt",
+                bytes.len()
+            )
+        );
     }
 
     #[test]

@@ -1,0 +1,406 @@
+//! Resource limits: the memory budget (images, textures, bench sizes), input
+//! files that are not regular files, thread counts beyond what helps, and
+//! ray trees that explode.
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use super::support::{MIB, probe};
+
+/// A scene of one sphere, for the cases that need a scene and a texture.
+fn sphere_scene(diffuse: &str) -> String {
+    format!(
+        r#"[render]
+width = 16
+height = 12
+[camera]
+eye = [0, 0, -4]
+look_at = [0, 0, 0]
+fov = 40
+[materials.ball]
+diffuse = {diffuse}
+[[lights]]
+type = "point"
+position = [2, 3, -4]
+[[objects]]
+shape = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "ball"
+"#
+    )
+}
+
+/// CRC-32 (IEEE) of `bytes`, as PNG chunks carry it.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in bytes {
+        crc ^= u32::from(b);
+        for _ in 0..8 {
+            crc = (crc >> 1) ^ (0xedb8_8320 & (crc & 1).wrapping_neg());
+        }
+    }
+    !crc
+}
+
+/// A zlib stream holding `data` in stored (uncompressed) blocks.
+fn zlib_stored(data: &[u8]) -> Vec<u8> {
+    let mut out = vec![0x78, 0x01];
+    let blocks: Vec<&[u8]> = data.chunks(65535).collect();
+    for (i, block) in blocks.iter().enumerate() {
+        out.push(u8::from(i + 1 == blocks.len()));
+        let len = block.len() as u16;
+        out.extend_from_slice(&len.to_le_bytes());
+        out.extend_from_slice(&(!len).to_le_bytes());
+        out.extend_from_slice(block);
+    }
+    let (mut a, mut b) = (1u32, 0u32);
+    for &byte in data {
+        a = (a + u32::from(byte)) % 65521;
+        b = (b + a) % 65521;
+    }
+    out.extend_from_slice(&((b << 16) | a).to_be_bytes());
+    out
+}
+
+/// An 8-bit grey PNG declaring `width` × `height` pixels whose image data
+/// is `rows` rows of black (all of them for a whole image, a few for one
+/// that only declares its size).
+fn grey_png(width: u32, height: u32, rows: usize) -> Vec<u8> {
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut chunk = |kind: &[u8], data: &[u8]| {
+        png.extend_from_slice(&(data.len() as u32).to_be_bytes());
+        let mut body = kind.to_vec();
+        body.extend_from_slice(data);
+        png.extend_from_slice(&body);
+        png.extend_from_slice(&crc32(&body).to_be_bytes());
+    };
+    let mut header = Vec::new();
+    header.extend_from_slice(&width.to_be_bytes());
+    header.extend_from_slice(&height.to_be_bytes());
+    header.extend_from_slice(&[8, 0, 0, 0, 0]);
+    chunk(b"IHDR", &header);
+    chunk(b"IDAT", &zlib_stored(&vec![0; rows * (width as usize + 1)]));
+    chunk(b"IEND", &[]);
+    png
+}
+
+fn write(dir: &Path, name: &str, contents: impl AsRef<[u8]>) {
+    std::fs::write(dir.join(name), contents).unwrap();
+}
+
+#[test]
+fn a_bench_image_beyond_the_budget_is_refused_before_any_ray_is_made() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "s.toml", sphere_scene("0.5"));
+    let p = probe(
+        &["bench", "s.toml", "--width", "70000", "--height", "70000"],
+        dir.path(),
+    );
+    assert_eq!(p.code(), Some(1), "{}", p.stderr);
+    assert!(
+        p.stderr.starts_with(
+            "error: benchmarking a 70000x70000 image (3 sets of up to 4900000000 rays) needs "
+        ),
+        "{}",
+        p.stderr
+    );
+    assert!(
+        p.stderr
+            .contains("use a smaller --width and --height, or raise the budget with --max-memory"),
+        "{}",
+        p.stderr
+    );
+    assert!(p.peak_bytes < 100 * MIB, "{}", p.peak_bytes);
+}
+
+#[test]
+fn a_render_beyond_the_budget_is_refused_with_what_it_needs() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = probe(
+        &[
+            "render",
+            "--width",
+            "16384",
+            "--height",
+            "16384",
+            "--aov",
+            "depth=d.pfm",
+            "--aov",
+            "normal=n.exr",
+            "--max-memory",
+            "4G",
+        ],
+        dir.path(),
+    );
+    assert_eq!(p.code(), Some(1), "{}", p.stderr);
+    assert_eq!(
+        p.stderr,
+        "error: a 16384x16384 image with 2 AOVs needs 13.0 GiB; the memory budget is 4.0 GiB \
+         (as given): render a smaller image or fewer AOVs, or raise the budget with \
+         --max-memory\n"
+    );
+    assert!(p.peak_bytes < 100 * MIB, "{}", p.peak_bytes);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+#[test]
+fn max_memory_must_be_a_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = probe(&["render", "--max-memory", "lots"], dir.path());
+    assert_eq!(p.code(), Some(2), "{}", p.stderr);
+    assert!(
+        p.stderr.contains(
+            "`lots` is not a size: expected a number of bytes, or one with K, M, G or T, like \
+             512M or 4G"
+        ),
+        "{}",
+        p.stderr
+    );
+}
+
+#[test]
+fn dev_zero_as_a_scene_is_refused_as_not_a_regular_file() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["zero.toml", "zero.obj", "zero.nff"] {
+        std::os::unix::fs::symlink("/dev/zero", dir.path().join(name)).unwrap();
+        let p = probe(&["render", name], dir.path());
+        assert_eq!(p.code(), Some(1), "{name}: {}", p.stderr);
+        assert!(
+            p.stderr
+                .ends_with("not a regular file: a character device (such as /dev/zero)\n"),
+            "{name}: {}",
+            p.stderr
+        );
+        assert!(p.stderr.contains(name), "{}", p.stderr);
+        assert!(p.peak_bytes < 100 * MIB, "{name}: {}", p.peak_bytes);
+    }
+    let p = probe(&["bench", "zero.obj"], dir.path());
+    assert_eq!(p.code(), Some(1), "{}", p.stderr);
+    assert!(p.stderr.contains("not a regular file"), "{}", p.stderr);
+    assert!(p.peak_bytes < 100 * MIB, "{}", p.peak_bytes);
+}
+
+#[test]
+fn a_fifo_as_a_scene_is_refused_without_waiting_for_a_writer() {
+    let dir = tempfile::tempdir().unwrap();
+    let status = std::process::Command::new("mkfifo")
+        .arg(dir.path().join("pipe.toml"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let p = probe(&["render", "pipe.toml"], dir.path());
+    assert_eq!(p.code(), Some(1), "{}", p.stderr);
+    assert!(
+        p.stderr
+            .ends_with("not a regular file: a FIFO (named pipe)\n"),
+        "{}",
+        p.stderr
+    );
+}
+
+#[test]
+fn dev_zero_as_a_texture_is_an_error_at_its_name() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "s.toml",
+        sphere_scene(r#"{ image = "/dev/zero" }"#),
+    );
+    let p = probe(&["render", "s.toml"], dir.path());
+    assert_eq!(p.code(), Some(1), "{}", p.stderr);
+    assert!(
+        p.stderr.contains(
+            "error: cannot read the image `/dev/zero`: not a regular file: a character device"
+        ),
+        "{}",
+        p.stderr
+    );
+    assert!(p.peak_bytes < 100 * MIB, "{}", p.peak_bytes);
+}
+
+#[test]
+fn dev_zero_as_a_material_library_or_map_is_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    std::os::unix::fs::symlink("/dev/zero", dir.path().join("zero.mtl")).unwrap();
+    write(
+        dir.path(),
+        "m.obj",
+        "mtllib zero.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    );
+    let p = probe(
+        &["render", "m.obj", "--width", "8", "--height", "8"],
+        dir.path(),
+    );
+    assert_eq!(p.code(), Some(0), "{}", p.stderr);
+    assert!(
+        p.stderr.contains(
+            "cannot read the material library `zero.mtl` (not a regular file: a character \
+             device (such as /dev/zero)); its materials are grey"
+        ),
+        "{}",
+        p.stderr
+    );
+    assert!(p.peak_bytes < 100 * MIB, "{}", p.peak_bytes);
+
+    write(
+        dir.path(),
+        "t.mtl",
+        "newmtl t\nKd 1 1 1\nmap_Kd /dev/zero\n",
+    );
+    write(
+        dir.path(),
+        "t.obj",
+        "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl t\nf 1 2 3\n",
+    );
+    let p = probe(
+        &["render", "t.obj", "--width", "8", "--height", "8"],
+        dir.path(),
+    );
+    assert_eq!(p.code(), Some(0), "{}", p.stderr);
+    assert!(p.stderr.contains("warning"), "{}", p.stderr);
+    assert!(p.stderr.contains("not a regular file"), "{}", p.stderr);
+    assert!(p.peak_bytes < 100 * MIB, "{}", p.peak_bytes);
+}
+
+#[test]
+fn a_texture_header_declaring_forty_thousand_squared_is_refused_before_decoding() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "huge.png", grey_png(40000, 40000, 2));
+    write(
+        dir.path(),
+        "s.toml",
+        sphere_scene(r#"{ image = "huge.png" }"#),
+    );
+    let p = probe(&["render", "s.toml"], dir.path());
+    assert_eq!(p.code(), Some(1), "{}", p.stderr);
+    assert!(
+        p.stderr.contains(
+            "cannot decode the image `huge.png`: the header claims 40000x40000 pixels, far \
+             more than"
+        ),
+        "{}",
+        p.stderr
+    );
+    assert!(p.peak_bytes < 100 * MIB, "{}", p.peak_bytes);
+
+    // In an MTL, the docs promise a warning and a render without the map.
+    write(dir.path(), "h.mtl", "newmtl h\nKd 1 0 0\nmap_Kd huge.png\n");
+    write(
+        dir.path(),
+        "h.obj",
+        "mtllib h.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl h\nf 1 2 3\n",
+    );
+    let p = probe(
+        &["render", "h.obj", "--width", "8", "--height", "8"],
+        dir.path(),
+    );
+    assert_eq!(p.code(), Some(0), "{}", p.stderr);
+    assert!(p.stderr.contains("warning"), "{}", p.stderr);
+    assert!(p.stderr.contains("40000x40000"), "{}", p.stderr);
+    assert!(p.peak_bytes < 100 * MIB, "{}", p.peak_bytes);
+}
+
+#[test]
+fn a_texture_beyond_the_budget_is_refused_with_what_it_needs() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "big.png", grey_png(1000, 1000, 1000));
+    write(
+        dir.path(),
+        "s.toml",
+        sphere_scene(r#"{ image = "big.png" }"#),
+    );
+    let p = probe(&["render", "s.toml", "--max-memory", "8M"], dir.path());
+    assert_eq!(p.code(), Some(1), "{}", p.stderr);
+    assert!(
+        p.stderr.contains(
+            "cannot decode the image `big.png`: decoding its 1000x1000 texels needs 12.4 MiB; \
+             the memory budget is 8.0 MiB (as given): use a smaller image, or raise the budget \
+             with --max-memory"
+        ),
+        "{}",
+        p.stderr
+    );
+    let p = probe(&["render", "s.toml", "--max-memory", "64M"], dir.path());
+    assert_eq!(p.code(), Some(0), "{}", p.stderr);
+}
+
+#[test]
+fn a_hundred_thousand_threads_are_clamped_to_what_helps() {
+    let dir = tempfile::tempdir().unwrap();
+    let start = Instant::now();
+    let p = probe(
+        &[
+            "render",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--threads",
+            "100000",
+        ],
+        dir.path(),
+    );
+    let elapsed = start.elapsed();
+    assert_eq!(p.code(), Some(0), "{}", p.stderr);
+    assert!(
+        p.stderr.contains("note: 100000 threads asked for, "),
+        "{}",
+        p.stderr
+    );
+    assert!(p.stderr.contains("the image has 12 tiles"), "{}", p.stderr);
+    assert!(elapsed < Duration::from_secs(10), "{elapsed:?}");
+    assert!(dir.path().join("whitted.png").is_file());
+}
+
+#[test]
+fn a_glass_ball_in_a_mirror_box_is_cut_at_the_ray_budget_with_one_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "box.toml",
+        r#"[render]
+width = 8
+height = 8
+max_depth = 40
+[camera]
+eye = [0, 0, -1.8]
+look_at = [0, 0, 0]
+fov = 40
+[materials.mirror]
+reflection = 1
+[materials.glass]
+reflection = 1
+transmission = 1
+ior = 1.5
+[[lights]]
+type = "point"
+position = [0, 1, -1]
+[[objects]]
+shape = "box"
+min = [-2, -2, -2]
+max = [2, 2, 2]
+material = "mirror"
+[[objects]]
+shape = "sphere"
+center = [0, 0, 0]
+radius = 1.5
+material = "glass"
+"#,
+    );
+    let start = Instant::now();
+    let p = probe(&["render", "box.toml"], dir.path());
+    let elapsed = start.elapsed();
+    assert_eq!(p.code(), Some(0), "{}", p.stderr);
+    assert_eq!(p.stderr.matches("warning").count(), 1, "{}", p.stderr);
+    assert!(
+        p.stderr.contains(
+            "warning: 64 of 64 camera samples reached the budget of 4096 secondary rays per \
+             sample and were cut short, most often at material `glass`"
+        ),
+        "{}",
+        p.stderr
+    );
+    assert!(p.stderr.contains("with max_depth 40"), "{}", p.stderr);
+    assert!(elapsed < Duration::from_secs(10), "{elapsed:?}");
+}

@@ -1,0 +1,300 @@
+//! The memory budget: the most bytes one request sized by input may take.
+//!
+//! The budget is one per process. By default it is 3/4 of the memory this
+//! process may use: the smaller of the machine's `MemTotal`
+//! (`/proc/meminfo`) and the control group's limit (`memory.max`, or
+//! `memory.limit_in_bytes` under cgroup v1); where neither can be read it
+//! is 4 GiB. The command replaces it with `--max-memory`
+//! ([`MemoryBudget::set_current`]). A request ([`MemoryBudget::check`]) is
+//! measured before anything is allocated for it, so what input declares
+//! (an image size, a texture header) is refused with a message instead of
+//! ending in the allocator's abort.
+
+use std::fmt;
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Budget used where the machine's memory cannot be read.
+const FALLBACK_BYTES: u64 = 4 << 30;
+
+/// The share of the machine's memory the default budget takes, as a
+/// fraction numerator / denominator.
+const SHARE: (u64, u64) = (3, 4);
+
+/// Where a budget comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BudgetOrigin {
+    /// 3/4 of the memory this process may use, which is `total` bytes.
+    Machine {
+        /// The memory this process may use.
+        total: u64,
+    },
+    /// The machine's memory could not be read.
+    Fallback,
+    /// Given by the user (`--max-memory`).
+    Given,
+}
+
+/// The most bytes one request sized by input may take, and why.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MemoryBudget {
+    /// The budget in bytes.
+    pub bytes: u64,
+    /// Where it comes from.
+    pub origin: BudgetOrigin,
+}
+
+/// A request larger than the budget.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "{what} needs {}; the memory budget is {budget}: {remedy}, or raise the budget with --max-memory",
+    format_bytes(*needed)
+)]
+pub struct MemoryError {
+    /// What was asked for, such as "a 16384x16384 image with 2 AOVs".
+    pub what: String,
+    /// The bytes it needs.
+    pub needed: u64,
+    /// The budget it exceeds.
+    pub budget: MemoryBudget,
+    /// How to ask for less, such as "render a smaller image".
+    pub remedy: String,
+}
+
+/// The budget given for this process in bytes; 0 when none was given.
+static GIVEN: AtomicU64 = AtomicU64::new(0);
+
+impl MemoryBudget {
+    /// A budget of `bytes` given by the user.
+    pub fn given(bytes: u64) -> Self {
+        Self {
+            bytes,
+            origin: BudgetOrigin::Given,
+        }
+    }
+
+    /// The default budget: 3/4 of the memory this process may use, or
+    /// 4 GiB where that cannot be read. Read from the system once.
+    pub fn of_machine() -> Self {
+        static MACHINE: OnceLock<MemoryBudget> = OnceLock::new();
+        *MACHINE.get_or_init(|| Self::from_total(usable_memory()))
+    }
+
+    /// The default budget for a process that may use `total` bytes
+    /// (`None`: unknown).
+    fn from_total(total: Option<u64>) -> Self {
+        match total {
+            Some(total) => Self {
+                bytes: total / SHARE.1 * SHARE.0,
+                origin: BudgetOrigin::Machine { total },
+            },
+            None => Self {
+                bytes: FALLBACK_BYTES,
+                origin: BudgetOrigin::Fallback,
+            },
+        }
+    }
+
+    /// This process's budget: the one set by [`MemoryBudget::set_current`],
+    /// else [`MemoryBudget::of_machine`].
+    pub fn current() -> Self {
+        match GIVEN.load(Ordering::Relaxed) {
+            0 => Self::of_machine(),
+            bytes => Self::given(bytes),
+        }
+    }
+
+    /// Makes `self` this process's budget (the command does this for
+    /// `--max-memory`). A budget of 0 bytes restores the default.
+    pub fn set_current(self) {
+        GIVEN.store(self.bytes, Ordering::Relaxed);
+    }
+
+    /// Refuses a request for `needed` bytes above the budget: `what` names
+    /// the request ("a 16384x16384 image with 2 AOVs"), `remedy` how to ask
+    /// for less ("render a smaller image").
+    pub fn check(&self, what: &str, needed: u64, remedy: &str) -> Result<(), MemoryError> {
+        if needed <= self.bytes {
+            return Ok(());
+        }
+        Err(MemoryError {
+            what: what.to_string(),
+            needed,
+            budget: *self,
+            remedy: remedy.to_string(),
+        })
+    }
+}
+
+impl fmt::Display for MemoryBudget {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let bytes = format_bytes(self.bytes);
+        match self.origin {
+            BudgetOrigin::Machine { total } => write!(
+                f,
+                "{bytes} ({}/{} of the {} this machine gives the process)",
+                SHARE.0,
+                SHARE.1,
+                format_bytes(total)
+            ),
+            BudgetOrigin::Fallback => {
+                write!(f, "{bytes} (the machine's memory could not be read)")
+            }
+            BudgetOrigin::Given => write!(f, "{bytes} (as given)"),
+        }
+    }
+}
+
+/// The memory this process may use: the smaller of the machine's total and
+/// its control group's limit, where they can be read.
+fn usable_memory() -> Option<u64> {
+    let read = |path: &str| std::fs::read_to_string(path).ok();
+    let total = read("/proc/meminfo").and_then(|text| mem_total(&text));
+    let group = [
+        "/sys/fs/cgroup/memory.max",
+        "/sys/fs/cgroup/memory/memory.limit_in_bytes",
+    ]
+    .into_iter()
+    .filter_map(|path| read(path)?.trim().parse::<u64>().ok())
+    .min();
+    match (total, group) {
+        (Some(t), Some(g)) => Some(t.min(g)),
+        (t, g) => t.or(g),
+    }
+}
+
+/// `MemTotal` in bytes from the text of `/proc/meminfo`.
+fn mem_total(meminfo: &str) -> Option<u64> {
+    let line = meminfo.lines().find(|l| l.starts_with("MemTotal:"))?;
+    let kib: u64 = line
+        .trim_start_matches("MemTotal:")
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
+    kib.checked_mul(1024)
+}
+
+/// Bytes as people read them: "800 bytes", "1.5 KiB", "9.6 GiB".
+pub fn format_bytes(bytes: u64) -> String {
+    const UNITS: [&str; 5] = ["KiB", "MiB", "GiB", "TiB", "PiB"];
+    if bytes < 1024 {
+        return format!("{bytes} bytes");
+    }
+    let mut value = bytes as f64 / 1024.0;
+    let mut unit = 0;
+    while value >= 1024.0 && unit + 1 < UNITS.len() {
+        value /= 1024.0;
+        unit += 1;
+    }
+    format!("{value:.1} {}", UNITS[unit])
+}
+
+/// Parses a size such as `4G`, `512MiB`, `1.5g` or `1000000` (bytes): a
+/// number, then optionally K, M, G or T (powers of 1024, any case), with or
+/// without a trailing `B` or `iB`. At least one byte.
+pub fn parse_size(text: &str) -> Result<u64, String> {
+    let expected = || {
+        format!(
+            "`{text}` is not a size: expected a number of bytes, or one with K, M, G or T, like 512M or 4G"
+        )
+    };
+    let lower = text.trim().to_ascii_lowercase();
+    let unitless = lower
+        .strip_suffix("ib")
+        .or_else(|| lower.strip_suffix('b'))
+        .unwrap_or(&lower);
+    let (number, shift) = match unitless.chars().last() {
+        Some('k') => (&unitless[..unitless.len() - 1], 10),
+        Some('m') => (&unitless[..unitless.len() - 1], 20),
+        Some('g') => (&unitless[..unitless.len() - 1], 30),
+        Some('t') => (&unitless[..unitless.len() - 1], 40),
+        _ if lower.ends_with("ib") => return Err(expected()),
+        _ => (unitless, 0),
+    };
+    let value: f64 = number.trim().parse().map_err(|_| expected())?;
+    let bytes = value * (1u64 << shift) as f64;
+    if !bytes.is_finite() || bytes < 1.0 || bytes >= u64::MAX as f64 {
+        return Err(format!("`{text}` is not a size between 1 byte and 16 EiB"));
+    }
+    Ok(bytes as u64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_request_above_the_budget_says_what_it_needs_and_how_to_proceed() {
+        let budget = MemoryBudget::from_total(Some(16 << 30));
+        assert_eq!(budget.bytes, 12 << 30);
+        assert!(
+            budget
+                .check("a small image", 12 << 30, "render smaller")
+                .is_ok()
+        );
+        let error = budget
+            .check("a 16384x16384 image", 13 << 30, "render a smaller image")
+            .unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "a 16384x16384 image needs 13.0 GiB; the memory budget is 12.0 GiB (3/4 of the \
+             16.0 GiB this machine gives the process): render a smaller image, or raise the \
+             budget with --max-memory"
+        );
+        let given = MemoryBudget::given(1 << 20).check("x", 1 << 21, "less");
+        assert!(
+            given
+                .unwrap_err()
+                .to_string()
+                .contains("1.0 MiB (as given)")
+        );
+    }
+
+    #[test]
+    fn an_unreadable_machine_falls_back_to_four_gibibytes() {
+        let budget = MemoryBudget::from_total(None);
+        assert_eq!(budget.bytes, 4 << 30);
+        assert_eq!(
+            budget.to_string(),
+            "4.0 GiB (the machine's memory could not be read)"
+        );
+    }
+
+    #[test]
+    fn the_machine_budget_is_a_share_of_a_positive_total() {
+        let budget = MemoryBudget::of_machine();
+        assert!(budget.bytes > 0);
+        if let BudgetOrigin::Machine { total } = budget.origin {
+            assert_eq!(budget.bytes, total / 4 * 3);
+        }
+    }
+
+    #[test]
+    fn mem_total_is_read_in_kibibytes() {
+        let text = "MemTotal:       24684084 kB\nMemFree:         2730424 kB\n";
+        assert_eq!(mem_total(text), Some(24684084 * 1024));
+        assert_eq!(mem_total("MemFree: 3 kB"), None);
+    }
+
+    #[test]
+    fn sizes_parse_with_binary_units() {
+        assert_eq!(parse_size("1000"), Ok(1000));
+        assert_eq!(parse_size("4G"), Ok(4 << 30));
+        assert_eq!(parse_size("4gib"), Ok(4 << 30));
+        assert_eq!(parse_size("512MB"), Ok(512 << 20));
+        assert_eq!(parse_size("1.5k"), Ok(1536));
+        assert_eq!(parse_size(" 2T "), Ok(2 << 40));
+        for bad in ["", "G", "4X", "-1G", "0", "4iB", "nan", "1e30T"] {
+            assert!(parse_size(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn bytes_format_in_the_largest_whole_unit() {
+        assert_eq!(format_bytes(800), "800 bytes");
+        assert_eq!(format_bytes(1536), "1.5 KiB");
+        assert_eq!(format_bytes(9_600 << 20), "9.4 GiB");
+    }
+}
