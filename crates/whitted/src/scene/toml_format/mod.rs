@@ -50,7 +50,7 @@ use self::reader::{Parsed, Reader};
 use crate::image::ColorSpace;
 use crate::math::Vec3;
 use crate::render::{Camera, CameraError};
-use crate::render::{MAX_DEPTH, MAX_SIDE};
+use crate::render::{MAX_DEPTH, MAX_SAMPLES, MAX_SIDE, check_image_size};
 use crate::render::{RenderSettings, Scene};
 use crate::scene::{Diagnostic, SceneError};
 use crate::shading::Color;
@@ -158,8 +158,18 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
     let width = r.or_default(&f, "width", d.width, side);
     let height = r.or_default(&f, "height", d.height, side);
     let samples = r.or_default(&f, "samples", d.samples_per_pixel, |r, v, k| {
-        r.count(v, k, 1, u32::MAX)
+        r.count(v, k, 1, MAX_SAMPLES)
     });
+    let size = match (width, height) {
+        (Ok(width), Ok(height)) => match check_image_size(width, height) {
+            Ok(()) => Ok((width, height)),
+            Err(error) => {
+                let span = r.value_span(&f, "height");
+                Err(r.error(span, error.to_string()))
+            }
+        },
+        (width, height) => width.and(height).map(|_| (0, 0)),
+    };
     let max_depth = r.or_default(&f, "max_depth", d.max_depth, |r, v, k| {
         r.count(v, k, 0, MAX_DEPTH)
     });
@@ -169,10 +179,11 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
     let accel = r.or_default(&f, "accel", d.accel, read_accel);
     let color_space = r.or_default(&f, "colours", ColorSpace::Linear, read_color_space);
     keys?;
+    let (width, height) = size?;
     Ok(Render {
         settings: RenderSettings {
-            width: width?,
-            height: height?,
+            width,
+            height,
             samples_per_pixel: samples?,
             max_depth: max_depth?,
             min_weight: min_weight?,
@@ -331,6 +342,24 @@ pub(super) mod tests {
                 "unknown colour convention `srgb` for `colours`; expected one of: linear, display",
             ]
         );
+    }
+
+    #[test]
+    fn samples_and_pixels_are_bounded_by_the_render_limits() {
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[render]\nwidth = 1\nheight = 1\nsamples = 4294967295\n"
+            )),
+            ["`samples` must be at most 65536, got 4294967295"]
+        );
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[render]\nwidth = 65535\nheight = 65535\n"
+            )),
+            ["the image 65535x65535 is too large: at most 268435456 pixels are allowed"]
+        );
+        let s = scene(&format!("{CAMERA}[render]\nsamples = 65536\n"));
+        assert_eq!(s.settings.samples_per_pixel, MAX_SAMPLES);
     }
 
     #[test]
