@@ -12,12 +12,15 @@ use serde_json::{Value, json};
 use whitted::accel::{AccelKind, AccelStats, AccelerationStructure};
 use whitted::bench::obj_positions::load_obj_positions;
 use whitted::bench::ray_files::{RayFile, agreement, read_ray_file};
-use whitted::bench::{RayKind, RaySet, TraceResults, scene_ray_sets, time_set, trace_all};
+use whitted::bench::{
+    MAX_RAY_PIXELS, RayKind, RaySet, TraceResults, scene_ray_sets, time_set, trace_all,
+};
 use whitted::render::Camera;
 use whitted::render::Scene;
 use whitted::scene::load_any;
 use whitted::world::World;
 
+use crate::arguments;
 use crate::progress::Status;
 
 /// Brute force is skipped in `--accel all` above this many primitive tests
@@ -47,12 +50,14 @@ pub struct BenchArgs {
     #[arg(long, default_value = "all", value_name = "NAME")]
     accel: String,
 
-    /// Width of the image the primary rays cover.
-    #[arg(long, default_value_t = 1024, value_name = "W")]
+    /// Width of the image the primary rays cover (1 to 65535; at most
+    /// 4194304 pixels in all).
+    #[arg(long, default_value_t = 1024, value_name = "W", value_parser = arguments::image_side, allow_negative_numbers = true)]
     width: u32,
 
-    /// Height of the image the primary rays cover.
-    #[arg(long, default_value_t = 1024, value_name = "H")]
+    /// Height of the image the primary rays cover (1 to 65535; at most
+    /// 4194304 pixels in all).
+    #[arg(long, default_value_t = 1024, value_name = "H", value_parser = arguments::image_side, allow_negative_numbers = true)]
     height: u32,
 
     /// Trace the rays in DIR ({primary,shadow,diffuse}.rays and .hits, as
@@ -61,8 +66,8 @@ pub struct BenchArgs {
     rays: Option<PathBuf>,
 
     /// Timed passes per measurement, and builds per structure (the best is
-    /// reported).
-    #[arg(long, default_value_t = 3, value_name = "N")]
+    /// reported; 1 to 1000).
+    #[arg(long, default_value_t = 3, value_name = "N", value_parser = arguments::runs, allow_negative_numbers = true)]
     runs: usize,
 
     /// Print JSON instead of a table.
@@ -96,6 +101,20 @@ fn kinds(list: &str) -> Result<Vec<AccelKind>, String> {
         kinds.push(kind);
     }
     Ok(kinds)
+}
+
+/// Refuses an image too large to hold rays for (see [`MAX_RAY_PIXELS`]),
+/// before the scene is read.
+fn check_ray_image(width: u32, height: u32) -> Result<(), String> {
+    let pixels = u64::from(width) * u64::from(height);
+    if pixels > MAX_RAY_PIXELS {
+        return Err(format!(
+            "--width {width} --height {height}: {pixels} pixels is too many to hold rays for \
+             (up to three rays of 88 bytes each per pixel); at most {MAX_RAY_PIXELS} pixels, \
+             e.g. 2048x2048"
+        ));
+    }
+    Ok(())
 }
 
 /// The scene to measure: a scene file, or a mesh framed by the anchor
@@ -137,9 +156,7 @@ struct AccelReport {
 /// Runs the command.
 pub fn run(args: &BenchArgs) -> Result<(), String> {
     let kinds = kinds(&args.accel)?;
-    if args.width == 0 || args.height == 0 {
-        return Err("--width and --height must be at least 1".to_string());
-    }
+    check_ray_image(args.width, args.height)?;
     let status = Status::new(args.quiet || args.json);
     status.set(format!("loading {}", args.scene.display()));
     let scene = load(&args.scene, args.width, args.height)?;
@@ -367,6 +384,17 @@ mod tests {
         assert_eq!(
             kinds("bvh, kdtree,linear").unwrap(),
             vec![AccelKind::Bvh, AccelKind::KdTree, AccelKind::Linear]
+        );
+    }
+
+    #[test]
+    fn images_too_large_to_hold_rays_for_are_refused() {
+        assert_eq!(check_ray_image(2048, 2048), Ok(()));
+        assert_eq!(check_ray_image(1, 65535), Ok(()));
+        assert_eq!(
+            check_ray_image(65535, 65535).unwrap_err(),
+            "--width 65535 --height 65535: 4294836225 pixels is too many to hold rays for (up \
+             to three rays of 88 bytes each per pixel); at most 4194304 pixels, e.g. 2048x2048"
         );
     }
 

@@ -1,5 +1,6 @@
 //! The `whitted` command: renders scenes with the whitted ray tracer.
 
+mod arguments;
 mod bench_command;
 mod progress;
 mod render_command;

@@ -12,7 +12,7 @@ pub mod ray_files;
 mod scene_rays;
 mod timing;
 
-pub use scene_rays::scene_ray_sets;
+pub use scene_rays::{MAX_RAY_PIXELS, scene_ray_sets};
 pub use timing::{TraceResults, time_set, trace_all};
 
 use crate::accel::RayCoherence;

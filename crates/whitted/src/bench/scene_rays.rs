@@ -8,6 +8,11 @@ use crate::render::Scene;
 use crate::shading::{Color, Light};
 use crate::world::World;
 
+/// Largest image (in pixels) to make rays for: a ray takes 88 bytes and a
+/// pixel up to three (primary, shadow, diffuse), about 1.1 GB at this size
+/// (2048 × 2048), held for the whole measurement.
+pub const MAX_RAY_PIXELS: u64 = 1 << 22;
+
 /// Primary rays through the centre of every pixel of a `width` × `height`
 /// image, then one shadow ray and one diffuse ray per primary hit. Shadow
 /// rays go towards the scene's first light (or, without lights, a point
