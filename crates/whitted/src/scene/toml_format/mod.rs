@@ -60,17 +60,32 @@ use crate::world::MaterialId;
 /// Reads a scene from the text of a scene file; `path` is only used in
 /// messages.
 pub fn parse_scene(source: &str, path: &Path) -> Result<Scene, SceneError> {
-    let root = toml_span::parse(source).map_err(|error| SceneError::Invalid {
-        diagnostics: vec![Diagnostic::new(
-            path,
-            source,
-            error.span.start..error.span.end,
-            format!("invalid TOML: {error}"),
-        )],
+    let root = toml_span::parse(source).map_err(|error| {
+        let span = error.span.start..error.span.end;
+        let message = match source.get(span.clone()) {
+            Some(text) if is_too_large_integer(text) => format!(
+                "invalid TOML: {text} is too large for an integer (TOML integers are 64-bit, \
+                 from {} to {})",
+                i64::MIN,
+                i64::MAX
+            ),
+            _ => format!("invalid TOML: {error}"),
+        };
+        SceneError::Invalid {
+            diagnostics: vec![Diagnostic::new(path, source, span, message)],
+        }
     })?;
     let mut reader = Reader::new(source, path);
     let scene = read_document(&mut reader, &root);
     reader.finish(scene)
+}
+
+/// True when `text` is a whole number (an optional sign, then digits)
+/// outside the 64-bit range that TOML integers have: the parser calls it
+/// only "invalid number".
+fn is_too_large_integer(text: &str) -> bool {
+    let digits = text.strip_prefix(['-', '+']).unwrap_or(text);
+    !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()) && text.parse::<i64>().is_err()
 }
 
 /// Reads a scene file.
@@ -358,6 +373,16 @@ pub(super) mod tests {
             )),
             ["the image 65535x65535 is too large: at most 268435456 pixels are allowed"]
         );
+        assert_eq!(
+            errors(&format!("{CAMERA}[render]\nsamples = 99999999999999999999\n")),
+            [
+                "invalid TOML: 99999999999999999999 is too large for an integer (TOML integers \
+                 are 64-bit, from -9223372036854775808 to 9223372036854775807)"
+            ]
+        );
+        assert!(!is_too_large_integer("9223372036854775807"));
+        assert!(is_too_large_integer("-9223372036854775809"));
+        assert!(!is_too_large_integer("1_000"));
         let s = scene(&format!("{CAMERA}[render]\nsamples = 65536\n"));
         assert_eq!(s.settings.samples_per_pixel, MAX_SAMPLES);
     }
