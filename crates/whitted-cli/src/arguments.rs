@@ -26,10 +26,7 @@ impl Range {
         let expected = if self.max == u64::MAX {
             format!("expected a whole number, at least {}", self.min)
         } else {
-            format!(
-                "expected a whole number from {} to {}",
-                self.min, self.max
-            )
+            format!("expected a whole number from {} to {}", self.min, self.max)
         };
         let cause = match parse_whole_number(text, self.min, self.max) {
             Ok(value) => return Ok(value),
@@ -86,7 +83,8 @@ pub fn threads(text: &str) -> Result<usize, String> {
         limit: "",
     };
     let count = range.parse(text)?;
-    usize::try_from(count).map_err(|_| format!("{text} is too large; expected a whole number, at least 1"))
+    usize::try_from(count)
+        .map_err(|_| format!("{text} is too large; expected a whole number, at least 1"))
 }
 
 /// A number of timed passes: 1 to [`MAX_RUNS`].
@@ -231,9 +229,7 @@ mod tests {
         ] {
             assert_eq!(
                 got.unwrap_err(),
-                format!(
-                    "{says}; expected three finite numbers separated by commas, like 1,2.5,-3"
-                )
+                format!("{says}; expected three finite numbers separated by commas, like 1,2.5,-3")
             );
         }
     }

@@ -123,7 +123,12 @@ mod tests {
             given(Some(Vec3::Z), None, None, None),
             given(None, Some(far), None, None),
             given(Some(-far), None, Some(Vec3::Y), None),
-            given(Some(Vec3::splat(1e308)), Some(Vec3::splat(-1e308)), None, None),
+            given(
+                Some(Vec3::splat(1e308)),
+                Some(Vec3::splat(-1e308)),
+                None,
+                None,
+            ),
             given(Some(Vec3::splat(1e-300)), Some(Vec3::ZERO), None, None),
             given(None, None, Some(Vec3::new(0.0, 1e-200, 0.0)), Some(179.0)),
             given(Some(Vec3::Z), Some(Vec3::ZERO), Some(Vec3::Y), Some(1.0)),
@@ -132,8 +137,14 @@ mod tests {
         }
         for (wrong, error) in [
             (given(None, None, None, Some(0.0)), CameraError::BadFov(0.0)),
-            (given(None, None, None, Some(180.0)), CameraError::BadFov(180.0)),
-            (given(None, None, Some(Vec3::ZERO), None), CameraError::BadUp),
+            (
+                given(None, None, None, Some(180.0)),
+                CameraError::BadFov(180.0),
+            ),
+            (
+                given(None, None, Some(Vec3::ZERO), None),
+                CameraError::BadUp,
+            ),
             (
                 given(Some(Vec3::Z), Some(Vec3::Z), None, None),
                 CameraError::NoViewDirection,

@@ -110,9 +110,10 @@ pub(super) fn read_view(r: &mut Reader<'_>, at: Range<usize>) -> Parsed<View> {
 
 /// One side of the view's `resolution`, from 1 to [`MAX_SIDE`] pixels.
 fn side(r: &mut Reader<'_>, name: &str) -> Parsed<u32> {
-    Ok(r
-        .count(&format!("the view's resolution ({name})"), 1, MAX_SIDE)?
-        .0)
+    Ok(
+        r.count(&format!("the view's resolution ({name})"), 1, MAX_SIDE)?
+            .0,
+    )
 }
 
 /// A line `name X Y Z` of the view: the vector and the span of its

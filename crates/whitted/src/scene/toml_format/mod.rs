@@ -374,7 +374,9 @@ pub(super) mod tests {
             ["the image 65535x65535 is too large: at most 268435456 pixels are allowed"]
         );
         assert_eq!(
-            errors(&format!("{CAMERA}[render]\nsamples = 99999999999999999999\n")),
+            errors(&format!(
+                "{CAMERA}[render]\nsamples = 99999999999999999999\n"
+            )),
             [
                 "invalid TOML: 99999999999999999999 is too large for an integer (TOML integers \
                  are 64-bit, from -9223372036854775808 to 9223372036854775807)"
