@@ -21,6 +21,7 @@ use whitted::render::Scene;
 use whitted::scene::load_any;
 use whitted::world::World;
 
+use crate::arguments;
 use crate::progress::Status;
 use crate::report::{self, note};
 
@@ -51,12 +52,14 @@ pub struct BenchArgs {
     #[arg(long, default_value = "all", value_name = "NAME")]
     accel: String,
 
-    /// Width of the image the primary rays cover.
-    #[arg(long, default_value_t = 1024, value_name = "W")]
+    /// Width of the image the primary rays cover (1 to 65535; at most
+    /// 4194304 pixels in all).
+    #[arg(long, default_value_t = 1024, value_name = "W", value_parser = arguments::image_side, allow_negative_numbers = true)]
     width: u32,
 
-    /// Height of the image the primary rays cover.
-    #[arg(long, default_value_t = 1024, value_name = "H")]
+    /// Height of the image the primary rays cover (1 to 65535; at most
+    /// 4194304 pixels in all).
+    #[arg(long, default_value_t = 1024, value_name = "H", value_parser = arguments::image_side, allow_negative_numbers = true)]
     height: u32,
 
     /// Trace the rays in DIR ({primary,shadow,diffuse}.rays and .hits, as
@@ -65,8 +68,8 @@ pub struct BenchArgs {
     rays: Option<PathBuf>,
 
     /// Timed passes per measurement, and builds per structure (the best is
-    /// reported).
-    #[arg(long, default_value_t = 3, value_name = "N")]
+    /// reported; 1 to 1000).
+    #[arg(long, default_value_t = 3, value_name = "N", value_parser = arguments::runs, allow_negative_numbers = true)]
     runs: usize,
 
     /// The memory budget: the most the rays, an input file or the scene's
@@ -147,9 +150,6 @@ struct AccelReport {
 /// Runs the command.
 pub fn run(args: &BenchArgs) -> Result<(), String> {
     let kinds = kinds(&args.accel)?;
-    if args.width == 0 || args.height == 0 {
-        return Err("--width and --height must be at least 1".to_string());
-    }
     if let Some(bytes) = args.max_memory {
         MemoryBudget::given(bytes).set_current();
     }

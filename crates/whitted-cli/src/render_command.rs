@@ -9,9 +9,10 @@ use whitted::image::heat_map;
 use whitted::image::{ImageError, ImageFormat, check_destination};
 use whitted::limits::MemoryBudget;
 use whitted::math::Vec3;
-use whitted::render::{Aov, render};
+use whitted::render::{Aov, check_image_size, render};
 use whitted::scene::{CameraOverride, LoadOptions, load_any_with};
 
+use crate::arguments;
 use crate::progress::ProgressReport;
 use crate::report::note;
 
@@ -37,21 +38,22 @@ pub struct RenderArgs {
     #[arg(short, long, value_name = "OUT", default_value = "whitted.png")]
     output: PathBuf,
 
-    /// Image width in pixels.
-    #[arg(long, value_name = "W")]
+    /// Image width in pixels (1 to 65535; at most 268435456 pixels in all).
+    #[arg(long, value_name = "W", value_parser = arguments::image_side, allow_negative_numbers = true)]
     width: Option<u32>,
 
-    /// Image height in pixels.
-    #[arg(long, value_name = "H")]
+    /// Image height in pixels (1 to 65535; at most 268435456 pixels in all).
+    #[arg(long, value_name = "H", value_parser = arguments::image_side, allow_negative_numbers = true)]
     height: Option<u32>,
 
-    /// Samples per pixel, on a stratified seeded pattern (1 = pixel centre).
-    #[arg(long, value_name = "N")]
+    /// Samples per pixel, on a stratified seeded pattern (1 = pixel centre;
+    /// at most 65536).
+    #[arg(long, value_name = "N", value_parser = arguments::samples, allow_negative_numbers = true)]
     spp: Option<u32>,
 
     /// Maximum reflection/refraction depth (0 = no secondary rays; default 8;
     /// at most 1000).
-    #[arg(long, value_name = "D", value_parser = clap::value_parser!(u32).range(..=i64::from(whitted::render::MAX_DEPTH)))]
+    #[arg(long, value_name = "D", value_parser = arguments::depth, allow_negative_numbers = true)]
     max_depth: Option<u32>,
 
     /// Acceleration structure over the objects (overrides the scene's
@@ -61,7 +63,7 @@ pub struct RenderArgs {
 
     /// Worker threads (default: all cores). The picture is the same for any
     /// number.
-    #[arg(long, value_name = "T")]
+    #[arg(long, value_name = "T", value_parser = arguments::threads, allow_negative_numbers = true)]
     threads: Option<usize>,
 
     /// Also write per-pixel data of the ray through each pixel centre, as
@@ -74,20 +76,20 @@ pub struct RenderArgs {
     aov: Vec<String>,
 
     /// Put the camera's eye here (replaces the scene's).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = arguments::vec3, allow_hyphen_values = true)]
     eye: Option<Vec3>,
 
     /// Point the camera at this point (replaces the scene's).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = arguments::vec3, allow_hyphen_values = true)]
     look_at: Option<Vec3>,
 
     /// The direction that is up on the image (replaces the scene's).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = arguments::vec3, allow_hyphen_values = true)]
     up: Option<Vec3>,
 
     /// Vertical field of view in degrees, top edge to bottom edge
-    /// (replaces the scene's).
-    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    /// (replaces the scene's; between 0 and 180, both excluded).
+    #[arg(long, value_name = "DEG", value_parser = arguments::field_of_view, allow_hyphen_values = true)]
     fov: Option<f64>,
 
     /// The memory budget: the most an image, a texture or an input file
@@ -98,19 +100,6 @@ pub struct RenderArgs {
     /// Print nothing but errors.
     #[arg(short, long)]
     quiet: bool,
-}
-
-/// Parses `X,Y,Z` into a vector of three finite numbers.
-fn parse_vec3(text: &str) -> Result<Vec3, String> {
-    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let numbers: Vec<f64> = parts
-        .iter()
-        .filter_map(|p| p.parse::<f64>().ok().filter(|x| x.is_finite()))
-        .collect();
-    match numbers.as_slice() {
-        &[x, y, z] if parts.len() == 3 => Ok(Vec3::new(x, y, z)),
-        _ => Err("expected three finite numbers separated by commas, like 1,2.5,-3".to_string()),
-    }
 }
 
 /// Parses the name of an acceleration structure.
@@ -173,8 +162,32 @@ fn check_destinations(output: &Path, aovs: &[(Aov, PathBuf)]) -> Result<(), Stri
     Ok(())
 }
 
+/// The parts of the scene's camera the arguments replace.
+fn camera_override(args: &RenderArgs) -> CameraOverride {
+    CameraOverride {
+        eye: args.eye,
+        look_at: args.look_at,
+        up: args.up,
+        fov_degrees: args.fov,
+    }
+}
+
+/// Refuses, before the scene is read, what the arguments alone show cannot
+/// be rendered: an image of too many pixels, a camera no scene could have.
+/// (Each value was checked on its own as it was parsed.)
+fn check_arguments(args: &RenderArgs) -> Result<(), String> {
+    if let (Some(width), Some(height)) = (args.width, args.height) {
+        check_image_size(width, height)
+            .map_err(|e| format!("--width {width} --height {height}: {e}"))?;
+    }
+    camera_override(args)
+        .check()
+        .map_err(|e| format!("the camera asked for is invalid: {e}"))
+}
+
 /// Runs the command.
 pub fn run(args: &RenderArgs) -> Result<(), String> {
+    check_arguments(args)?;
     if let Some(bytes) = args.max_memory {
         MemoryBudget::given(bytes).set_current();
     }
@@ -186,12 +199,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     check_destinations(&args.output, &aov_outputs)?;
 
     let options = LoadOptions {
-        camera: CameraOverride {
-            eye: args.eye,
-            look_at: args.look_at,
-            up: args.up,
-            fov_degrees: args.fov,
-        },
+        camera: camera_override(args),
     };
     let mut scene = match &args.scene {
         Some(path) => {
@@ -225,9 +233,6 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     settings.samples_per_pixel = args.spp.unwrap_or(settings.samples_per_pixel);
     settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
     settings.accel = args.accel.unwrap_or(settings.accel);
-    if args.threads == Some(0) {
-        return Err("--threads must be at least 1".to_string());
-    }
 
     scene.settings.threads = args.threads;
     scene.settings.aovs = aov_outputs.iter().map(|(a, _)| *a).collect();

@@ -447,7 +447,14 @@ fn camera_overrides_replace_parts_of_the_scene_camera_and_bad_ones_are_refused()
     );
     let out = whitted(&[&small[..], &["--fov", "200"]].concat(), dir.path());
     assert!(!out.status.success());
-    assert!(stderr(&out).contains("the camera asked for is invalid: the field of view must be between 0 and 180 degrees, got 200"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains(
+            "invalid value '200' for '--fov <DEG>': 200 degrees is out of range; \
+             expected degrees between 0 and 180 (both excluded)"
+        ),
+        "{}",
+        stderr(&out)
+    );
 }
 
 #[test]

@@ -94,13 +94,13 @@ fn a_bench_image_beyond_the_budget_is_refused_before_any_ray_is_made() {
     let dir = tempfile::tempdir().unwrap();
     write(dir.path(), "s.toml", sphere_scene("0.5"));
     let p = probe(
-        &["bench", "s.toml", "--width", "70000", "--height", "70000"],
+        &["bench", "s.toml", "--width", "60000", "--height", "60000"],
         dir.path(),
     );
     assert_eq!(p.code(), Some(1), "{}", p.stderr);
     assert!(
         p.stderr.starts_with(
-            "error: benchmarking a 70000x70000 image (3 sets of up to 4900000000 rays) needs "
+            "error: benchmarking a 60000x60000 image (3 sets of up to 3600000000 rays) needs "
         ),
         "{}",
         p.stderr

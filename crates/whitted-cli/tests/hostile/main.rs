@@ -3,6 +3,7 @@
 //! files on disk, and where memory is the point, the child's peak resident
 //! memory). Every case runs the real `whitted` binary.
 
+mod args;
 mod limits;
 mod outputs;
 mod support;

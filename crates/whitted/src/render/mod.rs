@@ -10,7 +10,9 @@ mod settings;
 pub use camera::{Camera, CameraError};
 pub use resources::{RayBudgetCut, ThreadClamp, memory_needed};
 pub use scene::Scene;
-pub use settings::{Aov, MAX_DEPTH, MAX_PIXELS, MAX_SIDE, RenderSettings};
+pub use settings::{
+    Aov, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, RenderSettings, check_image_size,
+};
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -80,6 +82,12 @@ pub enum RenderError {
     /// Zero samples per pixel.
     #[error("samples per pixel must be at least 1")]
     NoSamples,
+    /// More samples per pixel than [`MAX_SAMPLES`].
+    #[error(
+        "{0} samples per pixel is too many: at most {MAX_SAMPLES} are allowed (a 256x256 grid \
+         in each pixel, finer than an 8-bit channel can show)"
+    )]
+    TooManySamples(u32),
     /// A recursion depth beyond [`MAX_DEPTH`].
     #[error("the maximum depth {0} is too large: at most {MAX_DEPTH} is allowed")]
     DepthTooLarge(u32),
@@ -167,18 +175,7 @@ pub fn render(
 ) -> Result<RenderOutput, RenderError> {
     let settings = &scene.settings;
     let (width, height) = (settings.width, settings.height);
-    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
-        return Err(RenderError::BadSize { width, height });
-    }
-    if settings.samples_per_pixel == 0 {
-        return Err(RenderError::NoSamples);
-    }
-    if settings.max_depth > MAX_DEPTH {
-        return Err(RenderError::DepthTooLarge(settings.max_depth));
-    }
-    if u64::from(width) * u64::from(height) > MAX_PIXELS {
-        return Err(RenderError::TooManyPixels { width, height });
-    }
+    settings.check()?;
     let primitives = scene.objects.primitive_count();
     if primitives > MAX_PRIMITIVES {
         return Err(RenderError::TooManyPrimitives(primitives));

@@ -2,6 +2,7 @@
 //! part (size, samples, depth, structure), the command line may replace any
 //! of it and adds the rest (threads, per-pixel data).
 
+use super::RenderError;
 use crate::accel::AccelKind;
 use crate::integrator::IntegratorKind;
 
@@ -14,6 +15,28 @@ pub const MAX_SIDE: u32 = 65535;
 
 /// Largest image (in pixels) a render accepts: a few gigabytes of film.
 pub const MAX_PIXELS: u64 = 1 << 28;
+
+/// Most samples per pixel a render accepts: 65536 is a 256 × 256 grid of
+/// strata over the pixel, which resolves how much of the pixel an edge
+/// covers to 1/256 along each axis, the step of an 8-bit channel. The
+/// position in the pixel is the only thing a sample varies, so more
+/// samples cannot change an 8-bit pixel by a step; they only multiply the
+/// time (2³² samples of a single pixel would take hours).
+pub const MAX_SAMPLES: u32 = 1 << 16;
+
+/// Refuses an image of `width` × `height` pixels that a render would
+/// refuse: a side of 0 or beyond [`MAX_SIDE`], or more than [`MAX_PIXELS`]
+/// pixels. Readers and the command line call it as soon as they know the
+/// size, before anything is loaded or built.
+pub fn check_image_size(width: u32, height: u32) -> Result<(), RenderError> {
+    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
+        return Err(RenderError::BadSize { width, height });
+    }
+    if u64::from(width) * u64::from(height) > MAX_PIXELS {
+        return Err(RenderError::TooManyPixels { width, height });
+    }
+    Ok(())
+}
 
 /// Per-pixel data besides the colour.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -85,6 +108,24 @@ pub struct RenderSettings {
     pub aovs: Vec<Aov>,
 }
 
+impl RenderSettings {
+    /// Refuses settings a render cannot honour: see [`check_image_size`],
+    /// samples from 1 to [`MAX_SAMPLES`], a depth of at most [`MAX_DEPTH`].
+    pub fn check(&self) -> Result<(), RenderError> {
+        check_image_size(self.width, self.height)?;
+        if self.samples_per_pixel == 0 {
+            return Err(RenderError::NoSamples);
+        }
+        if self.samples_per_pixel > MAX_SAMPLES {
+            return Err(RenderError::TooManySamples(self.samples_per_pixel));
+        }
+        if self.max_depth > MAX_DEPTH {
+            return Err(RenderError::DepthTooLarge(self.max_depth));
+        }
+        Ok(())
+    }
+}
+
 impl Default for RenderSettings {
     fn default() -> Self {
         Self {
@@ -98,5 +139,49 @@ impl Default for RenderSettings {
             threads: None,
             aovs: Vec::new(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_defaults_pass_their_own_check() {
+        assert!(RenderSettings::default().check().is_ok());
+    }
+
+    #[test]
+    fn sizes_samples_and_depths_beyond_the_limits_are_refused() {
+        assert!(check_image_size(1, 1).is_ok());
+        assert!(check_image_size(MAX_SIDE, 4096).is_ok());
+        for (width, height) in [(0, 1), (1, 0), (MAX_SIDE + 1, 1), (1, u32::MAX)] {
+            assert!(
+                matches!(
+                    check_image_size(width, height),
+                    Err(RenderError::BadSize { .. })
+                ),
+                "{width}x{height}"
+            );
+        }
+        assert!(matches!(
+            check_image_size(MAX_SIDE, MAX_SIDE),
+            Err(RenderError::TooManyPixels { .. })
+        ));
+        let with = |samples_per_pixel, max_depth| RenderSettings {
+            samples_per_pixel,
+            max_depth,
+            ..RenderSettings::default()
+        };
+        assert!(with(MAX_SAMPLES, MAX_DEPTH).check().is_ok());
+        assert!(matches!(with(0, 1).check(), Err(RenderError::NoSamples)));
+        assert!(matches!(
+            with(MAX_SAMPLES + 1, 1).check(),
+            Err(RenderError::TooManySamples(65537))
+        ));
+        assert!(matches!(
+            with(1, MAX_DEPTH + 1).check(),
+            Err(RenderError::DepthTooLarge(1001))
+        ));
     }
 }

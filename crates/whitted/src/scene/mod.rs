@@ -8,6 +8,7 @@ mod diagnostic;
 mod nff;
 pub mod obj;
 mod toml_format;
+mod whole_number;
 
 pub use camera_override::CameraOverride;
 pub use diagnostic::{
@@ -16,6 +17,7 @@ pub use diagnostic::{
 pub use nff::{load_nff, parse_nff};
 pub use obj::{load_obj, parse_obj};
 pub use toml_format::{load_scene, parse_scene};
+pub use whole_number::{WholeNumberError, parse_whole_number};
 
 use std::path::Path;
 

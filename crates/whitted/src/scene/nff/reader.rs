@@ -13,7 +13,7 @@ use std::path::Path;
 
 use super::lexer::{Lexer, Token, is_entity_keyword};
 use crate::math::Vec3;
-use crate::scene::{Diagnostic, Severity, push_limited};
+use crate::scene::{Diagnostic, Severity, WholeNumberError, parse_whole_number, push_limited};
 use crate::shading::Color;
 
 /// A problem that has been recorded; the entity being read is abandoned.
@@ -155,20 +155,29 @@ impl<'a> Reader<'a> {
         Ok(color)
     }
 
-    /// A whole number of at least `least`, for `what`, with its span.
-    pub(super) fn count(&mut self, what: &str, least: u32) -> Parsed<(u32, Range<usize>)> {
+    /// A whole number from `least` to `most`, for `what`, with its span. A
+    /// number out of range is reported as such, however many digits it has.
+    pub(super) fn count(
+        &mut self,
+        what: &str,
+        least: u32,
+        most: u32,
+    ) -> Parsed<(u32, Range<usize>)> {
         let token = self.take("a whole number", what)?;
-        match token.text.parse::<u32>() {
-            Ok(value) if value >= least => Ok((value, token.span)),
-            Ok(value) => Err(self.error(
-                token.span,
-                format!("{what} must be at least {least}, got {value}"),
-            )),
-            Err(_) => Err(self.error(
-                token.span,
-                format!("expected a whole number for {what}, found `{}`", token.text),
-            )),
-        }
+        let text = token.text;
+        let message = match parse_whole_number(text, least.into(), most.into()) {
+            Ok(value) => return Ok((value as u32, token.span)),
+            Err(WholeNumberError::NotANumber | WholeNumberError::NotWhole) => {
+                format!("expected a whole number for {what}, found `{text}`")
+            }
+            Err(WholeNumberError::Negative | WholeNumberError::BelowMinimum) => {
+                format!("{what} must be at least {least}, got {text}")
+            }
+            Err(WholeNumberError::AboveMaximum) => {
+                format!("{what} must be at most {most}, got {text}")
+            }
+        };
+        Err(self.error(token.span, message))
     }
 
     /// The word `word`, which must come next in the `v` block.
@@ -202,14 +211,15 @@ mod tests {
 
     #[test]
     fn numbers_and_counts_are_read_and_checked() {
-        let mut r = reader("1.5 -2e3 abc nan 4 2.5 1");
+        let mut r = reader("1.5 -2e3 abc nan 4 2.5 1 -7 18446744073709551616 11");
         assert_eq!(r.number("x"), Ok(1.5));
         assert_eq!(r.number("x"), Ok(-2000.0));
         assert_eq!(r.number("the sphere's radius"), Err(Reported));
         assert_eq!(r.number("y"), Err(Reported));
-        assert_eq!(r.count("n", 3).map(|c| c.0), Ok(4));
-        assert_eq!(r.count("n", 3), Err(Reported));
-        assert_eq!(r.count("n", 3), Err(Reported));
+        assert_eq!(r.count("n", 3, 10).map(|c| c.0), Ok(4));
+        for _ in 0..5 {
+            assert_eq!(r.count("n", 3, 10), Err(Reported));
+        }
         assert_eq!(
             messages(r),
             [
@@ -217,6 +227,9 @@ mod tests {
                 "1:14: expected a finite number for y, found `nan`",
                 "1:20: expected a whole number for n, found `2.5`",
                 "1:24: n must be at least 3, got 1",
+                "1:26: n must be at least 3, got -7",
+                "1:29: n must be at most 10, got 18446744073709551616",
+                "1:50: n must be at most 10, got 11",
             ]
         );
     }

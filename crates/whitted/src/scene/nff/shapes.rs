@@ -87,9 +87,11 @@ pub(super) fn read_cone(r: &mut Reader<'_>, at: Range<usize>) -> Parsed<Placed> 
     Ok((shape, placement))
 }
 
-/// Reads the vertex count of a `p` or `pp` entity, `what` naming it.
+/// Reads the vertex count of a `p` or `pp` entity, `what` naming it: from
+/// 3 to 2³² - 1 (vertices are numbered by `u32`).
 pub(super) fn vertex_count(r: &mut Reader<'_>, what: &str) -> Parsed<u32> {
-    Ok(r.count(&format!("the {what}'s vertex count"), 3)?.0)
+    Ok(r.count(&format!("the {what}'s vertex count"), 3, u32::MAX)?
+        .0)
 }
 
 /// Reads a `p` entity; `at` is the span of its keyword.

@@ -173,6 +173,32 @@ fn the_view_is_required_once_and_checked() {
 }
 
 #[test]
+fn numbers_out_of_range_are_called_so_however_many_digits_they_have() {
+    let view = |resolution: &str| {
+        format!("v\nfrom 0 0 0\nat 1 0 0\nup 0 0 1\nangle 45\nhither 1\nresolution {resolution}\n")
+    };
+    assert_eq!(
+        errors(&view("-1 8")),
+        ["7:12: the view's resolution (width) must be at least 1, got -1"]
+    );
+    assert_eq!(
+        errors(&view("8 99999999999999999999")),
+        ["7:14: the view's resolution (height) must be at most 65535, got 99999999999999999999"]
+    );
+    assert_eq!(
+        errors(&view("65535 65535")),
+        [
+            "7:12: the view's resolution: the image 65535x65535 is too large: at most 268435456 \
+             pixels are allowed"
+        ]
+    );
+    assert_eq!(
+        errors(&format!("{VIEW}p 18446744073709551615\n")),
+        ["8:3: the polygon's vertex count must be at most 4294967295, got 18446744073709551615"]
+    );
+}
+
+#[test]
 fn a_degenerate_patch_is_refused_at_its_place() {
     assert_eq!(
         errors(&format!(

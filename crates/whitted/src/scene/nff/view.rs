@@ -20,8 +20,8 @@ use std::ops::Range;
 
 use super::reader::{Parsed, Reader};
 use crate::math::Vec3;
-use crate::render::MAX_SIDE;
 use crate::render::{Camera, CameraError};
+use crate::render::{MAX_SIDE, check_image_size};
 
 /// What the `v` block says.
 #[derive(Clone, Debug, PartialEq)]
@@ -71,8 +71,13 @@ pub(super) fn read_view(r: &mut Reader<'_>, at: Range<usize>) -> Parsed<View> {
         ));
     }
     r.word("resolution")?;
+    let resolution_start = r.next_start();
     let width = side(r, "width")?;
     let height = side(r, "height")?;
+    if let Err(error) = check_image_size(width, height) {
+        let span = r.since(resolution_start);
+        return Err(r.error(span, format!("the view's resolution: {error}")));
+    }
     if !(angle > 0.0 && angle < 180.0) {
         return Err(r.error(
             angle_span,
@@ -105,14 +110,10 @@ pub(super) fn read_view(r: &mut Reader<'_>, at: Range<usize>) -> Parsed<View> {
 
 /// One side of the view's `resolution`, from 1 to [`MAX_SIDE`] pixels.
 fn side(r: &mut Reader<'_>, name: &str) -> Parsed<u32> {
-    let (pixels, span) = r.count(&format!("the view's resolution ({name})"), 1)?;
-    if pixels > MAX_SIDE {
-        return Err(r.error(
-            span,
-            format!("the view's resolution ({name}) must be at most {MAX_SIDE}, got {pixels}"),
-        ));
-    }
-    Ok(pixels)
+    Ok(
+        r.count(&format!("the view's resolution ({name})"), 1, MAX_SIDE)?
+            .0,
+    )
 }
 
 /// A line `name X Y Z` of the view: the vector and the span of its

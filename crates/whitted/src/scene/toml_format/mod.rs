@@ -50,7 +50,7 @@ use self::reader::{Parsed, Reader};
 use crate::image::ColorSpace;
 use crate::math::Vec3;
 use crate::render::{Camera, CameraError};
-use crate::render::{MAX_DEPTH, MAX_SIDE};
+use crate::render::{MAX_DEPTH, MAX_SAMPLES, MAX_SIDE, check_image_size};
 use crate::render::{RenderSettings, Scene};
 use crate::scene::{Diagnostic, SceneError};
 use crate::shading::Color;
@@ -60,17 +60,32 @@ use crate::world::MaterialId;
 /// Reads a scene from the text of a scene file; `path` is only used in
 /// messages.
 pub fn parse_scene(source: &str, path: &Path) -> Result<Scene, SceneError> {
-    let root = toml_span::parse(source).map_err(|error| SceneError::Invalid {
-        diagnostics: vec![Diagnostic::new(
-            path,
-            source,
-            error.span.start..error.span.end,
-            format!("invalid TOML: {error}"),
-        )],
+    let root = toml_span::parse(source).map_err(|error| {
+        let span = error.span.start..error.span.end;
+        let message = match source.get(span.clone()) {
+            Some(text) if is_too_large_integer(text) => format!(
+                "invalid TOML: {text} is too large for an integer (TOML integers are 64-bit, \
+                 from {} to {})",
+                i64::MIN,
+                i64::MAX
+            ),
+            _ => format!("invalid TOML: {error}"),
+        };
+        SceneError::Invalid {
+            diagnostics: vec![Diagnostic::new(path, source, span, message)],
+        }
     })?;
     let mut reader = Reader::new(source, path);
     let scene = read_document(&mut reader, &root);
     reader.finish(scene)
+}
+
+/// True when `text` is a whole number (an optional sign, then digits)
+/// outside the 64-bit range that TOML integers have: the parser calls it
+/// only "invalid number".
+fn is_too_large_integer(text: &str) -> bool {
+    let digits = text.strip_prefix(['-', '+']).unwrap_or(text);
+    !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()) && text.parse::<i64>().is_err()
 }
 
 /// Reads a scene file.
@@ -158,8 +173,18 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
     let width = r.or_default(&f, "width", d.width, side);
     let height = r.or_default(&f, "height", d.height, side);
     let samples = r.or_default(&f, "samples", d.samples_per_pixel, |r, v, k| {
-        r.count(v, k, 1, u32::MAX)
+        r.count(v, k, 1, MAX_SAMPLES)
     });
+    let size = match (width, height) {
+        (Ok(width), Ok(height)) => match check_image_size(width, height) {
+            Ok(()) => Ok((width, height)),
+            Err(error) => {
+                let span = r.value_span(&f, "height");
+                Err(r.error(span, error.to_string()))
+            }
+        },
+        (width, height) => width.and(height).map(|_| (0, 0)),
+    };
     let max_depth = r.or_default(&f, "max_depth", d.max_depth, |r, v, k| {
         r.count(v, k, 0, MAX_DEPTH)
     });
@@ -169,10 +194,11 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
     let accel = r.or_default(&f, "accel", d.accel, read_accel);
     let color_space = r.or_default(&f, "colours", ColorSpace::Linear, read_color_space);
     keys?;
+    let (width, height) = size?;
     Ok(Render {
         settings: RenderSettings {
-            width: width?,
-            height: height?,
+            width,
+            height,
             samples_per_pixel: samples?,
             max_depth: max_depth?,
             min_weight: min_weight?,
@@ -331,6 +357,36 @@ pub(super) mod tests {
                 "unknown colour convention `srgb` for `colours`; expected one of: linear, display",
             ]
         );
+    }
+
+    #[test]
+    fn samples_and_pixels_are_bounded_by_the_render_limits() {
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[render]\nwidth = 1\nheight = 1\nsamples = 4294967295\n"
+            )),
+            ["`samples` must be at most 65536, got 4294967295"]
+        );
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[render]\nwidth = 65535\nheight = 65535\n"
+            )),
+            ["the image 65535x65535 is too large: at most 268435456 pixels are allowed"]
+        );
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[render]\nsamples = 99999999999999999999\n"
+            )),
+            [
+                "invalid TOML: 99999999999999999999 is too large for an integer (TOML integers \
+                 are 64-bit, from -9223372036854775808 to 9223372036854775807)"
+            ]
+        );
+        assert!(!is_too_large_integer("9223372036854775807"));
+        assert!(is_too_large_integer("-9223372036854775809"));
+        assert!(!is_too_large_integer("1_000"));
+        let s = scene(&format!("{CAMERA}[render]\nsamples = 65536\n"));
+        assert_eq!(s.settings.samples_per_pixel, MAX_SAMPLES);
     }
 
     #[test]
