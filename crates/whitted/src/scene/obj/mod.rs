@@ -32,7 +32,7 @@ use self::reader::{NONE, ObjData, read_obj};
 use crate::math::{Aabb, Transform};
 use crate::render::Camera;
 use crate::render::{RenderSettings, Scene};
-use crate::scene::{Diagnostic, LoadedScene, SceneError, Severity};
+use crate::scene::{Diagnostic, LoadedScene, SceneError, Severity, without_bom};
 use crate::shading::Color;
 use crate::shading::Material;
 use crate::shading::texture::ImageCache;
@@ -48,6 +48,7 @@ pub const AMBIENT: f64 = 0.1;
 /// Reads an OBJ model from its text; `path` names it in messages and is
 /// where `mtllib` files are looked for (beside it).
 pub fn parse_obj(source: &str, path: &Path) -> Result<LoadedScene, SceneError> {
+    let source = without_bom(source);
     let mut data = read_obj(source, path);
     let mut diagnostics = std::mem::take(&mut data.diagnostics);
     let mut materials = HashMap::new();

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use super::maps::{Channel, MapSlot, MapStatement, read_map};
 use super::text::lines;
-use crate::scene::{Diagnostic, Severity, push_limited};
+use crate::scene::{Diagnostic, Severity, push_limited, without_bom};
 use crate::shading::Bump;
 use crate::shading::Color;
 use crate::shading::Material;
@@ -29,6 +29,7 @@ const NUMBERS: &[&str] = &["Ns", "Ni", "d", "Tr", "illum", "sharpness"];
 /// Reads the library text `source`, named `path` in messages; its texture
 /// maps are looked for beside it and decoded through `images`.
 pub(super) fn read_library(source: &str, path: &Path, images: &mut ImageCache) -> Library {
+    let source = without_bom(source);
     let mut diagnostics = check(source, path);
     if diagnostics.iter().any(is_error) {
         return Library {
