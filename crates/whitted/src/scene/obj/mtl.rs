@@ -93,6 +93,18 @@ fn check(source: &str, path: &Path) -> Vec<Diagnostic> {
             } else {
                 word.parse::<f64>().is_ok_and(f64::is_finite)
             };
+            if ok && COLORS.contains(&keyword) && word.parse::<f64>().is_ok_and(|v| v < 0.0) {
+                push_limited(&mut diagnostics, Severity::Error, || {
+                    Diagnostic::new(
+                        path,
+                        source,
+                        span,
+                        format!("the colour `{keyword}` must not be negative, got {word}"),
+                    )
+                });
+                found = wanted;
+                break;
+            }
             if !ok {
                 let what = if keyword == "illum" {
                     "an illumination model 0 to 10"
@@ -532,6 +544,23 @@ mod tests {
         let a = &lib.materials["a"];
         assert_eq!(a.opacity, Texture::Constant(Color::splat(0.75)));
         assert_eq!(a.bump, None);
+    }
+
+    #[test]
+    fn negative_colours_are_refused_at_their_place() {
+        let lib = read("newmtl a\nKa 0 0 0\nKd -1 -1 -1\nKs 0 -0.5 0\nKe 0 0 -2\nTf -0 0 -1e-9\n");
+        let text: Vec<String> = lib.diagnostics.iter().map(ToString::to_string).collect();
+        let firsts: Vec<&str> = text.iter().filter_map(|t| t.lines().next()).collect();
+        assert_eq!(
+            firsts,
+            [
+                "m.mtl:3:4: error: the colour `Kd` must not be negative, got -1",
+                "m.mtl:4:6: error: the colour `Ks` must not be negative, got -0.5",
+                "m.mtl:5:8: error: the colour `Ke` must not be negative, got -2",
+                "m.mtl:6:9: error: the colour `Tf` must not be negative, got -1e-9",
+            ]
+        );
+        assert!(lib.materials.is_empty());
     }
 
     #[test]
