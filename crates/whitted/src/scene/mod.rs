@@ -13,7 +13,7 @@ mod toml_format;
 pub use bom::{BYTE_ORDER_MARK, without_bom};
 pub use camera_override::CameraOverride;
 pub use diagnostic::{
-    Diagnostic, MAX_DIAGNOSTICS, MAX_SHOWN_CHARS, SceneError, Severity, push_limited,
+    Diagnostic, MAX_DIAGNOSTICS, MAX_SHOWN_CHARS, SceneError, Severity, limit_warnings, push_limited,
 };
 pub use nff::{load_nff, parse_nff};
 pub use obj::{load_obj, parse_obj};

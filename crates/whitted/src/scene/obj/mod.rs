@@ -32,7 +32,9 @@ use self::reader::{NONE, ObjData, read_obj};
 use crate::math::{Aabb, Transform};
 use crate::render::Camera;
 use crate::render::{RenderSettings, Scene};
-use crate::scene::{Diagnostic, LoadedScene, SceneError, Severity, without_bom};
+use crate::scene::{
+    Diagnostic, LoadedScene, SceneError, Severity, limit_warnings, push_limited, without_bom,
+};
 use crate::shading::Color;
 use crate::shading::Material;
 use crate::shading::texture::ImageCache;
@@ -89,7 +91,10 @@ pub fn parse_obj(source: &str, path: &Path) -> Result<LoadedScene, SceneError> {
         });
     }
     let scene = build_scene(&data, &materials, path, source, &mut warnings)?;
-    Ok(LoadedScene { scene, warnings })
+    Ok(LoadedScene {
+        scene,
+        warnings: limit_warnings(warnings),
+    })
 }
 
 /// Reads an OBJ file and the material libraries it names.
@@ -139,12 +144,14 @@ fn build_scene(
         } else {
             let (name, span) = &data.material_uses[slot as usize];
             materials.get(name).cloned().unwrap_or_else(|| {
-                warnings.push(Diagnostic::warning(
-                    path,
-                    source,
-                    span.clone(),
-                    format!("no material `{name}` in the material libraries; it is grey"),
-                ));
+                push_limited(warnings, Severity::Warning, || {
+                    Diagnostic::warning(
+                        path,
+                        source,
+                        span.clone(),
+                        format!("no material `{name}` in the material libraries; it is grey"),
+                    )
+                });
                 Material::default()
             })
         };

@@ -3,7 +3,7 @@
 //! with its material and smoothing group. Every problem is recorded with
 //! its place and reading carries on with the next line.
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::ops::Range;
 use std::path::Path;
 
@@ -62,6 +62,7 @@ pub(super) fn read_obj(source: &str, path: &Path) -> ObjData {
         material: NONE,
         smoothing: 0,
         warned: HashSet::new(),
+        material_slots: HashMap::new(),
     };
     for line in lines(source) {
         reader.statement(line);
@@ -77,6 +78,8 @@ struct Reader<'a> {
     smoothing: u32,
     /// Statements already warned about (warned once per file).
     warned: HashSet<String>,
+    /// The index in [`ObjData::material_uses`] of each name.
+    material_slots: HashMap<String, u32>,
 }
 
 /// A problem already recorded.
@@ -315,13 +318,14 @@ impl Reader<'_> {
             return Err(self.error(at, "expected a material name after `usemtl`"));
         }
         let uses = &mut self.data.material_uses;
-        self.material = match uses.iter().position(|(known, _)| known == name) {
-            Some(index) => index as u32,
-            None => {
+        let next = uses.len() as u32;
+        self.material = *self
+            .material_slots
+            .entry(name.to_string())
+            .or_insert_with(|| {
                 uses.push((name.to_string(), span));
-                (uses.len() - 1) as u32
-            }
-        };
+                next
+            });
         Ok(())
     }
 
