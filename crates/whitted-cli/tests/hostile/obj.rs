@@ -19,7 +19,10 @@ fn render(dir: &Path, scene: &str, quiet: bool) -> Probe {
 
 /// The first line of each warning `whitted` printed.
 fn warnings(stderr: &str) -> Vec<&str> {
-    stderr.lines().filter(|l| l.contains(": warning: ")).collect()
+    stderr
+        .lines()
+        .filter(|l| l.contains(": warning: "))
+        .collect()
 }
 
 /// Three vertices, then `faces`.
@@ -68,7 +71,11 @@ fn a_byte_order_mark_hides_no_vertex_and_no_entity() {
         format!("{bom}v 0 0 0\nv 1 0 0\nv 0 1 0\nmtllib a.mtl\nusemtl red\nf 1 2 3\n"),
     )
     .unwrap();
-    std::fs::write(dir.path().join("a.mtl"), format!("{bom}newmtl red\nKd 1 0 0\n")).unwrap();
+    std::fs::write(
+        dir.path().join("a.mtl"),
+        format!("{bom}newmtl red\nKd 1 0 0\n"),
+    )
+    .unwrap();
     // Before: "vertex index 3 is out of range: 2 vertices are defined".
     let p = render(dir.path(), "a.obj", false);
     assert_eq!(p.code(), Some(0), "{}", p.stderr);
@@ -95,7 +102,11 @@ fn a_negative_mtl_colour_is_refused_at_its_place() {
         triangle("mtllib a.mtl\nusemtl dark\nf 1 2 3\n"),
     )
     .unwrap();
-    std::fs::write(dir.path().join("a.mtl"), "newmtl dark\nKe 0 0 0\nKd -1 -1 -1\n").unwrap();
+    std::fs::write(
+        dir.path().join("a.mtl"),
+        "newmtl dark\nKe 0 0 0\nKd -1 -1 -1\n",
+    )
+    .unwrap();
     let p = render(dir.path(), "a.obj", true);
     assert_eq!(p.code(), Some(1), "{}", p.stderr);
     assert!(

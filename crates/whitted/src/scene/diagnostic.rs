@@ -153,7 +153,9 @@ fn too_many(severity: Severity) -> String {
         Severity::Error => "errors",
         Severity::Warning => "warnings",
     };
-    format!("too many {kind}: the first {MAX_DIAGNOSTICS} are reported, the rest from here on are not")
+    format!(
+        "too many {kind}: the first {MAX_DIAGNOSTICS} are reported, the rest from here on are not"
+    )
 }
 
 /// The warnings of a scene and its side files (an OBJ's material

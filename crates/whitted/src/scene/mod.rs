@@ -13,7 +13,8 @@ mod toml_format;
 pub use bom::{BYTE_ORDER_MARK, without_bom};
 pub use camera_override::CameraOverride;
 pub use diagnostic::{
-    Diagnostic, MAX_DIAGNOSTICS, MAX_SHOWN_CHARS, SceneError, Severity, limit_warnings, push_limited,
+    Diagnostic, MAX_DIAGNOSTICS, MAX_SHOWN_CHARS, SceneError, Severity, limit_warnings,
+    push_limited,
 };
 pub use nff::{load_nff, parse_nff};
 pub use obj::{load_obj, parse_obj};
@@ -151,12 +152,20 @@ mod tests {
             "a.nff",
             "b 0 0 1\nv from 0 0 5 at 0 0 0 up 0 1 0 angle 30 hither 1 resolution 4 2",
         );
-        assert_eq!(load_any(&nff).unwrap().background, Color::new(0.0, 0.0, 1.0));
+        assert_eq!(
+            load_any(&nff).unwrap().background,
+            Color::new(0.0, 0.0, 1.0)
+        );
         let toml = write("a.toml", DEFAULT_SCENE);
         assert_eq!(load_any(&toml).unwrap(), default_scene());
         // A message's column counts from after the mark.
         let error = parse_nff("\u{feff}x", Path::new("a.nff")).unwrap_err();
-        assert!(error.to_string().starts_with("a.nff:1:1: error: unknown entity `x`"), "{error}");
+        assert!(
+            error
+                .to_string()
+                .starts_with("a.nff:1:1: error: unknown entity `x`"),
+            "{error}"
+        );
     }
 
     #[test]
