@@ -16,6 +16,7 @@
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
+use super::file_names::file_path;
 use super::text::Line;
 use crate::math::DVec2;
 use crate::shading::texture::Wrap;
@@ -154,7 +155,7 @@ pub(super) fn read_map(line: Line<'_>, folder: &Path) -> Option<MapStatement> {
     let (_, first) = words.next()?;
     let name = line.text[first.start - line.start..].trim();
     statement.span = first.start..first.start + name.len();
-    statement.file = folder.join(name.replace('\\', "/"));
+    statement.file = folder.join(file_path(name));
     Some(statement)
 }
 

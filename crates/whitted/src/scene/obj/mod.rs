@@ -18,6 +18,7 @@
 //! and a light at the eye.
 
 mod build;
+mod file_names;
 mod maps;
 mod mtl;
 mod reader;
@@ -27,6 +28,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use self::build::build_meshes;
+use self::file_names::library_paths;
 use self::mtl::read_library;
 use self::reader::{NONE, ObjData, read_obj};
 use crate::math::{Aabb, Transform};
@@ -55,8 +57,12 @@ pub fn parse_obj(source: &str, path: &Path) -> Result<LoadedScene, SceneError> {
     let mut diagnostics = std::mem::take(&mut data.diagnostics);
     let mut materials = HashMap::new();
     let mut images = ImageCache::default();
-    for (name, span) in &data.libraries {
-        let file = path.parent().unwrap_or(Path::new("")).join(name);
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let libraries = data
+        .libraries
+        .iter()
+        .flat_map(|(names, span)| library_paths(names, span.clone(), folder));
+    for (file, span) in libraries {
         match std::fs::read_to_string(&file) {
             Ok(text) => {
                 let library = read_library(&text, &file, &mut images);
@@ -66,7 +72,7 @@ pub fn parse_obj(source: &str, path: &Path) -> Result<LoadedScene, SceneError> {
             Err(error) => diagnostics.push(Diagnostic::warning(
                 path,
                 source,
-                span.clone(),
+                span,
                 format!(
                     "cannot read the material library `{}` ({error}); its materials are grey",
                     file.display()

@@ -126,3 +126,30 @@ fn normals_and_texture_coordinates_that_do_not_exist_are_dropped_with_one_warnin
     // The same mesh as without the indices: computed normals, no (u, v).
     assert_eq!(loaded.scene.objects.meshes, without.objects.meshes);
 }
+
+#[test]
+fn every_library_of_an_mtllib_line_is_read_and_a_missing_one_is_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("a.mtl"), "newmtl red\nKd 1 0 0\n").unwrap();
+    std::fs::write(dir.path().join("my b.mtl"), "newmtl blue\nKd 0 0 1\n").unwrap();
+    let source = "mtllib a.mtl gone.mtl my\\ b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n\
+                  usemtl red\nf 1 2 3\nusemtl blue\nf 1 3 2\n";
+    let loaded = parse_obj(source, &dir.path().join("m.obj")).unwrap();
+    let text: Vec<String> = loaded.warnings.iter().map(ToString::to_string).collect();
+    assert_eq!(text.len(), 1, "{text:?}");
+    assert!(
+        text[0].contains("m.obj:1:14: warning: cannot read the material library `")
+            && text[0].contains("gone.mtl` ("),
+        "{}",
+        text[0]
+    );
+    let diffuse: Vec<&crate::shading::Texture> =
+        loaded.scene.materials.iter().map(|m| &m.diffuse).collect();
+    assert_eq!(
+        diffuse,
+        [
+            &Color::new(1.0, 0.0, 0.0).into(),
+            &Color::new(0.0, 0.0, 1.0).into()
+        ]
+    );
+}
