@@ -224,6 +224,20 @@ fn load_maps(
 ) -> Maps {
     let mut maps = Maps::default();
     for statement in statements {
+        for unknown in &statement.unknown_options {
+            let taken = match unknown.arguments.as_str() {
+                "" => String::new(),
+                words => format!(" with `{words}`"),
+            };
+            let message = format!(
+                "unknown texture map option `{}`; ignored{taken}, the file is `{}`",
+                unknown.name,
+                statement.file.display()
+            );
+            push_limited(diagnostics, Severity::Warning, || {
+                Diagnostic::warning(path, source, unknown.span.clone(), message)
+            });
+        }
         let data = match images.load(&statement.file, decoding(statement)) {
             Ok(data) => data,
             Err(error) => {
@@ -561,6 +575,19 @@ mod tests {
             ]
         );
         assert!(lib.materials.is_empty());
+    }
+
+    #[test]
+    fn an_unknown_map_option_is_warned_about_by_name() {
+        let lib = read("newmtl a\nmap_Kd -colorspace sRGB -halo 3 -o 0.1 diffuse.jpg\n");
+        let text: Vec<&str> = lib.diagnostics.iter().map(|d| d.message.as_str()).collect();
+        assert_eq!(text.len(), 2, "{text:?}");
+        assert_eq!(
+            text[0],
+            "unknown texture map option `-halo`; ignored with `3`, the file is `diffuse.jpg`"
+        );
+        assert!(text[1].starts_with("cannot read the image `diffuse.jpg`"));
+        assert_eq!(lib.diagnostics[0].column, 25);
     }
 
     #[test]
