@@ -117,3 +117,55 @@ fn a_negative_mtl_colour_is_refused_at_its_place() {
     );
     assert!(!dir.path().join("out.png").exists());
 }
+
+#[test]
+fn an_exporters_model_loads_with_located_warnings() {
+    let dir = tempfile::tempdir().unwrap();
+    // Several libraries on one line, one of them missing, one with an
+    // escaped space; normals commented out but still named by the faces.
+    std::fs::write(
+        dir.path().join("a.obj"),
+        "mtllib a.mtl gone.mtl my\\ b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n# vn 0 0 1\n\
+         usemtl red\nf 1//1 2//1 3//1\nusemtl blue\nf 1//1 3//1 2//1\n",
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("a.mtl"), "newmtl red\nKd 1 0 0\n").unwrap();
+    std::fs::write(
+        dir.path().join("my b.mtl"),
+        "newmtl blue\nKd 0 0 1\nmap_Kd -colorspace sRGB -halo 2 -o 0.1 texture 01.png\n",
+    )
+    .unwrap();
+    // Before: every material lost ("cannot read the material library
+    // `a.mtl gone.mtl my\ b.mtl`"), then "normal index 1 is out of range"
+    // refused the file.
+    let p = render(dir.path(), "a.obj", false);
+    assert_eq!(p.code(), Some(0), "{}", p.stderr);
+    let shown = warnings(&p.stderr);
+    assert_eq!(shown.len(), 4, "{}", p.stderr);
+    assert!(
+        shown[0].starts_with("a.obj:1:14: warning: cannot read the material library `")
+            && shown[0].ends_with(
+                "gone.mtl` (No such file or directory (os error 2)); its materials are grey"
+            ),
+        "{}",
+        shown[0]
+    );
+    assert!(
+        shown[1].starts_with(
+            "a.obj:7:6: warning: normal index 1 is out of range: 0 normals are defined before this line"
+        ),
+        "{}",
+        shown[1]
+    );
+    assert_eq!(
+        shown[2],
+        "my b.mtl:3:25: warning: unknown texture map option `-halo`; ignored with `2`, \
+         the file is `texture 01.png`"
+    );
+    assert!(
+        shown[3].starts_with("my b.mtl:3:40: warning: cannot read the image `texture 01.png`"),
+        "{}",
+        shown[3]
+    );
+    assert!(dir.path().join("out.png").is_file());
+}
