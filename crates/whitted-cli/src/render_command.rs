@@ -205,10 +205,10 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         Some(path) => {
             let start = Instant::now();
             let loaded = load_any_with(path, &options).map_err(|e| e.to_string())?;
-            for warning in &loaded.warnings {
-                note!("{warning}\n");
-            }
             if !args.quiet {
+                for warning in &loaded.warnings {
+                    note!("{warning}\n");
+                }
                 note!(
                     "{}: read in {:.3} s, {} primitives",
                     path.display(),

@@ -5,5 +5,6 @@
 
 mod args;
 mod limits;
+mod obj;
 mod outputs;
 mod support;

@@ -15,7 +15,7 @@ use crate::math::{Aabb, Transform, Vec3};
 use crate::mesh::{MeshError, TriangleMesh};
 use crate::render::Camera;
 use crate::render::Scene;
-use crate::scene::{Diagnostic, SceneError, Severity, push_limited};
+use crate::scene::{Diagnostic, SceneError, Severity, push_limited, without_bom};
 use crate::shading::Material;
 
 /// Positions and triangles as they appear in the file.
@@ -58,6 +58,7 @@ pub fn load_obj_positions(path: &Path) -> Result<TriangleSoup, SceneError> {
 /// Parses OBJ text; `path` is only used in messages. Every malformed line is
 /// reported.
 pub fn parse_obj_positions(source: &str, path: &Path) -> Result<TriangleSoup, SceneError> {
+    let source = without_bom(source);
     let mut soup = TriangleSoup::default();
     let mut diagnostics = Vec::new();
     let mut face: Vec<u32> = Vec::new();
@@ -171,6 +172,13 @@ mod tests {
 
     fn parse(text: &str) -> Result<TriangleSoup, String> {
         parse_obj_positions(text, Path::new("m.obj")).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn a_byte_order_mark_does_not_hide_the_first_vertex() {
+        let soup = parse("\u{feff}v 0 0 1\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        assert_eq!(soup.positions.len(), 3);
+        assert_eq!(soup.positions[0], Vec3::new(0.0, 0.0, 1.0));
     }
 
     #[test]

@@ -12,6 +12,7 @@
 //! Nothing here depends on the file format: any reader that knows the byte
 //! range of a problem can build a [`Diagnostic`].
 
+use std::collections::HashMap;
 use std::fmt;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -141,15 +142,65 @@ pub fn push_limited(
     }
     let mut diagnostic = make();
     if count == MAX_DIAGNOSTICS {
-        let kind = match severity {
-            Severity::Error => "errors",
-            Severity::Warning => "warnings",
-        };
-        diagnostic.message = format!(
-            "too many {kind}: the first {MAX_DIAGNOSTICS} are reported, the rest from here on are not"
-        );
+        diagnostic.message = too_many(severity);
     }
     list.push(diagnostic);
+}
+
+/// The message of the diagnostic past [`MAX_DIAGNOSTICS`] of a severity.
+fn too_many(severity: Severity) -> String {
+    let kind = match severity {
+        Severity::Error => "errors",
+        Severity::Warning => "warnings",
+    };
+    format!(
+        "too many {kind}: the first {MAX_DIAGNOSTICS} are reported, the rest from here on are not"
+    )
+}
+
+/// The warnings of a scene and its side files (an OBJ's material
+/// libraries), as they are to be reported: each message once per file, at
+/// its first place, saying how many more places have it; at most
+/// [`MAX_DIAGNOSTICS`] of them, then one saying that reporting stopped. A
+/// list one reader already cut with [`push_limited`] stays cut where it
+/// was.
+pub fn limit_warnings(warnings: Vec<Diagnostic>) -> Vec<Diagnostic> {
+    let stop = too_many(Severity::Warning);
+    let mut first_place: HashMap<(PathBuf, String), usize> = HashMap::new();
+    let mut kept: Vec<(Diagnostic, usize)> = Vec::new();
+    let mut cut: Option<Diagnostic> = None;
+    for warning in warnings {
+        if warning.message == stop {
+            cut.get_or_insert(warning);
+            continue;
+        }
+        let key = (warning.path.clone(), warning.message.clone());
+        match first_place.get(&key) {
+            Some(&index) => kept[index].1 += 1,
+            None => {
+                first_place.insert(key, kept.len());
+                kept.push((warning, 0));
+            }
+        }
+    }
+    if kept.len() > MAX_DIAGNOSTICS {
+        let (mut first_cut, _) = kept.swap_remove(MAX_DIAGNOSTICS);
+        kept.truncate(MAX_DIAGNOSTICS);
+        first_cut.message = stop;
+        cut.get_or_insert(first_cut);
+    }
+    let mut limited: Vec<Diagnostic> = kept
+        .into_iter()
+        .map(|(mut warning, more)| {
+            if more > 0 {
+                let places = if more == 1 { "place" } else { "places" };
+                warning.message = format!("{} (and at {more} more {places})", warning.message);
+            }
+            warning
+        })
+        .collect();
+    limited.extend(cut);
+    limited
 }
 
 /// The part of `line` shown for a problem at `column`, and the column it
@@ -360,6 +411,52 @@ mod tests {
             "too many errors: the first 100 are reported, the rest from here on are not"
         );
         assert_eq!(list[MAX_DIAGNOSTICS + 1].message, "still reported");
+    }
+
+    #[test]
+    fn warnings_are_reported_once_per_message_and_at_most_the_limit() {
+        let source = "x ".repeat(1000);
+        let warn = |i: usize, message: &str| {
+            Diagnostic::warning(Path::new("a.obj"), &source, 2 * i..2 * i + 1, message)
+        };
+        let repeated = limit_warnings(vec![
+            warn(0, "same"),
+            warn(1, "other"),
+            warn(2, "same"),
+            warn(3, "same"),
+            warn(4, "other"),
+            warn(5, "alone"),
+        ]);
+        let shown: Vec<(usize, &str)> = repeated
+            .iter()
+            .map(|d| (d.column, d.message.as_str()))
+            .collect();
+        assert_eq!(
+            shown,
+            [
+                (1, "same (and at 2 more places)"),
+                (3, "other (and at 1 more place)"),
+                (11, "alone")
+            ]
+        );
+        let many = limit_warnings((0..500).map(|i| warn(i, &format!("w{i}"))).collect());
+        assert_eq!(many.len(), MAX_DIAGNOSTICS + 1);
+        assert_eq!(many[MAX_DIAGNOSTICS - 1].message, "w99");
+        assert_eq!(many[MAX_DIAGNOSTICS].message, too_many(Severity::Warning));
+        assert_eq!(many[MAX_DIAGNOSTICS].column, 2 * MAX_DIAGNOSTICS + 1);
+        // A list a reader cut keeps its cut, once, after what it reported.
+        let mut cut = Vec::new();
+        for i in 0..300 {
+            push_limited(&mut cut, Severity::Warning, || warn(i, &format!("w{i}")));
+        }
+        cut.push(warn(400, "from another file"));
+        cut.push(warn(401, &too_many(Severity::Warning)));
+        let limited = limit_warnings(cut);
+        assert_eq!(limited.len(), MAX_DIAGNOSTICS + 1);
+        assert_eq!(limited[MAX_DIAGNOSTICS].column, 2 * MAX_DIAGNOSTICS + 1);
+        let few = limit_warnings(vec![warn(0, "a"), warn(1, &too_many(Severity::Warning))]);
+        assert_eq!(few.len(), 2);
+        assert_eq!(few[1].message, too_many(Severity::Warning));
     }
 
     #[test]

@@ -3,6 +3,7 @@
 //! [`load_any`] picks the reader by the file's extension; every error names
 //! `path:line:column`.
 
+mod bom;
 mod camera_override;
 mod diagnostic;
 mod nff;
@@ -10,9 +11,11 @@ pub mod obj;
 mod toml_format;
 mod whole_number;
 
+pub use bom::{BYTE_ORDER_MARK, without_bom};
 pub use camera_override::CameraOverride;
 pub use diagnostic::{
-    Diagnostic, MAX_DIAGNOSTICS, MAX_SHOWN_CHARS, SceneError, Severity, push_limited,
+    Diagnostic, MAX_DIAGNOSTICS, MAX_SHOWN_CHARS, SceneError, Severity, limit_warnings,
+    push_limited,
 };
 pub use nff::{load_nff, parse_nff};
 pub use obj::{load_obj, parse_obj};
@@ -102,6 +105,8 @@ pub fn default_scene() -> Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::Vec3;
+    use crate::shading::Color;
 
     #[test]
     fn load_any_reads_by_extension_and_refuses_others() {
@@ -123,6 +128,46 @@ mod tests {
             "cannot read `mesh.ply`: unknown scene format; expected a file ending in .toml, .nff or .obj"
         );
         assert!(load_any(Path::new("no_extension")).is_err());
+    }
+
+    #[test]
+    fn every_reader_reads_a_file_that_starts_with_a_byte_order_mark() {
+        let folder = tempfile::tempdir().unwrap();
+        let write = |name: &str, text: &str| {
+            let path = folder.path().join(name);
+            std::fs::write(&path, format!("{BYTE_ORDER_MARK}{text}")).unwrap();
+            path
+        };
+        write("red.mtl", "newmtl red\nKd 1 0 0\n");
+        let obj = write(
+            "tri.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nmtllib red.mtl\nusemtl red\nf 1 2 3\n",
+        );
+        let loaded = load_any_with(&obj, &LoadOptions::default()).unwrap();
+        assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+        assert_eq!(loaded.scene.objects.meshes[0].positions()[0], Vec3::ZERO);
+        assert_eq!(
+            loaded.scene.materials[0].diffuse,
+            Color::new(1.0, 0.0, 0.0).into()
+        );
+        let nff = write(
+            "a.nff",
+            "b 0 0 1\nv from 0 0 5 at 0 0 0 up 0 1 0 angle 30 hither 1 resolution 4 2",
+        );
+        assert_eq!(
+            load_any(&nff).unwrap().background,
+            Color::new(0.0, 0.0, 1.0)
+        );
+        let toml = write("a.toml", DEFAULT_SCENE);
+        assert_eq!(load_any(&toml).unwrap(), default_scene());
+        // A message's column counts from after the mark.
+        let error = parse_nff("\u{feff}x", Path::new("a.nff")).unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .starts_with("a.nff:1:1: error: unknown entity `x`"),
+            "{error}"
+        );
     }
 
     #[test]

@@ -48,7 +48,7 @@ use self::view::{View, read_view};
 use crate::image::ColorSpace;
 use crate::math::{Transform, Vec3};
 use crate::render::{RenderSettings, Scene};
-use crate::scene::SceneError;
+use crate::scene::{SceneError, without_bom};
 use crate::shading::Color;
 use crate::shading::Material;
 use crate::shading::{Attenuation, Light};
@@ -57,6 +57,7 @@ use crate::world::MaterialId;
 /// Reads a scene from the text of an NFF file; `path` is only used in
 /// messages.
 pub fn parse_nff(source: &str, path: &Path) -> Result<Scene, SceneError> {
+    let source = without_bom(source);
     let mut r = Reader::new(source, path);
     let mut document = Document::default();
     while let Some(token) = r.next_token() {

@@ -86,16 +86,14 @@ impl MeshBuilder {
 /// into [`ObjData::material_uses`], or [`NONE`]) and its mesh.
 pub(super) fn build_meshes(data: &ObjData) -> Result<Vec<(u32, TriangleMesh)>, MeshError> {
     let mut builders: Vec<(u32, MeshBuilder)> = Vec::new();
+    let mut builder_of_slot: HashMap<u32, usize> = HashMap::new();
     let mut points = Vec::new();
     for (face_index, face) in data.faces.iter().enumerate() {
         let corners = &data.corners[face.first as usize..(face.first + face.count) as usize];
-        let slot = match builders.iter().position(|(slot, _)| *slot == face.material) {
-            Some(i) => i,
-            None => {
-                builders.push((face.material, MeshBuilder::default()));
-                builders.len() - 1
-            }
-        };
+        let slot = *builder_of_slot.entry(face.material).or_insert_with(|| {
+            builders.push((face.material, MeshBuilder::default()));
+            builders.len() - 1
+        });
         let builder = &mut builders[slot].1;
         let smoothing = if data.smoothing_given {
             face.smoothing

@@ -2,7 +2,9 @@
 //! dissolve map `map_d`, bump maps (`bump`, `map_bump`, in any
 //! capitalisation) and normal maps (`norm`, `map_Kn`, `map_norm`), with
 //! their `-s`, `-o`, `-clamp`, `-bm` and `-imfchan` options, are applied;
-//! other options are read and ignored.
+//! the other options of the specification and the common extensions
+//! (`-colorspace`, `-texres`, `-type`) are read and ignored, and an unknown
+//! option is ignored with the words up to the file name (see [`read_map`]).
 //!
 //! ```text
 //! map_Kd -s 2 2 -o 0.5 0 -clamp on textures\wood grain.png
@@ -10,12 +12,13 @@
 //! ```
 //!
 //! The file name is the rest of the line after the options (spaces
-//! allowed); backslashes are read as folder separators and the path is
-//! relative to the MTL file.
+//! allowed); `\ ` is an escaped space, other backslashes are read as folder
+//! separators and the path is relative to the MTL file.
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
+use super::file_names::file_path;
 use super::text::Line;
 use crate::math::DVec2;
 use crate::shading::texture::Wrap;
@@ -97,27 +100,70 @@ pub(super) struct MapStatement {
     pub(super) bump_multiplier: f64,
     /// `-imfchan c`.
     pub(super) channel: Channel,
+    /// Options we do not know, ignored (and warned about).
+    pub(super) unknown_options: Vec<UnknownOption>,
 }
 
 /// Options and how many words follow each (at most; `-s`, `-o` and `-t`
-/// take one to three numbers).
+/// take one to three numbers, `-mm` two). Besides the specification's, the
+/// common extensions `-colorspace`, `-texres`, `-imfchan` and `-type`.
 fn arguments(option: &str) -> Option<usize> {
     match option {
         "-s" | "-o" | "-t" => Some(3),
-        "-clamp" | "-blendu" | "-blendv" | "-cc" | "-bm" | "-boost" | "-texres" | "-imfchan" => {
-            Some(1)
-        }
+        "-clamp" | "-blendu" | "-blendv" | "-cc" | "-bm" | "-boost" | "-texres" | "-imfchan"
+        | "-colorspace" | "-type" => Some(1),
         "-mm" => Some(2),
         _ => None,
+    }
+}
+
+/// True for a word that is an option we do not know: a `-` and a name, not
+/// a negative number.
+fn is_unknown_option(word: &str) -> bool {
+    word.len() > 1 && word.starts_with('-') && word.parse::<f64>().is_err()
+}
+
+/// An option of a map statement that we do not know, ignored.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct UnknownOption {
+    /// The option, as written (`-foo`).
+    pub(super) name: String,
+    /// Where it is, for the warning.
+    pub(super) span: Range<usize>,
+    /// The words taken as its arguments, between spaces.
+    pub(super) arguments: String,
+}
+
+impl MapStatement {
+    /// Applies a known option `option` with the words after it.
+    fn apply(&mut self, option: &str, values: &[&str]) {
+        let numbers: Vec<f64> = values.iter().filter_map(|w| w.parse().ok()).collect();
+        match (option, numbers.as_slice(), values.first()) {
+            ("-s", &[u], _) => self.scale = DVec2::splat(u),
+            ("-s", &[u, v, ..], _) => self.scale = DVec2::new(u, v),
+            ("-o", &[u], _) => self.offset = DVec2::new(u, 0.0),
+            ("-o", &[u, v, ..], _) => self.offset = DVec2::new(u, v),
+            ("-clamp", _, Some(&"on")) => self.wrap = Wrap::Clamp,
+            ("-clamp", _, Some(&"off")) => self.wrap = Wrap::Repeat,
+            ("-bm", &[m], _) => self.bump_multiplier = m,
+            ("-imfchan", _, Some(&"m")) => self.channel = Channel::Matte,
+            ("-imfchan", _, Some(_)) => self.channel = Channel::Luminance,
+            _ => {}
+        }
     }
 }
 
 /// Reads a map line of an MTL file in folder `folder` (one whose keyword
 /// [`MapSlot::of`] knows); `None` for other lines or a map without a file
 /// name.
+///
+/// An option we do not know takes the words up to the next option we know;
+/// when none follows, the file is the longest end of the line that names
+/// an existing file, or else the last word, and the words between are the
+/// unknown option's.
 pub(super) fn read_map(line: Line<'_>, folder: &Path) -> Option<MapStatement> {
-    let mut words = line.words().peekable();
-    let slot = MapSlot::of(words.next()?.0)?;
+    let words: Vec<(&str, Range<usize>)> = line.words().collect();
+    let slot = MapSlot::of(words.first()?.0)?;
     let mut statement = MapStatement {
         slot,
         file: PathBuf::new(),
@@ -127,34 +173,47 @@ pub(super) fn read_map(line: Line<'_>, folder: &Path) -> Option<MapStatement> {
         offset: DVec2::ZERO,
         bump_multiplier: 1.0,
         channel: Channel::Default,
+        unknown_options: Vec::new(),
     };
-    while let Some((option, _)) = words.next_if(|(word, _)| arguments(word).is_some()) {
-        let count = arguments(option).unwrap_or(0);
-        let mut values = Vec::new();
-        // A one-word option takes its word; number lists take numbers only.
-        while let Some((word, _)) = words.next_if(|(word, _)| {
-            values.len() < count && (count == 1 || word.parse::<f64>().is_ok())
-        }) {
-            values.push(word);
-        }
-        let numbers: Vec<f64> = values.iter().filter_map(|w| w.parse().ok()).collect();
-        match (option, numbers.as_slice(), values.first()) {
-            ("-s", &[u], _) => statement.scale = DVec2::splat(u),
-            ("-s", &[u, v, ..], _) => statement.scale = DVec2::new(u, v),
-            ("-o", &[u], _) => statement.offset = DVec2::new(u, 0.0),
-            ("-o", &[u, v, ..], _) => statement.offset = DVec2::new(u, v),
-            ("-clamp", _, Some(&"on")) => statement.wrap = Wrap::Clamp,
-            ("-clamp", _, Some(&"off")) => statement.wrap = Wrap::Repeat,
-            ("-bm", &[m], _) => statement.bump_multiplier = m,
-            ("-imfchan", _, Some(&"m")) => statement.channel = Channel::Matte,
-            ("-imfchan", _, Some(_)) => statement.channel = Channel::Luminance,
-            _ => {}
+    // The rest of the line from word `i`: a file name may hold spaces.
+    let tail = |i: usize| line.text[words[i].1.start - line.start..].trim();
+    let mut at = 1;
+    while let Some((option, span)) = words.get(at) {
+        at += 1;
+        if let Some(count) = arguments(option) {
+            // A one-word option takes its word; number lists take numbers only.
+            let mut values = Vec::new();
+            while let Some((word, _)) = words.get(at).filter(|(word, _)| {
+                values.len() < count && (count == 1 || word.parse::<f64>().is_ok())
+            }) {
+                values.push(*word);
+                at += 1;
+            }
+            statement.apply(option, &values);
+        } else if is_unknown_option(option) {
+            let rest = &words[at..];
+            let taken = match rest.iter().position(|(word, _)| arguments(word).is_some()) {
+                Some(next_option) => next_option,
+                None => (at..words.len())
+                    .position(|i| folder.join(file_path(tail(i))).is_file())
+                    .unwrap_or(rest.len().saturating_sub(1)),
+            };
+            let arguments: Vec<&str> = rest[..taken].iter().map(|(word, _)| *word).collect();
+            statement.unknown_options.push(UnknownOption {
+                name: (*option).to_string(),
+                span: span.clone(),
+                arguments: arguments.join(" "),
+            });
+            at += taken;
+        } else {
+            at -= 1;
+            break;
         }
     }
-    let (_, first) = words.next()?;
-    let name = line.text[first.start - line.start..].trim();
+    let (_, first) = words.get(at)?;
+    let name = tail(at);
     statement.span = first.start..first.start + name.len();
-    statement.file = folder.join(name.replace('\\', "/"));
+    statement.file = folder.join(file_path(name));
     Some(statement)
 }
 
@@ -205,6 +264,47 @@ mod tests {
         );
         assert_eq!(map("map_d a.png").unwrap().channel, Channel::Default);
         assert!(map("disp d.png").is_none() && map("map_Ns n.png").is_none());
+    }
+
+    #[test]
+    fn common_extensions_are_read_and_unknown_options_never_become_the_file() {
+        let m = map("map_Kd -colorspace sRGB -o 0.1 -texres 512 -type sphere diffuse.jpg").unwrap();
+        assert_eq!(m.file, Path::new("models/diffuse.jpg"));
+        assert_eq!(m.offset, DVec2::new(0.1, 0.0));
+        assert!(m.unknown_options.is_empty());
+        // An unknown option takes the words up to the next known one...
+        let m = map("map_Kd -foo 1 2 -s 2 texture 01.png").unwrap();
+        assert_eq!(m.file, Path::new("models/texture 01.png"));
+        assert_eq!(m.scale, DVec2::splat(2.0));
+        assert_eq!(
+            m.unknown_options,
+            [UnknownOption {
+                name: "-foo".into(),
+                span: 7..11,
+                arguments: "1 2".into()
+            }]
+        );
+        // ... or, last, all but the file: the last word unless a longer end
+        // of the line names an existing file.
+        let m = map("map_Kd -bar on texture 01.png").unwrap();
+        assert_eq!(m.file, Path::new("models/01.png"));
+        assert_eq!(m.unknown_options[0].arguments, "on texture");
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("texture 01.png"), "").unwrap();
+        let line = lines("map_Kd -bar on texture 01.png").next().unwrap();
+        let m = read_map(line, dir.path()).unwrap();
+        assert_eq!(m.file, dir.path().join("texture 01.png"));
+        assert_eq!(m.unknown_options[0].arguments, "on");
+        let m = map("map_Kd -flip a.png").unwrap();
+        assert_eq!(
+            (m.file.as_path(), m.unknown_options[0].arguments.as_str()),
+            (Path::new("models/a.png"), "")
+        );
+        assert!(map("map_Kd -flip").is_none());
+        // A negative number is an argument, not an option.
+        let m = map("map_Kd -o -0.5 -0.25 a\\ b.png").unwrap();
+        assert_eq!(m.offset, DVec2::new(-0.5, -0.25));
+        assert_eq!(m.file, Path::new("models/a b.png"));
     }
 
     #[test]

@@ -18,6 +18,7 @@
 //! and a light at the eye.
 
 mod build;
+mod file_names;
 mod maps;
 mod mtl;
 mod reader;
@@ -27,12 +28,15 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use self::build::build_meshes;
+use self::file_names::library_paths;
 use self::mtl::read_library;
 use self::reader::{NONE, ObjData, read_obj};
 use crate::math::{Aabb, Transform};
 use crate::render::Camera;
 use crate::render::{RenderSettings, Scene};
-use crate::scene::{Diagnostic, LoadedScene, SceneError, Severity};
+use crate::scene::{
+    Diagnostic, LoadedScene, SceneError, Severity, limit_warnings, push_limited, without_bom,
+};
 use crate::shading::Color;
 use crate::shading::Material;
 use crate::shading::texture::ImageCache;
@@ -48,12 +52,17 @@ pub const AMBIENT: f64 = 0.1;
 /// Reads an OBJ model from its text; `path` names it in messages and is
 /// where `mtllib` files are looked for (beside it).
 pub fn parse_obj(source: &str, path: &Path) -> Result<LoadedScene, SceneError> {
+    let source = without_bom(source);
     let mut data = read_obj(source, path);
     let mut diagnostics = std::mem::take(&mut data.diagnostics);
     let mut materials = HashMap::new();
     let mut images = ImageCache::default();
-    for (name, span) in &data.libraries {
-        let file = path.parent().unwrap_or(Path::new("")).join(name);
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let libraries = data
+        .libraries
+        .iter()
+        .flat_map(|(names, span)| library_paths(names, span.clone(), folder));
+    for (file, span) in libraries {
         match crate::limits::read_input_text(&file) {
             Ok(text) => {
                 let library = read_library(&text, &file, &mut images);
@@ -63,7 +72,7 @@ pub fn parse_obj(source: &str, path: &Path) -> Result<LoadedScene, SceneError> {
             Err(error) => diagnostics.push(Diagnostic::warning(
                 path,
                 source,
-                span.clone(),
+                span,
                 format!(
                     "cannot read the material library `{}` ({error}); its materials are grey",
                     file.display()
@@ -88,7 +97,10 @@ pub fn parse_obj(source: &str, path: &Path) -> Result<LoadedScene, SceneError> {
         });
     }
     let scene = build_scene(&data, &materials, path, source, &mut warnings)?;
-    Ok(LoadedScene { scene, warnings })
+    Ok(LoadedScene {
+        scene,
+        warnings: limit_warnings(warnings),
+    })
 }
 
 /// Reads an OBJ file and the material libraries it names.
@@ -138,12 +150,14 @@ fn build_scene(
         } else {
             let (name, span) = &data.material_uses[slot as usize];
             materials.get(name).cloned().unwrap_or_else(|| {
-                warnings.push(Diagnostic::warning(
-                    path,
-                    source,
-                    span.clone(),
-                    format!("no material `{name}` in the material libraries; it is grey"),
-                ));
+                push_limited(warnings, Severity::Warning, || {
+                    Diagnostic::warning(
+                        path,
+                        source,
+                        span.clone(),
+                        format!("no material `{name}` in the material libraries; it is grey"),
+                    )
+                });
                 Material::default()
             })
         };

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use super::maps::{Channel, MapSlot, MapStatement, read_map};
 use super::text::lines;
-use crate::scene::{Diagnostic, Severity, push_limited};
+use crate::scene::{Diagnostic, Severity, push_limited, without_bom};
 use crate::shading::Bump;
 use crate::shading::Color;
 use crate::shading::Material;
@@ -29,6 +29,7 @@ const NUMBERS: &[&str] = &["Ns", "Ni", "d", "Tr", "illum", "sharpness"];
 /// Reads the library text `source`, named `path` in messages; its texture
 /// maps are looked for beside it and decoded through `images`.
 pub(super) fn read_library(source: &str, path: &Path, images: &mut ImageCache) -> Library {
+    let source = without_bom(source);
     let mut diagnostics = check(source, path);
     if diagnostics.iter().any(is_error) {
         return Library {
@@ -92,6 +93,18 @@ fn check(source: &str, path: &Path) -> Vec<Diagnostic> {
             } else {
                 word.parse::<f64>().is_ok_and(f64::is_finite)
             };
+            if ok && COLORS.contains(&keyword) && word.parse::<f64>().is_ok_and(|v| v < 0.0) {
+                push_limited(&mut diagnostics, Severity::Error, || {
+                    Diagnostic::new(
+                        path,
+                        source,
+                        span,
+                        format!("the colour `{keyword}` must not be negative, got {word}"),
+                    )
+                });
+                found = wanted;
+                break;
+            }
             if !ok {
                 let what = if keyword == "illum" {
                     "an illumination model 0 to 10"
@@ -211,6 +224,20 @@ fn load_maps(
 ) -> Maps {
     let mut maps = Maps::default();
     for statement in statements {
+        for unknown in &statement.unknown_options {
+            let taken = match unknown.arguments.as_str() {
+                "" => String::new(),
+                words => format!(" with `{words}`"),
+            };
+            let message = format!(
+                "unknown texture map option `{}`; ignored{taken}, the file is `{}`",
+                unknown.name,
+                statement.file.display()
+            );
+            push_limited(diagnostics, Severity::Warning, || {
+                Diagnostic::warning(path, source, unknown.span.clone(), message)
+            });
+        }
         let data = match images.load(&statement.file, decoding(statement)) {
             Ok(data) => data,
             Err(error) => {
@@ -531,6 +558,36 @@ mod tests {
         let a = &lib.materials["a"];
         assert_eq!(a.opacity, Texture::Constant(Color::splat(0.75)));
         assert_eq!(a.bump, None);
+    }
+
+    #[test]
+    fn negative_colours_are_refused_at_their_place() {
+        let lib = read("newmtl a\nKa 0 0 0\nKd -1 -1 -1\nKs 0 -0.5 0\nKe 0 0 -2\nTf -0 0 -1e-9\n");
+        let text: Vec<String> = lib.diagnostics.iter().map(ToString::to_string).collect();
+        let firsts: Vec<&str> = text.iter().filter_map(|t| t.lines().next()).collect();
+        assert_eq!(
+            firsts,
+            [
+                "m.mtl:3:4: error: the colour `Kd` must not be negative, got -1",
+                "m.mtl:4:6: error: the colour `Ks` must not be negative, got -0.5",
+                "m.mtl:5:8: error: the colour `Ke` must not be negative, got -2",
+                "m.mtl:6:9: error: the colour `Tf` must not be negative, got -1e-9",
+            ]
+        );
+        assert!(lib.materials.is_empty());
+    }
+
+    #[test]
+    fn an_unknown_map_option_is_warned_about_by_name() {
+        let lib = read("newmtl a\nmap_Kd -colorspace sRGB -halo 3 -o 0.1 diffuse.jpg\n");
+        let text: Vec<&str> = lib.diagnostics.iter().map(|d| d.message.as_str()).collect();
+        assert_eq!(text.len(), 2, "{text:?}");
+        assert_eq!(
+            text[0],
+            "unknown texture map option `-halo`; ignored with `3`, the file is `diffuse.jpg`"
+        );
+        assert!(text[1].starts_with("cannot read the image `diffuse.jpg`"));
+        assert_eq!(lib.diagnostics[0].column, 25);
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //! with its material and smoothing group. Every problem is recorded with
 //! its place and reading carries on with the next line.
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::ops::Range;
 use std::path::Path;
 
@@ -62,6 +62,7 @@ pub(super) fn read_obj(source: &str, path: &Path) -> ObjData {
         material: NONE,
         smoothing: 0,
         warned: HashSet::new(),
+        material_slots: HashMap::new(),
     };
     for line in lines(source) {
         reader.statement(line);
@@ -77,6 +78,8 @@ struct Reader<'a> {
     smoothing: u32,
     /// Statements already warned about (warned once per file).
     warned: HashSet<String>,
+    /// The index in [`ObjData::material_uses`] of each name.
+    material_slots: HashMap<String, u32>,
 }
 
 /// A problem already recorded.
@@ -180,8 +183,9 @@ impl Reader<'_> {
     fn face(&mut self, words: Words<'_>, at: Range<usize>) -> Result<(), Reported> {
         let first = self.data.corners.len();
         let mut failed = false;
+        let mut missing = [None, None];
         for (word, span) in words {
-            match self.corner(word, span.start) {
+            match self.corner(word, span.start, &mut missing) {
                 Ok(corner) => self.data.corners.push(corner),
                 Err(Reported) => failed = true,
             }
@@ -191,6 +195,7 @@ impl Reader<'_> {
             self.data.corners.truncate(first);
             return Err(Reported);
         }
+        self.drop_missing(first, missing);
         if count < 3 {
             self.data.corners.truncate(first);
             return Err(self.error(
@@ -207,8 +212,42 @@ impl Reader<'_> {
         Ok(())
     }
 
+    /// Drops the texture coordinates or the normals of the face whose
+    /// corners start at `first` when one of its corners refers to some that
+    /// do not exist (`missing`: where, and what was said, for texture
+    /// coordinates and normals): the face is read as one without them
+    /// (as other readers do), with a warning once per file.
+    fn drop_missing(&mut self, first: usize, missing: [Option<(Range<usize>, String)>; 2]) {
+        let [uv, normal] = missing;
+        if let Some((span, what)) = uv {
+            for corner in &mut self.data.corners[first..] {
+                corner.uv = NONE;
+            }
+            let message = format!(
+                "{what}; faces that refer to texture coordinates that do not exist are read without texture coordinates (warned once per file)"
+            );
+            self.warn_once("missing vt", span, message);
+        }
+        if let Some((span, what)) = normal {
+            for corner in &mut self.data.corners[first..] {
+                corner.normal = NONE;
+            }
+            let message = format!(
+                "{what}; faces that refer to normals that do not exist get normals computed as for a face without any (warned once per file)"
+            );
+            self.warn_once("missing vn", span, message);
+        }
+    }
+
     /// A corner `v`, `v/vt`, `v//vn` or `v/vt/vn` starting at byte `start`.
-    fn corner(&mut self, word: &str, start: usize) -> Result<Corner, Reported> {
+    /// A texture coordinate or normal index out of range is recorded in
+    /// `missing` (by slot, the first only) and read as absent.
+    fn corner(
+        &mut self,
+        word: &str,
+        start: usize,
+        missing: &mut [Option<(Range<usize>, String)>; 2],
+    ) -> Result<Corner, Reported> {
         let mut parts = word.split('/');
         let mut offset = start;
         let mut indices = [NONE; 3];
@@ -225,7 +264,14 @@ impl Reader<'_> {
             if part.is_empty() && slot > 0 {
                 continue;
             }
-            indices[slot] = self.index(part, span, counts[slot], names[slot])?;
+            indices[slot] = match self.index(part, &span, counts[slot], names[slot])? {
+                Ok(index) => index,
+                Err(out_of_range) if slot > 0 => {
+                    missing[slot - 1].get_or_insert((span, out_of_range));
+                    NONE
+                }
+                Err(out_of_range) => return Err(self.error(span, out_of_range)),
+            };
         }
         if parts.next().is_some() {
             let span = start..start + word.len();
@@ -241,17 +287,18 @@ impl Reader<'_> {
         })
     }
 
-    /// An index from 1, or negative counting back from the last defined.
+    /// An index from 1, or negative counting back from the last defined;
+    /// one past those defined is `Ok(Err(what to say))`.
     fn index(
         &mut self,
         text: &str,
-        span: Range<usize>,
+        span: &Range<usize>,
         count: usize,
         name: &str,
-    ) -> Result<u32, Reported> {
+    ) -> Result<Result<u32, String>, Reported> {
         let Ok(value) = text.parse::<i64>() else {
             return Err(self.error(
-                span,
+                span.clone(),
                 format!("expected a {name} index (a whole number), found `{text}`"),
             ));
         };
@@ -262,7 +309,7 @@ impl Reader<'_> {
         };
         if value == 0 {
             return Err(self.error(
-                span,
+                span.clone(),
                 format!("{name} index 0: indices count from 1 (or back from -1)"),
             ));
         }
@@ -276,12 +323,11 @@ impl Reader<'_> {
                 1 => format!("1 {name} is"),
                 _ => format!("{count} {plural} are"),
             };
-            return Err(self.error(
-                span,
-                format!("{name} index {value} is out of range: {defined} defined before this line"),
-            ));
+            return Ok(Err(format!(
+                "{name} index {value} is out of range: {defined} defined before this line"
+            )));
         }
-        Ok(resolved as u32)
+        Ok(Ok(resolved as u32))
     }
 
     fn smoothing_group(
@@ -315,13 +361,14 @@ impl Reader<'_> {
             return Err(self.error(at, "expected a material name after `usemtl`"));
         }
         let uses = &mut self.data.material_uses;
-        self.material = match uses.iter().position(|(known, _)| known == name) {
-            Some(index) => index as u32,
-            None => {
+        let next = uses.len() as u32;
+        self.material = *self
+            .material_slots
+            .entry(name.to_string())
+            .or_insert_with(|| {
                 uses.push((name.to_string(), span));
-                (uses.len() - 1) as u32
-            }
-        };
+                next
+            });
         Ok(())
     }
 

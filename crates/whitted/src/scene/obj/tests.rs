@@ -94,3 +94,62 @@ fn a_face_that_crosses_itself_covers_its_wings_with_attributes_interpolated_alon
     }
     assert!(hits > 300, "{hits}");
 }
+
+#[test]
+fn normals_and_texture_coordinates_that_do_not_exist_are_dropped_with_one_warning() {
+    // The `vn` and `vt` lines commented out, as exporters' users do.
+    let roof = "v -1 0 0\nv 0 1 0\nv 1 0 0\nv -1 0 1\nv 0 1 1\nv 1 0 1\n";
+    let without = parse(&format!("{roof}f 1 4 5 2\nf 2 5 6 3\n")).scene;
+    let loaded = parse(&format!(
+        "{roof}# vn 0 1 0\n# vt 0 0\nf 1//1 4//1 5//1 2//1\nf 2/1/2 5/1/2 6/1/2 3/1/2\n"
+    ));
+    let text: Vec<String> = loaded.warnings.iter().map(ToString::to_string).collect();
+    assert_eq!(text.len(), 2, "{text:?}");
+    assert!(
+        text[0].starts_with(
+            "model.obj:9:6: warning: normal index 1 is out of range: 0 normals are defined \
+             before this line; faces that refer to normals that do not exist get normals \
+             computed as for a face without any (warned once per file)\n"
+        ),
+        "{}",
+        text[0]
+    );
+    assert!(
+        text[1].starts_with(
+            "model.obj:10:5: warning: texture coordinate index 1 is out of range: \
+             0 texture coordinates are defined before this line; faces that refer to \
+             texture coordinates that do not exist are read without texture coordinates"
+        ),
+        "{}",
+        text[1]
+    );
+    // The same mesh as without the indices: computed normals, no (u, v).
+    assert_eq!(loaded.scene.objects.meshes, without.objects.meshes);
+}
+
+#[test]
+fn every_library_of_an_mtllib_line_is_read_and_a_missing_one_is_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("a.mtl"), "newmtl red\nKd 1 0 0\n").unwrap();
+    std::fs::write(dir.path().join("my b.mtl"), "newmtl blue\nKd 0 0 1\n").unwrap();
+    let source = "mtllib a.mtl gone.mtl my\\ b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n\
+                  usemtl red\nf 1 2 3\nusemtl blue\nf 1 3 2\n";
+    let loaded = parse_obj(source, &dir.path().join("m.obj")).unwrap();
+    let text: Vec<String> = loaded.warnings.iter().map(ToString::to_string).collect();
+    assert_eq!(text.len(), 1, "{text:?}");
+    assert!(
+        text[0].contains("m.obj:1:14: warning: cannot read the material library `")
+            && text[0].contains("gone.mtl` ("),
+        "{}",
+        text[0]
+    );
+    let diffuse: Vec<&crate::shading::Texture> =
+        loaded.scene.materials.iter().map(|m| &m.diffuse).collect();
+    assert_eq!(
+        diffuse,
+        [
+            &Color::new(1.0, 0.0, 0.0).into(),
+            &Color::new(0.0, 0.0, 1.0).into()
+        ]
+    );
+}

@@ -52,7 +52,7 @@ use crate::math::Vec3;
 use crate::render::{Camera, CameraError};
 use crate::render::{MAX_DEPTH, MAX_SAMPLES, MAX_SIDE, check_image_size};
 use crate::render::{RenderSettings, Scene};
-use crate::scene::{Diagnostic, SceneError};
+use crate::scene::{Diagnostic, SceneError, without_bom};
 use crate::shading::Color;
 use crate::shading::Material;
 use crate::world::MaterialId;
@@ -60,6 +60,7 @@ use crate::world::MaterialId;
 /// Reads a scene from the text of a scene file; `path` is only used in
 /// messages.
 pub fn parse_scene(source: &str, path: &Path) -> Result<Scene, SceneError> {
+    let source = without_bom(source);
     let root = toml_span::parse(source).map_err(|error| {
         let span = error.span.start..error.span.end;
         let message = match source.get(span.clone()) {
