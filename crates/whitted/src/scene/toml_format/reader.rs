@@ -13,7 +13,7 @@ use toml_span::Span;
 use toml_span::value::{Key, Table, Value};
 
 use crate::image::ColorSpace;
-use crate::math::{Vec3, unit};
+use crate::math::{Vec3, magnitude, unit};
 use crate::scene::{Diagnostic, SceneError, Severity, push_limited};
 use crate::shading::Color;
 use crate::shading::texture::{Decoding, ImageCache, ImageData};
@@ -433,10 +433,22 @@ impl<'s> Reader<'s> {
         Ok(array)
     }
 
-    /// A point or vector `[x, y, z]`.
+    /// A point or vector `[x, y, z]`, each number within
+    /// ±[`magnitude::MAX_COORDINATE`].
     pub(super) fn vec3(&mut self, value: &Value<'_>, key: &str) -> Parsed<Vec3> {
-        self.numbers::<3>(value, key, Self::number)
+        self.numbers::<3>(value, key, Self::coordinate)
             .map(Vec3::from_array)
+    }
+
+    /// A finite number within ±[`magnitude::MAX_COORDINATE`].
+    pub(super) fn coordinate(&mut self, value: &Value<'_>, key: &str) -> Parsed<f64> {
+        let number = self.number(value, key)?;
+        magnitude::coordinate(number).map_err(|error| {
+            self.error(
+                value.span,
+                format!("`{key}` is out of range: {error}"),
+            )
+        })
     }
 
     /// A list of points `[[x, y, z], ...]`.
@@ -448,7 +460,7 @@ impl<'s> Reader<'s> {
     /// A non-zero vector `[x, y, z]`, normalised. Only `[0, 0, 0]` is
     /// refused: however short or long, any other vector has a direction.
     pub(super) fn direction(&mut self, value: &Value<'_>, key: &str) -> Parsed<Vec3> {
-        let v = self.vec3(value, key)?;
+        let v = Vec3::from_array(self.numbers::<3>(value, key, Self::number)?);
         unit(v)
             .ok_or_else(|| self.error(value.span, format!("`{key}` must not be the zero vector")))
     }
