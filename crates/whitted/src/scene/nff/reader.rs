@@ -12,7 +12,7 @@ use std::ops::Range;
 use std::path::Path;
 
 use super::lexer::{Lexer, Token, is_entity_keyword};
-use crate::math::Vec3;
+use crate::math::{Vec3, magnitude};
 use crate::scene::{Diagnostic, Severity, push_limited};
 use crate::shading::Color;
 
@@ -116,11 +116,15 @@ impl<'a> Reader<'a> {
         Err(self.error(span, format!("expected {kind} for {what}, found {found}")))
     }
 
-    /// A finite number, for `what` ("the sphere's radius").
+    /// A finite number within ±[`magnitude::MAX_COORDINATE`] (beyond it,
+    /// squares in intersection overflow), for `what` ("the sphere's
+    /// radius").
     pub(super) fn number(&mut self, what: &str) -> Parsed<f64> {
         let token = self.take("a number", what)?;
         match token.text.parse::<f64>() {
-            Ok(value) if value.is_finite() => Ok(value),
+            Ok(value) if value.is_finite() => magnitude::coordinate(value).map_err(|error| {
+                self.error(token.span, format!("{what} is out of range: {error}"))
+            }),
             Ok(_) => Err(self.error(
                 token.span,
                 format!(
