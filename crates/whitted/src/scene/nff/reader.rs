@@ -14,7 +14,7 @@ use std::path::Path;
 use super::lexer::{Lexer, Token, is_entity_keyword};
 use crate::math::{Vec3, magnitude};
 use crate::scene::{Diagnostic, Severity, push_limited};
-use crate::shading::Color;
+use crate::shading::{Color, factor};
 
 /// A problem that has been recorded; the entity being read is abandoned.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -148,13 +148,18 @@ impl<'a> Reader<'a> {
         ))
     }
 
-    /// Three numbers that are not negative, for the colour `what`.
+    /// Three numbers that are not negative and at most
+    /// [`factor::MAX_FACTOR`], for the colour `what`.
     pub(super) fn color(&mut self, what: &str) -> Parsed<Color> {
         let start = self.next_start();
         let color = Color::from(self.vec3(what)?.to_array());
         if color.min_element() < 0.0 {
             let span = self.since(start);
             return Err(self.error(span, format!("{what} must not be negative, got {color}")));
+        }
+        if let Err(error) = factor::factor(color.max_element()) {
+            let span = self.since(start);
+            return Err(self.error(span, format!("{what} is out of range: {error}")));
         }
         Ok(color)
     }

@@ -12,6 +12,7 @@ use super::text::lines;
 use crate::scene::{Diagnostic, Severity, push_limited};
 use crate::shading::Bump;
 use crate::shading::Color;
+use crate::shading::factor::{self, FactorError};
 use crate::shading::Material;
 use crate::shading::Texture;
 use crate::shading::texture::{Decoding, DissolveMap, ImageCache, ImageData, ImageTexture};
@@ -59,6 +60,21 @@ pub(super) fn read_library(source: &str, path: &Path, images: &mut ImageCache) -
     }
 }
 
+/// Why the number `word` of a colour statement (`Kd`, `Ke` ...) or of `Ni`
+/// is out of range for radiance, if it is: a colour component beyond
+/// [`factor::MAX_FACTOR`] in magnitude, an index of refraction outside
+/// [`factor::divisor`]'s range.
+fn out_of_range(keyword: &str, word: &str) -> Option<FactorError> {
+    let value = word.parse::<f64>().ok()?;
+    if COLORS.contains(&keyword) {
+        factor::factor(value).err()
+    } else if keyword == "Ni" {
+        factor::divisor(value).err()
+    } else {
+        None
+    }
+}
+
 fn is_error(d: &Diagnostic) -> bool {
     d.severity == crate::scene::Severity::Error
 }
@@ -92,6 +108,18 @@ fn check(source: &str, path: &Path) -> Vec<Diagnostic> {
             } else {
                 word.parse::<f64>().is_ok_and(f64::is_finite)
             };
+            if ok && let Some(error) = out_of_range(keyword, word) {
+                push_limited(&mut diagnostics, Severity::Error, || {
+                    Diagnostic::new(
+                        path,
+                        source,
+                        span,
+                        format!("`{keyword}` {word} is out of range: {error}"),
+                    )
+                });
+                found = wanted;
+                break;
+            }
             if !ok {
                 let what = if keyword == "illum" {
                     "an illumination model 0 to 10"

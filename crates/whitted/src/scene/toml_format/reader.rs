@@ -15,7 +15,7 @@ use toml_span::value::{Key, Table, Value};
 use crate::image::ColorSpace;
 use crate::math::{Vec3, magnitude, unit};
 use crate::scene::{Diagnostic, SceneError, Severity, push_limited};
-use crate::shading::Color;
+use crate::shading::{Color, factor};
 use crate::shading::texture::{Decoding, ImageCache, ImageData};
 
 /// A value was wrong and its error has been recorded. Only [`Reader::error`]
@@ -443,12 +443,7 @@ impl<'s> Reader<'s> {
     /// A finite number within ±[`magnitude::MAX_COORDINATE`].
     pub(super) fn coordinate(&mut self, value: &Value<'_>, key: &str) -> Parsed<f64> {
         let number = self.number(value, key)?;
-        magnitude::coordinate(number).map_err(|error| {
-            self.error(
-                value.span,
-                format!("`{key}` is out of range: {error}"),
-            )
-        })
+        magnitude::coordinate(number).map_err(|error| self.out_of_range(value, key, error))
     }
 
     /// A list of points `[[x, y, z], ...]`.
@@ -465,13 +460,38 @@ impl<'s> Reader<'s> {
             .ok_or_else(|| self.error(value.span, format!("`{key}` must not be the zero vector")))
     }
 
-    /// A colour: `[r, g, b]` or one number for a grey, never negative.
+    /// A factor of radiance: a number `>= 0` and at most
+    /// [`factor::MAX_FACTOR`].
+    pub(super) fn factor(&mut self, value: &Value<'_>, key: &str) -> Parsed<f64> {
+        let number = self.non_negative(value, key)?;
+        factor::factor(number).map_err(|error| self.out_of_range(value, key, error))
+    }
+
+    /// A number that divides radiance: `0`, or positive within
+    /// [`factor::divisor`]'s range.
+    pub(super) fn divisor(&mut self, value: &Value<'_>, key: &str) -> Parsed<f64> {
+        let number = self.non_negative(value, key)?;
+        factor::divisor(number).map_err(|error| self.out_of_range(value, key, error))
+    }
+
+    /// Records "`key` is out of range: `error`" at `value`.
+    fn out_of_range(
+        &mut self,
+        value: &Value<'_>,
+        key: &str,
+        error: impl std::fmt::Display,
+    ) -> Reported {
+        self.error(value.span, format!("`{key}` is out of range: {error}"))
+    }
+
+    /// A colour: `[r, g, b]` or one number for a grey, never negative, each
+    /// component a [`Reader::factor`].
     pub(super) fn color(&mut self, value: &Value<'_>, key: &str) -> Parsed<Color> {
         if value.as_array().is_some() {
-            self.numbers::<3>(value, key, Self::non_negative)
+            self.numbers::<3>(value, key, Self::factor)
                 .map(Color::from)
         } else if value.as_integer().is_some() || value.as_float().is_some() {
-            self.non_negative(value, key).map(Color::splat)
+            self.factor(value, key).map(Color::splat)
         } else {
             Err(self.wrong_type(value, key, "a colour ([r, g, b] or a number)"))
         }
