@@ -4,3 +4,4 @@
 //! memory). Every case runs the real `whitted` binary.
 
 mod support;
+mod pictures;
