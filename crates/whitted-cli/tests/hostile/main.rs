@@ -3,5 +3,5 @@
 //! files on disk, and where memory is the point, the child's peak resident
 //! memory). Every case runs the real `whitted` binary.
 
-mod support;
 mod pictures;
+mod support;

@@ -41,7 +41,11 @@ fn pfm_pixels(path: &Path) -> Vec<[f32; 3]> {
     let bytes = std::fs::read(path).unwrap();
     let mut header_end = 0;
     for _ in 0..3 {
-        header_end += bytes[header_end..].iter().position(|&b| b == b'\n').unwrap() + 1;
+        header_end += bytes[header_end..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .unwrap()
+            + 1;
     }
     assert!(bytes.starts_with(b"PF\n"));
     bytes[header_end..]
@@ -60,7 +64,11 @@ fn a_flat_obj_is_framed_from_its_normal_side_and_seen() {
     assert_eq!(p.code(), Some(0), "{}", p.stderr);
     let pixels = pfm_pixels(&dir.path().join("out.pfm"));
     let lit = pixels.iter().filter(|c| c[0] > 0.1).count();
-    assert!(lit > pixels.len() / 4, "{lit} of {} pixels lit", pixels.len());
+    assert!(
+        lit > pixels.len() / 4,
+        "{lit} of {} pixels lit",
+        pixels.len()
+    );
 }
 
 #[test]
@@ -223,7 +231,10 @@ fn ray_record(origin: [f32; 3], dir: [f32; 3], t_far: f32) -> Vec<u8> {
 fn bench_refuses_rays_that_cannot_be_traced_naming_file_and_index() {
     let good = ray_record([0.0, 0.0, 5.0], [0.0, 0.0, -1.0], f32::INFINITY);
     for (bad, why) in [
-        (ray_record([0.0; 3], [0.0; 3], 1.0), "the direction has zero length"),
+        (
+            ray_record([0.0; 3], [0.0; 3], 1.0),
+            "the direction has zero length",
+        ),
         (
             ray_record([f32::NAN, 0.0, 0.0], [0.0, 0.0, 1.0], 1.0),
             "a value is not a finite number",

@@ -285,9 +285,11 @@ impl Transform {
         }
         let m = &world_from_object.matrix3;
         for axis in [m.x_axis, m.y_axis, m.z_axis] {
-            magnitude::length(magnitude::norm(axis)).map_err(|error| TransformError::OutOfRange {
-                what: "scale factor",
-                error,
+            magnitude::length(magnitude::norm(axis)).map_err(|error| {
+                TransformError::OutOfRange {
+                    what: "scale factor",
+                    error,
+                }
             })?;
         }
         magnitude::point(world_from_object.translation).map_err(|error| {

@@ -221,7 +221,11 @@ mod tests {
         for (eye, look_at, up) in [
             (Vec3::ZERO, Vec3::new(0.0, 0.0, -1e-200), Vec3::Y),
             (Vec3::ZERO, Vec3::new(0.0, 0.0, -1e30), Vec3::Y),
-            (Vec3::new(0.0, 0.0, 1e30), Vec3::new(0.0, 0.0, -1e30), Vec3::Y),
+            (
+                Vec3::new(0.0, 0.0, 1e30),
+                Vec3::new(0.0, 0.0, -1e30),
+                Vec3::Y,
+            ),
             (Vec3::ZERO, -Vec3::Z, Vec3::new(0.0, 1e-200, 0.0)),
             (Vec3::ZERO, -Vec3::Z, Vec3::new(0.0, 1e200, 0.0)),
         ] {

@@ -8,7 +8,7 @@
 //! the light (an attenuation term, an index of refraction) at least its
 //! inverse, so that one light on one surface stays far inside that range;
 //! the render checks the film for what deep recursion could still carry
-//! beyond it ([`crate::render::RenderError::NotFinite`]).
+//! beyond it, and refuses a film that holds inf or NaN.
 
 /// The largest colour component, intensity, emission or other factor of
 /// radiance.

@@ -15,7 +15,7 @@
 
 use super::plane::{onto_plane, plane_hit};
 use super::{LocalSurface, ShapeError, ShapeHit, finite, not_tiny};
-use crate::math::{magnitude, Aabb, DVec2, Ray, Vec3};
+use crate::math::{Aabb, DVec2, Ray, Vec3, magnitude};
 
 /// Edges count as parallel when the sine of the angle between them is below
 /// this: the normal would be rounding noise.

@@ -25,7 +25,7 @@
 use super::outline::Outline;
 use super::plane::{onto_plane, plane_hit};
 use super::{LocalSurface, ShapeError, ShapeHit, finite, not_tiny};
-use crate::math::{magnitude, Aabb, DVec2, Ray, Vec3, gamma, unit};
+use crate::math::{Aabb, DVec2, Ray, Vec3, gamma, magnitude, unit};
 
 /// Vertices count as collinear when twice the polygon's area is below this
 /// fraction of `Σ |wᵢ| |wᵢ₊₁|` (`wᵢ = vᵢ - v0`): the normal would be

@@ -16,7 +16,7 @@
 //! the surface is never taken to hit it again.
 
 use super::{LocalSurface, ShapeError, ShapeHit, finite, not_tiny};
-use crate::math::{magnitude, Aabb, DVec2, Ray, Vec3, gamma};
+use crate::math::{Aabb, DVec2, Ray, Vec3, gamma, magnitude};
 
 /// Vertices count as collinear when the sine of the angle at `p0` is below
 /// this: such a needle's normal would be rounding noise.

@@ -16,8 +16,8 @@
 //! | ior | `ior` when `T > 0`; 1 otherwise (opaque files may put 0 there) |
 
 use super::reader::{Parsed, Reader};
-use crate::shading::{Color, factor};
 use crate::shading::Material;
+use crate::shading::{Color, factor};
 
 /// The global ambient light `Ia`, white: small, but present on every
 /// surface, as the SPD asks (NFF itself has no ambient term).
@@ -116,7 +116,10 @@ fn weight(r: &mut Reader<'_>, name: &str) -> Parsed<f64> {
     }
     factor::factor(value).map_err(|error| {
         let span = r.since(start);
-        r.error(span, format!("the material's {name} is out of range: {error}"))
+        r.error(
+            span,
+            format!("the material's {name} is out of range: {error}"),
+        )
     })
 }
 

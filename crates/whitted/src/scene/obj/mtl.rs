@@ -12,9 +12,9 @@ use super::text::lines;
 use crate::scene::{Diagnostic, Severity, push_limited};
 use crate::shading::Bump;
 use crate::shading::Color;
-use crate::shading::factor::{self, FactorError};
 use crate::shading::Material;
 use crate::shading::Texture;
+use crate::shading::factor::{self, FactorError};
 use crate::shading::texture::{Decoding, DissolveMap, ImageCache, ImageData, ImageTexture};
 
 /// The materials of one library by name, or its errors; with its warnings.

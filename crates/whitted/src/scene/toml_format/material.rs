@@ -280,9 +280,8 @@ fn checker(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Texture> 
     let odd = r.require(&f, "odd", Reader::color);
     let size = r.or_default(&f, "size", 1.0, |r, value, key| {
         let size = r.positive(value, key)?;
-        magnitude::length(size).map_err(|error| {
-            r.error(value.span, format!("`{key}` is out of range: {error}"))
-        })
+        magnitude::length(size)
+            .map_err(|error| r.error(value.span, format!("`{key}` is out of range: {error}")))
     });
     keys?;
     Ok(Texture::Checker(Checker {

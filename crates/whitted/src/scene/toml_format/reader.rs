@@ -15,8 +15,8 @@ use toml_span::value::{Key, Table, Value};
 use crate::image::ColorSpace;
 use crate::math::{Vec3, magnitude, unit};
 use crate::scene::{Diagnostic, SceneError, Severity, push_limited};
-use crate::shading::{Color, factor};
 use crate::shading::texture::{Decoding, ImageCache, ImageData};
+use crate::shading::{Color, factor};
 
 /// A value was wrong and its error has been recorded. Only [`Reader::error`]
 /// makes one, so a failed walk always has at least one diagnostic.
@@ -488,8 +488,7 @@ impl<'s> Reader<'s> {
     /// component a [`Reader::factor`].
     pub(super) fn color(&mut self, value: &Value<'_>, key: &str) -> Parsed<Color> {
         if value.as_array().is_some() {
-            self.numbers::<3>(value, key, Self::factor)
-                .map(Color::from)
+            self.numbers::<3>(value, key, Self::factor).map(Color::from)
         } else if value.as_integer().is_some() || value.as_float().is_some() {
             self.factor(value, key).map(Color::splat)
         } else {
