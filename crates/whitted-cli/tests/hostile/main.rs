@@ -7,4 +7,5 @@ mod args;
 mod limits;
 mod obj;
 mod outputs;
+mod pictures;
 mod support;

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use super::{RayKind, RaySet, TraceResults, ray_set_bytes};
 use crate::limits::{MemoryBudget, MemoryError};
-use crate::math::{Ray, Vec3};
+use crate::math::{Ray, Vec3, magnitude};
 
 /// Size of one ray record.
 const RAY_RECORD: usize = 32;
@@ -76,7 +76,32 @@ fn u32_at(bytes: &[u8], at: usize) -> u32 {
     u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]])
 }
 
-/// Reads the rays and reference results of `kind` from `dir`.
+/// Why a ray cannot be traced, if it cannot: a value that is not a finite
+/// number, an origin beyond ±[`magnitude::MAX_COORDINATE`], a direction of
+/// zero length (or too short to square), a `t_far` that is not positive
+/// (it may be infinite).
+fn check_ray(origin: Vec3, dir: Vec3, t_far: f64) -> Result<(), String> {
+    if !(origin.is_finite() && dir.is_finite()) || t_far.is_nan() {
+        return Err(format!(
+            "a value is not a finite number (origin {origin}, direction {dir}, t_far {t_far})"
+        ));
+    }
+    magnitude::point(origin).map_err(|error| format!("the origin is out of range: {error}"))?;
+    let length = magnitude::norm(dir);
+    if length == 0.0 {
+        return Err("the direction has zero length".into());
+    }
+    magnitude::length(length)
+        .map_err(|error| format!("the direction's length is out of range: {error}"))?;
+    if t_far <= 0.0 {
+        return Err(format!("t_far must be positive, got {t_far}"));
+    }
+    Ok(())
+}
+
+/// Reads the rays and reference results of `kind` from `dir`; a ray that
+/// [`check_ray`] refuses is an error naming the file, the ray's index and
+/// why.
 pub fn read_ray_file(dir: &Path, kind: RayKind) -> Result<RayFile, RayFileError> {
     let rays_path = dir.join(format!("{}.rays", kind.name()));
     let hits_path = dir.join(format!("{}.hits", kind.name()));
@@ -103,7 +128,8 @@ pub fn read_ray_file(dir: &Path, kind: RayKind) -> Result<RayFile, RayFileError>
         })?;
     let rays: Vec<Ray> = bytes
         .chunks_exact(RAY_RECORD)
-        .map(|r| {
+        .enumerate()
+        .map(|(index, r)| {
             let v = |at| {
                 Vec3::new(
                     f32_at(r, at).into(),
@@ -111,9 +137,14 @@ pub fn read_ray_file(dir: &Path, kind: RayKind) -> Result<RayFile, RayFileError>
                     f32_at(r, at + 8).into(),
                 )
             };
-            Ray::segment(v(4), v(16), f32_at(r, 28).into())
+            let (origin, dir, t_far) = (v(4), v(16), f32_at(r, 28).into());
+            check_ray(origin, dir, t_far).map_err(|why| RayFileError::Malformed {
+                path: rays_path.clone(),
+                why: format!("ray {index}: {why}"),
+            })?;
+            Ok(Ray::segment(origin, dir, t_far))
         })
-        .collect();
+        .collect::<Result<_, _>>()?;
     let hits = read(&hits_path)?;
     let record = if kind.is_any_hit() { 1 } else { HIT_RECORD };
     if hits.len() != rays.len() * record {
@@ -230,10 +261,42 @@ mod tests {
         std::fs::write(dir.path().join("diffuse.rays"), [0u8; 33]).unwrap();
         let err = read_ray_file(dir.path(), RayKind::Diffuse).unwrap_err();
         assert!(err.to_string().contains("not a whole number"));
-        std::fs::write(dir.path().join("diffuse.rays"), [0u8; 32]).unwrap();
+        let ray = ray_record([0.0; 3], [0.0, 0.0, 1.0], 1.0);
+        std::fs::write(dir.path().join("diffuse.rays"), ray).unwrap();
         std::fs::write(dir.path().join("diffuse.hits"), [0u8; 4]).unwrap();
         let err = read_ray_file(dir.path(), RayKind::Diffuse).unwrap_err();
         assert!(err.to_string().contains("expected 8"));
+    }
+
+    #[test]
+    fn rays_that_cannot_be_traced_are_refused_with_their_index_and_why() {
+        let dir = tempfile::tempdir().unwrap();
+        let good = ray_record([0.0; 3], [0.0, 0.0, 1.0], f32::INFINITY);
+        for (bad, why) in [
+            (
+                ray_record([0.0; 3], [0.0; 3], 1.0),
+                "ray 1: the direction has zero length",
+            ),
+            (
+                ray_record([f32::NAN, 0.0, 0.0], [0.0, 0.0, 1.0], 1.0),
+                "ray 1: a value is not a finite number",
+            ),
+            (
+                ray_record([3e38; 3], [0.0, 0.0, 1.0], 1.0),
+                "ray 1: the origin is out of range: 3",
+            ),
+            (
+                ray_record([0.0; 3], [0.0, 0.0, 1.0], 0.0),
+                "ray 1: t_far must be positive, got 0",
+            ),
+        ] {
+            let rays = [good.clone(), bad].concat();
+            std::fs::write(dir.path().join("primary.rays"), rays).unwrap();
+            let err = read_ray_file(dir.path(), RayKind::Primary).unwrap_err();
+            let message = err.to_string();
+            assert!(message.contains("primary.rays: "), "{message}");
+            assert!(message.contains(why), "{message}");
+        }
     }
 
     #[test]

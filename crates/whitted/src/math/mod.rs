@@ -11,6 +11,7 @@
 //! surface normal. The offset is relative to the magnitudes involved, so a
 //! scene scaled by 1e-3 or 1e4 renders the same picture.
 
+pub mod magnitude;
 pub mod random;
 pub mod sampling;
 #[cfg(all(test, target_arch = "x86_64"))]
@@ -237,6 +238,16 @@ pub enum TransformError {
         /// The determinant of the linear part.
         determinant: f64,
     },
+    /// A scale factor (the length of an axis of the matrix) or the
+    /// translation beyond the range of [`magnitude`]: a shape it carries
+    /// could not be intersected without overflow or underflow.
+    #[error("the transform's {what} is out of range: {error}")]
+    OutOfRange {
+        /// "scale factor" or "translation".
+        what: &'static str,
+        /// How it is out of range.
+        error: magnitude::MagnitudeError,
+    },
     /// A rotation axis of zero length.
     #[error("the rotation axis has zero length")]
     ZeroAxis,
@@ -265,12 +276,28 @@ impl Transform {
         object_from_world: DAffine3::IDENTITY,
     };
 
-    /// A transform from its matrix, refused when singular or not finite.
+    /// A transform from its matrix, refused when not finite, when a scale
+    /// factor or the translation is out of [`magnitude`]'s range, or when
+    /// singular.
     pub fn from_affine(world_from_object: DAffine3) -> Result<Self, TransformError> {
         if !world_from_object.is_finite() {
             return Err(TransformError::NotFinite);
         }
         let m = &world_from_object.matrix3;
+        for axis in [m.x_axis, m.y_axis, m.z_axis] {
+            magnitude::length(magnitude::norm(axis)).map_err(|error| {
+                TransformError::OutOfRange {
+                    what: "scale factor",
+                    error,
+                }
+            })?;
+        }
+        magnitude::point(world_from_object.translation).map_err(|error| {
+            TransformError::OutOfRange {
+                what: "translation",
+                error,
+            }
+        })?;
         let determinant = m.determinant();
         // How flat the transformed unit cube is: |det| over the product of
         // the column lengths is 1 for orthogonal axes, whatever their scale,
@@ -502,6 +529,33 @@ mod tests {
             Transform::translate(Vec3::new(f64::NAN, 0.0, 0.0)),
             Err(TransformError::NotFinite)
         );
+    }
+
+    #[test]
+    fn scales_and_translations_out_of_range_are_refused_as_such() {
+        let too_large = magnitude::MagnitudeError::TooLarge { value: 1e103 };
+        assert_eq!(
+            Transform::scale(Vec3::splat(1e103)),
+            Err(TransformError::OutOfRange {
+                what: "scale factor",
+                error: too_large,
+            })
+        );
+        assert_eq!(
+            Transform::scale(Vec3::new(1.0, 1e-300, 1.0)),
+            Err(TransformError::OutOfRange {
+                what: "scale factor",
+                error: magnitude::MagnitudeError::TooSmall { value: 1e-300 },
+            })
+        );
+        assert!(matches!(
+            Transform::translate(Vec3::new(0.0, 0.0, 1e31)),
+            Err(TransformError::OutOfRange {
+                what: "translation",
+                ..
+            })
+        ));
+        assert!(Transform::scale(Vec3::new(1e30, 1e-30, -1.0)).is_ok());
     }
 
     #[test]

@@ -6,6 +6,7 @@
 //! pixel centres: pixel `(column, row)` is centred at `(column + 0.5,
 //! row + 0.5)` in image coordinates, row 0 at the top.
 
+use crate::math::magnitude::{self, MagnitudeError};
 use crate::math::{Aabb, Ray, Vec3, unit};
 
 /// Why a camera could not be built.
@@ -23,7 +24,23 @@ pub enum CameraError {
     /// A value that is not a finite number.
     #[error("the camera has a value that is not a finite number")]
     NotFinite,
+    /// `eye` or `look_at` beyond ±[`magnitude::MAX_COORDINATE`]: its rays
+    /// would meet the scene's shapes in squares that overflow.
+    #[error("the camera's {what} is out of range: {error}")]
+    OutOfRange {
+        /// `eye` or `look_at`.
+        what: &'static str,
+        /// How it is out of range.
+        error: MagnitudeError,
+    },
+    /// A model to frame whose size is out of range.
+    #[error("the model's size is out of range: {0}")]
+    ModelOutOfRange(MagnitudeError),
 }
+
+/// The fraction of a model's largest side below which [`Camera::framing`]
+/// takes it as flat along an axis.
+pub const THIN: f64 = 0.1;
 
 /// A pinhole camera.
 #[derive(Clone, Debug, PartialEq)]
@@ -48,15 +65,10 @@ impl Camera {
         if !(fov_degrees > 0.0 && fov_degrees < 180.0) {
             return Err(CameraError::BadFov(fov_degrees));
         }
-        // Halved when the difference overflows (an eye and a look_at near
-        // opposite ends of the f64 range): the direction is the same.
-        let view = look_at - eye;
-        let view = if view.is_finite() {
-            view
-        } else {
-            0.5 * look_at - 0.5 * eye
-        };
-        let forward = unit(view).ok_or(CameraError::NoViewDirection)?;
+        for (what, point) in [("eye", eye), ("look_at", look_at)] {
+            magnitude::point(point).map_err(|error| CameraError::OutOfRange { what, error })?;
+        }
+        let forward = unit(look_at - eye).ok_or(CameraError::NoViewDirection)?;
         let side = forward.cross(unit(up).ok_or(CameraError::BadUp)?);
         if side.length() <= 1e-9 {
             return Err(CameraError::BadUp);
@@ -80,12 +92,24 @@ impl Camera {
     /// image of the given aspect ratio (width / height), with `up` = +y.
     /// This is the default view of the Embree anchor harness, so both trace
     /// the same primary rays.
+    ///
+    /// A flat or thin model would be seen edge-on along its diagonal (a
+    /// quad in z = 0 has its diagonal in its plane): an axis along which
+    /// the box is thinner than [`THIN`] of its largest side counts as long
+    /// as that side in the view direction, so such a model is seen from
+    /// its normal side, at 35° from a square's plane.
     pub fn framing(bounds: &Aabb, aspect: f64, fov_degrees: f64) -> Result<Self, CameraError> {
         if bounds.is_empty() || !bounds.is_finite() {
             return Err(CameraError::NotFinite);
         }
+        for corner in [bounds.min, bounds.max] {
+            magnitude::point(corner).map_err(CameraError::ModelOutOfRange)?;
+        }
         let c = bounds.centroid();
-        let diagonal = unit(bounds.extent()).ok_or(CameraError::NoViewDirection)?;
+        let extent = bounds.extent();
+        let largest = extent.max_element();
+        let seen = extent.map(|side| if side < THIN * largest { largest } else { side });
+        let diagonal = unit(seen).ok_or(CameraError::NoViewDirection)?;
         let forward = -diagonal;
         let right = unit(forward.cross(Vec3::Y)).ok_or(CameraError::BadUp)?;
         let up = right.cross(forward);
@@ -192,14 +216,14 @@ mod tests {
     }
 
     #[test]
-    fn tiny_and_huge_view_directions_and_up_vectors_are_accepted() {
+    fn tiny_and_far_view_directions_and_huge_up_vectors_are_accepted() {
         let straight = camera().ray(3, 3, 1.5, 1.5).dir;
         for (eye, look_at, up) in [
             (Vec3::ZERO, Vec3::new(0.0, 0.0, -1e-200), Vec3::Y),
-            (Vec3::ZERO, Vec3::new(0.0, 0.0, -1e200), Vec3::Y),
+            (Vec3::ZERO, Vec3::new(0.0, 0.0, -1e30), Vec3::Y),
             (
-                Vec3::new(0.0, 0.0, f64::MAX),
-                Vec3::new(0.0, 0.0, -f64::MAX),
+                Vec3::new(0.0, 0.0, 1e30),
+                Vec3::new(0.0, 0.0, -1e30),
                 Vec3::Y,
             ),
             (Vec3::ZERO, -Vec3::Z, Vec3::new(0.0, 1e-200, 0.0)),
@@ -211,6 +235,36 @@ mod tests {
             let right = c.ray(3, 3, 3.0, 1.5).dir;
             assert!(right.x > 0.0, "{look_at} {up}: {right}");
         }
+    }
+
+    #[test]
+    fn a_flat_model_is_framed_from_its_normal_side() {
+        let quad = Aabb::new(Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0));
+        let c = Camera::framing(&quad, 1.0, 50.0).unwrap();
+        let centre = c.ray(3, 3, 1.5, 1.5);
+        assert!(centre.dir.z < -0.5, "{}", centre.dir);
+        let thin = Aabb::new(Vec3::ZERO, Vec3::new(4.0, 0.01, 4.0));
+        let c = Camera::framing(&thin, 1.0, 50.0).unwrap();
+        assert!(c.ray(3, 3, 1.5, 1.5).dir.y < -0.5);
+    }
+
+    #[test]
+    fn out_of_range_cameras_and_models_are_refused_as_such() {
+        let huge = Vec3::splat(3e38);
+        assert_eq!(
+            Camera::new(huge, Vec3::ZERO, Vec3::Y, 45.0),
+            Err(CameraError::OutOfRange {
+                what: "eye",
+                error: MagnitudeError::TooLarge { value: 3e38 }
+            })
+        );
+        let model = Aabb::new(Vec3::splat(-1e308), Vec3::splat(1e308));
+        assert_eq!(
+            Camera::framing(&model, 1.0, 50.0),
+            Err(CameraError::ModelOutOfRange(MagnitudeError::TooLarge {
+                value: -1e308
+            }))
+        );
     }
 
     #[test]

@@ -108,6 +108,23 @@ pub enum RenderError {
     /// The films would exceed the memory budget.
     #[error(transparent)]
     Memory(#[from] MemoryError),
+    /// Some pixels' colours came out infinite or NaN: the scene's numbers
+    /// (each bounded as it is read, see [`crate::shading::factor`])
+    /// multiplied over many bounces beyond what a 32-bit float holds. The
+    /// film is not returned, so no picture with inf or NaN is ever written.
+    #[error(
+        "{count} pixel(s) came out with a colour that is not a finite number (the first at \
+         column {x}, row {y}): the scene's colours, intensities and reflections multiply \
+         beyond the range of a 32-bit float; lower them or the maximum depth"
+    )]
+    NotFinite {
+        /// How many pixels.
+        count: u64,
+        /// The first one's column.
+        x: u32,
+        /// The first one's row.
+        y: u32,
+    },
     /// The thread pool could not be created.
     #[error("could not start {threads} worker threads: {message}")]
     Threads {
@@ -239,6 +256,7 @@ pub fn render(
         });
     });
     let films = films.into_inner().unwrap_or_else(PoisonError::into_inner);
+    check_finite(&films.image)?;
     let ray_budget_cut = budget_cut(scene, &films.cuts);
     Ok(RenderOutput {
         image: films.image,
@@ -266,6 +284,26 @@ fn budget_cut(scene: &Scene, cuts: &HashMap<MaterialId, u64>) -> Option<RayBudge
         material,
         material_name: scene.material_name(material),
         max_depth: settings.max_depth,
+    })
+}
+
+/// The final guard on the colour film: an error naming the first pixel
+/// that holds inf or NaN, and how many do.
+fn check_finite(image: &Film) -> Result<(), RenderError> {
+    let mut bad = image
+        .data()
+        .chunks_exact(image.channels())
+        .enumerate()
+        .filter(|(_, pixel)| pixel.iter().any(|v| !v.is_finite()))
+        .map(|(i, _)| i);
+    let Some(first) = bad.next() else {
+        return Ok(());
+    };
+    let width = image.width() as usize;
+    Err(RenderError::NotFinite {
+        count: 1 + bad.count() as u64,
+        x: (first % width) as u32,
+        y: (first / width) as u32,
     })
 }
 
@@ -442,5 +480,17 @@ mod tests {
         assert_eq!(clamp.tiles, 4);
         assert!(clamp.used <= clamp.tiles, "{clamp:?}");
         assert_eq!(clamped.image, output.image);
+    }
+
+    #[test]
+    fn a_film_with_inf_or_nan_is_refused_naming_the_first_pixel() {
+        let mut film = Film::new(4, 3, 3);
+        assert!(check_finite(&film).is_ok());
+        film.set_pixel(2, 1, &[0.0, f32::INFINITY, 0.0]);
+        film.set_pixel(3, 2, &[f32::NAN, 0.0, 0.0]);
+        let Err(RenderError::NotFinite { count, x, y }) = check_finite(&film) else {
+            panic!("an infinite pixel was let through");
+        };
+        assert_eq!((count, x, y), (2, 2, 1));
     }
 }

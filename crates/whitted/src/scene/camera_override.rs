@@ -1,7 +1,7 @@
 //! Replacing parts of a scene's camera, whatever format the scene came
 //! from: any part given replaces the scene's, the others are kept.
 
-use crate::math::{Vec3, unit};
+use crate::math::{Vec3, magnitude, unit};
 use crate::render::{Camera, CameraError};
 
 /// The parts of a camera to replace; `None` keeps the scene's.
@@ -37,6 +37,11 @@ impl CameraOverride {
             && self.fov_degrees.is_none_or(f64::is_finite))
         {
             return Err(CameraError::NotFinite);
+        }
+        for (what, point) in [("eye", self.eye), ("look_at", self.look_at)] {
+            if let Some(point) = point {
+                magnitude::point(point).map_err(|error| CameraError::OutOfRange { what, error })?;
+            }
         }
         if self.up.is_some_and(|up| unit(up).is_none()) {
             return Err(CameraError::BadUp);
@@ -117,18 +122,13 @@ mod tests {
             up,
             fov_degrees,
         };
-        let far = Vec3::splat(1e300);
+        let far = Vec3::splat(magnitude::MAX_COORDINATE);
         for fine in [
             CameraOverride::default(),
             given(Some(Vec3::Z), None, None, None),
             given(None, Some(far), None, None),
             given(Some(-far), None, Some(Vec3::Y), None),
-            given(
-                Some(Vec3::splat(1e308)),
-                Some(Vec3::splat(-1e308)),
-                None,
-                None,
-            ),
+            given(Some(far), Some(-far), None, None),
             given(Some(Vec3::splat(1e-300)), Some(Vec3::ZERO), None, None),
             given(None, None, Some(Vec3::new(0.0, 1e-200, 0.0)), Some(179.0)),
             given(Some(Vec3::Z), Some(Vec3::ZERO), Some(Vec3::Y), Some(1.0)),
@@ -156,6 +156,20 @@ mod tests {
             (
                 given(Some(Vec3::splat(f64::INFINITY)), None, None, None),
                 CameraError::NotFinite,
+            ),
+            (
+                given(Some(Vec3::splat(3e38)), None, None, None),
+                CameraError::OutOfRange {
+                    what: "eye",
+                    error: magnitude::point(Vec3::splat(3e38)).unwrap_err(),
+                },
+            ),
+            (
+                given(None, Some(-2.0 * far), None, None),
+                CameraError::OutOfRange {
+                    what: "look_at",
+                    error: magnitude::point(-2.0 * far).unwrap_err(),
+                },
             ),
         ] {
             assert_eq!(wrong.check(), Err(error), "{wrong:?}");

@@ -8,6 +8,7 @@
 pub mod bump;
 mod color;
 pub mod emission;
+pub mod factor;
 pub mod light;
 pub mod material;
 pub mod medium;

@@ -10,7 +10,7 @@
 //! faces), each scaled to [0, 1] over the face; `dpdu` and `dpdv` are the
 //! face's edges along the u and v axes.
 
-use super::{LocalSurface, ShapeError, ShapeHit, finite};
+use super::{LocalSurface, ShapeError, ShapeHit, finite, not_tiny};
 use crate::math::{Aabb, DVec2, Ray, Vec3, gamma};
 
 /// A box aligned with the axes.
@@ -32,6 +32,7 @@ impl AxisBox {
                 why: "min must be below max on every axis",
             });
         }
+        not_tiny("the box's shortest side", [(max - min).min_element()])?;
         Ok(Self { min, max })
     }
 

@@ -48,6 +48,7 @@ pub(crate) use triangle_clip::clipped_triangle_bounds;
 #[cfg(target_arch = "x86_64")]
 pub(crate) use watertight_avx::{Hits4, LANES, watertight4};
 
+use crate::math::magnitude::{self, MagnitudeError};
 use crate::math::{Aabb, DVec2, Ray, Vec3};
 
 /// A hit found during traversal: kept small, everything else is computed once
@@ -129,6 +130,16 @@ pub enum ShapeError {
         /// What makes it degenerate.
         why: &'static str,
     },
+    /// A coordinate or length outside the range whitted represents
+    /// ([`crate::math::magnitude`]): its square or products would overflow
+    /// or underflow in the intersection routine.
+    #[error("{what} is out of range: {error}")]
+    OutOfRange {
+        /// Which value.
+        what: &'static str,
+        /// How it is out of range.
+        error: MagnitudeError,
+    },
     /// The vertices of a polygon are not in one plane.
     #[error(
         "the polygon is not planar: vertex {vertex} lies {deviation:e} off its plane \
@@ -144,35 +155,58 @@ pub enum ShapeError {
     },
 }
 
-/// Checks that `value` is finite and positive.
+/// Checks that `value` is a positive length within
+/// [`crate::math::magnitude::length`]'s range.
 pub(crate) fn positive(what: &'static str, value: f64) -> Result<f64, ShapeError> {
     if !value.is_finite() {
         Err(ShapeError::NotFinite { what })
     } else if value <= 0.0 {
         Err(ShapeError::NotPositive { what, value })
     } else {
-        Ok(value)
+        in_range(what, value)
     }
 }
 
-/// Checks that `value` is finite and not negative.
+/// Checks that `value` is a length, zero or within
+/// [`crate::math::magnitude::length`]'s range.
 pub(crate) fn non_negative(what: &'static str, value: f64) -> Result<f64, ShapeError> {
     if !value.is_finite() {
         Err(ShapeError::NotFinite { what })
     } else if value < 0.0 {
         Err(ShapeError::Negative { what, value })
     } else {
-        Ok(value)
+        in_range(what, value)
     }
 }
 
-/// Checks that every component of `v` is finite.
+/// `value` when [`magnitude::length`] accepts it.
+fn in_range(what: &'static str, value: f64) -> Result<f64, ShapeError> {
+    magnitude::length(value).map_err(|error| ShapeError::OutOfRange { what, error })
+}
+
+/// Checks that every component of `v` is finite and within
+/// ±[`magnitude::MAX_COORDINATE`].
 pub(crate) fn finite(what: &'static str, v: Vec3) -> Result<Vec3, ShapeError> {
-    if v.is_finite() {
-        Ok(v)
-    } else {
+    if !v.is_finite() {
         Err(ShapeError::NotFinite { what })
+    } else {
+        magnitude::point(v).map_err(|error| ShapeError::OutOfRange { what, error })
     }
+}
+
+/// Checks that the largest of `lengths` (the edges of a flat shape) is at
+/// least [`magnitude::MIN_LENGTH`]: below it, the products of two edges
+/// (a normal, an area) underflow.
+pub(crate) fn not_tiny(
+    what: &'static str,
+    lengths: impl IntoIterator<Item = f64>,
+) -> Result<(), ShapeError> {
+    let longest = lengths.into_iter().fold(0.0, f64::max);
+    if longest > 0.0 && longest < magnitude::MIN_LENGTH {
+        let error = MagnitudeError::TooSmall { value: longest };
+        return Err(ShapeError::OutOfRange { what, error });
+    }
+    Ok(())
 }
 
 /// Every primitive whitted knows.

@@ -14,8 +14,8 @@
 //! point is inside.
 
 use super::plane::{onto_plane, plane_hit};
-use super::{LocalSurface, ShapeError, ShapeHit, finite};
-use crate::math::{Aabb, DVec2, Ray, Vec3};
+use super::{LocalSurface, ShapeError, ShapeHit, finite, not_tiny};
+use crate::math::{Aabb, DVec2, Ray, Vec3, magnitude};
 
 /// Edges count as parallel when the sine of the angle between them is below
 /// this: the normal would be rounding noise.
@@ -36,6 +36,8 @@ impl Parallelogram {
         let origin = finite("origin", origin)?;
         let edge_u = finite("edge_u", edge_u)?;
         let edge_v = finite("edge_v", edge_v)?;
+        not_tiny("edge_u", [magnitude::norm(edge_u)])?;
+        not_tiny("edge_v", [magnitude::norm(edge_v)])?;
         let cross = edge_u.cross(edge_v);
         let flat = cross.length() <= PARALLEL * edge_u.length() * edge_v.length();
         if flat || cross.try_normalize().is_none() {

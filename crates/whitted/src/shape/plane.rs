@@ -26,7 +26,10 @@ impl Plane {
     /// The plane through `point` with the given normal (any non-zero length).
     pub fn new(point: Vec3, normal: Vec3) -> Result<Self, ShapeError> {
         let point = finite("point", point)?;
-        let normal = unit(finite("normal", normal)?).ok_or(ShapeError::Degenerate {
+        if !normal.is_finite() {
+            return Err(ShapeError::NotFinite { what: "normal" });
+        }
+        let normal = unit(normal).ok_or(ShapeError::Degenerate {
             shape: "plane",
             why: "the normal has zero length",
         })?;

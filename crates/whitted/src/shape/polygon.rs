@@ -24,8 +24,8 @@
 
 use super::outline::Outline;
 use super::plane::{onto_plane, plane_hit};
-use super::{LocalSurface, ShapeError, ShapeHit, finite};
-use crate::math::{Aabb, DVec2, Ray, Vec3, gamma, unit};
+use super::{LocalSurface, ShapeError, ShapeHit, finite, not_tiny};
+use crate::math::{Aabb, DVec2, Ray, Vec3, gamma, magnitude, unit};
 
 /// Vertices count as collinear when twice the polygon's area is below this
 /// fraction of `Σ |wᵢ| |wᵢ₊₁|` (`wᵢ = vᵢ - v0`): the normal would be
@@ -72,18 +72,38 @@ impl Polygon {
             finite("vertex", v)?;
         }
 
+        not_tiny(
+            "the polygon's size",
+            vertices.iter().map(|&v| magnitude::norm(v - v0)),
+        )?;
+
         // Newell's normal, from vertices relative to v0 so that polygons far
-        // from the origin lose no precision.
-        let mut newell = Vec3::ZERO;
-        let mut scale = 0.0;
-        for pair in vertices.windows(2) {
-            let (a, b) = (pair[0] - v0, pair[1] - v0);
-            newell += a.cross(b);
-            scale += a.length() * b.length();
-        }
-        let normal = unit(newell)
-            .filter(|_| newell.length() > COLLINEAR * scale)
-            .ok_or(degenerate("it has no area (its vertices are collinear)"))?;
+        // from the origin lose no precision. Its terms are each parallel to
+        // the plane's normal; in an outline that crosses itself (a bow tie)
+        // they may cancel, and then the terms turned to agree with the
+        // largest one give the plane instead.
+        let terms: Vec<Vec3> = vertices
+            .windows(2)
+            .map(|pair| (pair[0] - v0).cross(pair[1] - v0))
+            .collect();
+        let scale: f64 = vertices
+            .windows(2)
+            .map(|pair| (pair[0] - v0).length() * (pair[1] - v0).length())
+            .sum();
+        let has_area = |sum: Vec3| unit(sum).filter(|_| sum.length() > COLLINEAR * scale);
+        let newell: Vec3 = terms.iter().sum();
+        let largest = terms
+            .iter()
+            .copied()
+            .max_by(|a, b| a.length_squared().total_cmp(&b.length_squared()))
+            .unwrap_or(Vec3::ZERO);
+        let aligned: Vec3 = terms
+            .iter()
+            .map(|&t| if t.dot(largest) < 0.0 { -t } else { t })
+            .sum();
+        let normal = has_area(newell)
+            .or_else(|| has_area(aligned))
+            .ok_or(degenerate("its vertices are collinear"))?;
 
         let bounds = Aabb::from_points(vertices.iter().copied());
         let largest = bounds.min.abs().max(bounds.max.abs()).max_element();
@@ -110,7 +130,7 @@ impl Polygon {
             .map(in_plane)
             .filter(|edge| edge.length() >= SHORT_EDGE * longest)
             .find_map(unit)
-            .ok_or(degenerate("it has no area (its vertices are collinear)"))?;
+            .ok_or(degenerate("its vertices are collinear"))?;
 
         let dropped = normal.abs().max_position();
         let axes = [(dropped + 1) % 3, (dropped + 2) % 3];
@@ -393,7 +413,7 @@ mod tests {
             })
         };
         let few = "it needs at least three vertices";
-        let flat = "it has no area (its vertices are collinear)";
+        let flat = "its vertices are collinear";
         assert_eq!(Polygon::new(vec![]), degenerate(few));
         assert_eq!(Polygon::new(vec![Vec3::ZERO, Vec3::X]), degenerate(few));
         let line = (0..5)
@@ -409,6 +429,30 @@ mod tests {
             ]),
             Err(ShapeError::NotFinite { what: "vertex" })
         );
+    }
+
+    #[test]
+    fn a_bow_tie_covers_its_two_lobes_by_the_even_odd_rule() {
+        let bow_tie = [[0.0, 0.0], [2.0, 2.0], [2.0, 0.0], [0.0, 2.0]]
+            .map(|[x, y]| Vec3::new(x, y, 0.0))
+            .to_vec();
+        let polygon = Polygon::new(bow_tie).unwrap();
+        assert_eq!(polygon.normal.abs(), Vec3::Z);
+        let hits = |x, y| polygon.occluded(&Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z));
+        assert!(hits(1.5, 1.0) && hits(0.5, 1.0));
+        assert!(!hits(1.0, 0.3) && !hits(1.0, 1.7));
+    }
+
+    #[test]
+    fn a_polygon_too_small_to_square_is_refused_as_out_of_range() {
+        let tiny = [Vec3::ZERO, Vec3::X, Vec3::Y].map(|v| v * 1e-300).to_vec();
+        assert!(matches!(
+            Polygon::new(tiny),
+            Err(ShapeError::OutOfRange {
+                error: magnitude::MagnitudeError::TooSmall { .. },
+                ..
+            })
+        ));
     }
 
     #[test]

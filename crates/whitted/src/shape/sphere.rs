@@ -177,6 +177,20 @@ mod tests {
     }
 
     #[test]
+    fn radii_whose_squares_overflow_or_underflow_are_refused() {
+        for radius in [2e154, 1e-200] {
+            assert!(matches!(
+                Sphere::new(Vec3::ZERO, radius),
+                Err(ShapeError::OutOfRange { what: "radius", .. })
+            ));
+        }
+        assert!(matches!(
+            Sphere::new(Vec3::new(0.0, 1e40, 0.0), 1.0),
+            Err(ShapeError::OutOfRange { what: "center", .. })
+        ));
+    }
+
+    #[test]
     fn culling_passed_spheres_never_changes_the_hit() {
         let mut rng = crate::math::random::Rng::new(11);
         let mut culled = 0;

@@ -15,8 +15,8 @@
 //! edge shared by two triangles hits at least one of them, and a ray leaving
 //! the surface is never taken to hit it again.
 
-use super::{LocalSurface, ShapeError, ShapeHit, finite};
-use crate::math::{Aabb, DVec2, Ray, Vec3, gamma};
+use super::{LocalSurface, ShapeError, ShapeHit, finite, not_tiny};
+use crate::math::{Aabb, DVec2, Ray, Vec3, gamma, magnitude};
 
 /// Vertices count as collinear when the sine of the angle at `p0` is below
 /// this: such a needle's normal would be rounding noise.
@@ -40,6 +40,10 @@ impl Triangle {
             finite("vertex", p2)?,
         );
         let (edge1, edge2) = (p1 - p0, p2 - p0);
+        not_tiny(
+            "the longest edge",
+            [edge1, edge2, p2 - p1].map(magnitude::norm),
+        )?;
         let cross = edge1.cross(edge2);
         let flat = cross.length() <= COLLINEAR * edge1.length() * edge2.length();
         if flat || cross.try_normalize().is_none() {

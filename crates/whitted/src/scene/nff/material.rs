@@ -16,8 +16,8 @@
 //! | ior | `ior` when `T > 0`; 1 otherwise (opaque files may put 0 there) |
 
 use super::reader::{Parsed, Reader};
-use crate::shading::Color;
 use crate::shading::Material;
+use crate::shading::{Color, factor};
 
 /// The global ambient light `Ia`, white: small, but present on every
 /// surface, as the SPD asks (NFF itself has no ambient term).
@@ -86,6 +86,13 @@ pub(super) fn read_fill(r: &mut Reader<'_>) -> Parsed<Fill> {
             ),
         ));
     }
+    if let Err(error) = factor::divisor(ior) {
+        let span = r.since(ior_start);
+        return Err(r.error(
+            span,
+            format!("the material's index of refraction is out of range: {error}"),
+        ));
+    }
     Ok(Fill {
         color,
         kd,
@@ -107,7 +114,13 @@ fn weight(r: &mut Reader<'_>, name: &str) -> Parsed<f64> {
             format!("the material's {name} must not be negative, got {value}"),
         ));
     }
-    Ok(value)
+    factor::factor(value).map_err(|error| {
+        let span = r.since(start);
+        r.error(
+            span,
+            format!("the material's {name} is out of range: {error}"),
+        )
+    })
 }
 
 #[cfg(test)]

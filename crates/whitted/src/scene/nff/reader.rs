@@ -12,9 +12,9 @@ use std::ops::Range;
 use std::path::Path;
 
 use super::lexer::{Lexer, Token, is_entity_keyword};
-use crate::math::Vec3;
+use crate::math::{Vec3, magnitude};
 use crate::scene::{Diagnostic, Severity, WholeNumberError, parse_whole_number, push_limited};
-use crate::shading::Color;
+use crate::shading::{Color, factor};
 
 /// A problem that has been recorded; the entity being read is abandoned.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -116,11 +116,15 @@ impl<'a> Reader<'a> {
         Err(self.error(span, format!("expected {kind} for {what}, found {found}")))
     }
 
-    /// A finite number, for `what` ("the sphere's radius").
+    /// A finite number within ±[`magnitude::MAX_COORDINATE`] (beyond it,
+    /// squares in intersection overflow), for `what` ("the sphere's
+    /// radius").
     pub(super) fn number(&mut self, what: &str) -> Parsed<f64> {
         let token = self.take("a number", what)?;
         match token.text.parse::<f64>() {
-            Ok(value) if value.is_finite() => Ok(value),
+            Ok(value) if value.is_finite() => magnitude::coordinate(value).map_err(|error| {
+                self.error(token.span, format!("{what} is out of range: {error}"))
+            }),
             Ok(_) => Err(self.error(
                 token.span,
                 format!(
@@ -144,13 +148,18 @@ impl<'a> Reader<'a> {
         ))
     }
 
-    /// Three numbers that are not negative, for the colour `what`.
+    /// Three numbers that are not negative and at most
+    /// [`factor::MAX_FACTOR`], for the colour `what`.
     pub(super) fn color(&mut self, what: &str) -> Parsed<Color> {
         let start = self.next_start();
         let color = Color::from(self.vec3(what)?.to_array());
         if color.min_element() < 0.0 {
             let span = self.since(start);
             return Err(self.error(span, format!("{what} must not be negative, got {color}")));
+        }
+        if let Err(error) = factor::factor(color.max_element()) {
+            let span = self.since(start);
+            return Err(self.error(span, format!("{what} is out of range: {error}")));
         }
         Ok(color)
     }

@@ -19,7 +19,7 @@
 use std::ops::Range;
 
 use super::reader::{Parsed, Reader};
-use crate::math::{Transform, Vec3};
+use crate::math::{Transform, Vec3, magnitude};
 use crate::shape::{Cone, Cylinder, Polygon, Shape, ShapeError, Sphere, Triangle};
 
 /// A shape and where its object space sits in the world.
@@ -77,10 +77,12 @@ pub(super) fn read_cone(r: &mut Reader<'_>, at: Range<usize>) -> Parsed<Placed> 
             "the cone's base and apex are the same point: it has no height",
         ));
     }
+    // Measured without squaring: an axis 1e-300 long is refused as such.
+    let height = magnitude::norm(axis);
     let shape = if base_radius == apex_radius {
-        Cylinder::new(base_radius, axis.length(), false).map(Shape::Cylinder)
+        Cylinder::new(base_radius, height, false).map(Shape::Cylinder)
     } else {
-        Cone::new(base_radius, apex_radius, axis.length(), false).map(Shape::Cone)
+        Cone::new(base_radius, apex_radius, height, false).map(Shape::Cone)
     };
     let shape = shape.map_err(|e| refused(r, at.start, e))?;
     let placement = Transform::frame(base, axis).map_err(|e| refused(r, at.start, e))?;

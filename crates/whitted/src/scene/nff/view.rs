@@ -53,7 +53,7 @@ pub(super) fn edge_to_edge_fov(angle: f64, rows: u32) -> f64 {
 
 /// Reads the `v` block; `at` is the span of the `v` keyword.
 pub(super) fn read_view(r: &mut Reader<'_>, at: Range<usize>) -> Parsed<View> {
-    let (from, _) = line(r, "from")?;
+    let (from, from_span) = line(r, "from")?;
     let (look_at, at_span) = line(r, "at")?;
     let (up, up_span) = line(r, "up")?;
     r.word("angle")?;
@@ -94,7 +94,11 @@ pub(super) fn read_view(r: &mut Reader<'_>, at: Range<usize>) -> Parsed<View> {
                 up_span,
                 "the view's `up` is zero or parallel to the view direction",
             ),
-            CameraError::BadFov(_) | CameraError::NotFinite => (
+            CameraError::OutOfRange { what: "eye", .. } => {
+                (from_span, "the view's `from` is out of range")
+            }
+            CameraError::OutOfRange { .. } => (at_span, "the view's `at` is out of range"),
+            CameraError::BadFov(_) | CameraError::NotFinite | CameraError::ModelOutOfRange(_) => (
                 at,
                 "the view's `angle` is too close to 180 degrees for this resolution",
             ),

@@ -14,6 +14,7 @@ use crate::shading::Bump;
 use crate::shading::Color;
 use crate::shading::Material;
 use crate::shading::Texture;
+use crate::shading::factor::{self, FactorError};
 use crate::shading::texture::{Decoding, DissolveMap, ImageCache, ImageData, ImageTexture};
 
 /// The materials of one library by name, or its errors; with its warnings.
@@ -60,6 +61,21 @@ pub(super) fn read_library(source: &str, path: &Path, images: &mut ImageCache) -
     }
 }
 
+/// Why the number `word` of a colour statement (`Kd`, `Ke` ...) or of `Ni`
+/// is out of range for radiance, if it is: a colour component beyond
+/// [`factor::MAX_FACTOR`] in magnitude, an index of refraction outside
+/// [`factor::divisor`]'s range.
+fn out_of_range(keyword: &str, word: &str) -> Option<FactorError> {
+    let value = word.parse::<f64>().ok()?;
+    if COLORS.contains(&keyword) {
+        factor::factor(value).err()
+    } else if keyword == "Ni" {
+        factor::divisor(value).err()
+    } else {
+        None
+    }
+}
+
 fn is_error(d: &Diagnostic) -> bool {
     d.severity == crate::scene::Severity::Error
 }
@@ -93,14 +109,18 @@ fn check(source: &str, path: &Path) -> Vec<Diagnostic> {
             } else {
                 word.parse::<f64>().is_ok_and(f64::is_finite)
             };
-            if ok && COLORS.contains(&keyword) && word.parse::<f64>().is_ok_and(|v| v < 0.0) {
+            let problem = if COLORS.contains(&keyword) && word.parse::<f64>().is_ok_and(|v| v < 0.0)
+            {
+                Some(format!(
+                    "the colour `{keyword}` must not be negative, got {word}"
+                ))
+            } else {
+                out_of_range(keyword, word)
+                    .map(|error| format!("`{keyword}` {word} is out of range: {error}"))
+            };
+            if ok && let Some(message) = problem {
                 push_limited(&mut diagnostics, Severity::Error, || {
-                    Diagnostic::new(
-                        path,
-                        source,
-                        span,
-                        format!("the colour `{keyword}` must not be negative, got {word}"),
-                    )
+                    Diagnostic::new(path, source, span, message)
                 });
                 found = wanted;
                 break;

@@ -8,7 +8,7 @@ use std::ops::Range;
 use std::path::Path;
 
 use super::text::{Line, Words, lines};
-use crate::math::{DVec2, Vec3};
+use crate::math::{DVec2, Vec3, magnitude};
 use crate::scene::{Diagnostic, Severity, push_limited};
 
 /// An absent index (a corner without texture coordinates or normal).
@@ -147,7 +147,8 @@ impl Reader<'_> {
         };
     }
 
-    /// At least `min` finite numbers, the first three returned (missing
+    /// At least `min` finite numbers within ±[`magnitude::MAX_COORDINATE`]
+    /// (beyond it, a model's size cannot be squared), the first three returned (missing
     /// ones as zero); numbers after them (a `w`, a vertex colour) are
     /// ignored. A problem is recorded and gives zeros.
     fn numbers(
@@ -166,6 +167,10 @@ impl Reader<'_> {
             };
             if !value.is_finite() {
                 self.error(span, format!("`{word}` is not a finite number"));
+                return [0.0; 3];
+            }
+            if let Err(error) = magnitude::coordinate(value) {
+                self.error(span, format!("`{word}` is out of range: {error}"));
                 return [0.0; 3];
             }
             if let Some(slot) = values.get_mut(count) {

@@ -131,9 +131,10 @@ fn find_kind(
         })
 }
 
-/// `[constant, linear, quadratic]`, none negative, not all zero.
+/// `[constant, linear, quadratic]`, none negative, not all zero, each a
+/// [`Reader::divisor`] (the light is divided by their sum).
 fn attenuation(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Attenuation> {
-    let [constant, linear, quadratic] = r.numbers::<3>(value, key, Reader::non_negative)?;
+    let [constant, linear, quadratic] = r.numbers::<3>(value, key, Reader::divisor)?;
     if constant + linear + quadratic == 0.0 {
         return Err(r.error(
             value.span,

@@ -40,7 +40,7 @@
 use toml_span::value::Value;
 
 use super::reader::{Fields, Parsed, Reader, all};
-use crate::math::DVec2;
+use crate::math::{DVec2, magnitude};
 use crate::shading::Bump;
 use crate::shading::Color;
 use crate::shading::Material;
@@ -111,7 +111,10 @@ fn read_material(r: &mut Reader<'_>, value: &Value<'_>, name: &str) -> Parsed<Ma
     let transmission = r.or_default(&f, "transmission", Texture::default(), texture);
     let emission = r.or_default(&f, "emission", Texture::default(), texture);
     let shininess = r.or_default(&f, "shininess", 32.0, Reader::non_negative);
-    let ior = r.or_default(&f, "ior", 1.0, Reader::positive);
+    let ior = r.or_default(&f, "ior", 1.0, |r, value, key| {
+        let ior = r.positive(value, key)?;
+        r.divisor(value, key).map(|_| ior)
+    });
     let fresnel = r.or_default(&f, "fresnel", false, Reader::boolean);
     let normal_map = r.optional(&f, "normal_map", normal_map);
     let bump_map = r.optional(&f, "bump_map", bump_map);
@@ -214,10 +217,10 @@ fn placed_image(
     });
     let wrap = r.or_default(f, "wrap", Wrap::Repeat, wrap);
     let scale = r.or_default(f, "scale", [1.0, 1.0], |r, v, k| {
-        r.numbers::<2>(v, k, Reader::number)
+        r.numbers::<2>(v, k, Reader::coordinate)
     });
     let offset = r.or_default(f, "offset", [0.0, 0.0], |r, v, k| {
-        r.numbers::<2>(v, k, Reader::number)
+        r.numbers::<2>(v, k, Reader::coordinate)
     });
     Ok(ImageTexture {
         data: data?,
@@ -232,7 +235,7 @@ fn normal_map(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Bump> 
     let f = r.table(value, key, format!("`{key}`"))?;
     let keys = r.check_keys(&f, &[&IMAGE_KEYS[..], &["strength", "flip_green"]].concat());
     let image = placed_image(r, &f, Decoding::Data);
-    let strength = r.or_default(&f, "strength", 1.0, Reader::number);
+    let strength = r.or_default(&f, "strength", 1.0, Reader::coordinate);
     let flip_green = r.or_default(&f, "flip_green", false, Reader::boolean);
     keys?;
     Ok(Bump::Normal {
@@ -247,7 +250,7 @@ fn bump_map(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Bump> {
     let f = r.table(value, key, format!("`{key}`"))?;
     let keys = r.check_keys(&f, &[&IMAGE_KEYS[..], &["strength"]].concat());
     let image = placed_image(r, &f, Decoding::Data);
-    let strength = r.or_default(&f, "strength", 1.0, Reader::number);
+    let strength = r.or_default(&f, "strength", 1.0, Reader::coordinate);
     keys?;
     Ok(Bump::Height {
         texture: Texture::Image(image?),
@@ -275,7 +278,11 @@ fn checker(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Texture> 
     let keys = r.check_keys(&f, &["even", "odd", "size"]);
     let even = r.require(&f, "even", Reader::color);
     let odd = r.require(&f, "odd", Reader::color);
-    let size = r.or_default(&f, "size", 1.0, Reader::positive);
+    let size = r.or_default(&f, "size", 1.0, |r, value, key| {
+        let size = r.positive(value, key)?;
+        magnitude::length(size)
+            .map_err(|error| r.error(value.span, format!("`{key}` is out of range: {error}")))
+    });
     keys?;
     Ok(Texture::Checker(Checker {
         even: even?,

@@ -259,7 +259,8 @@ fn read_camera(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Camera> {
             CameraError::NoViewDirection => Some("look_at"),
             CameraError::BadUp => Some("up"),
             CameraError::BadFov(_) => Some("fov"),
-            CameraError::NotFinite => None,
+            CameraError::OutOfRange { what, .. } => Some(what),
+            CameraError::NotFinite | CameraError::ModelOutOfRange(_) => None,
         };
         let span = key.map_or(f.span(), |key| r.value_span(&f, key));
         r.error(span, error.to_string())

@@ -22,7 +22,7 @@ use toml_span::value::Value;
 
 use super::reader::{Parsed, Reader, all, list};
 use super::shapes;
-use crate::math::{Transform, TransformError, Vec3};
+use crate::math::{Transform, TransformError, Vec3, magnitude};
 use crate::shape::Shape;
 
 /// An object read from the file.
@@ -81,10 +81,22 @@ fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> P
     let placed = shapes::build(kind, r, &f, kind_span);
     keys?;
     let placed = placed?;
+    let transform = transform?.then_after(&placed.placement);
+    let world = transform.bounds_to_world(&placed.shape.bounds());
+    if world.is_finite() {
+        let reach = world.min.abs().max(world.max.abs()).max_element();
+        if let Err(error) = magnitude::coordinate(reach) {
+            let span = r.value_span(&f, "transform");
+            return Err(r.error(
+                span,
+                format!("the object reaches out of range in the world: {error}"),
+            ));
+        }
+    }
     Ok(Object {
         shape: placed.shape,
         material: material?,
-        transform: transform?.then_after(&placed.placement),
+        transform,
     })
 }
 

@@ -13,10 +13,10 @@ use toml_span::Span;
 use toml_span::value::{Key, Table, Value};
 
 use crate::image::ColorSpace;
-use crate::math::{Vec3, unit};
+use crate::math::{Vec3, magnitude, unit};
 use crate::scene::{Diagnostic, SceneError, Severity, push_limited};
-use crate::shading::Color;
 use crate::shading::texture::{Decoding, ImageCache, ImageData};
+use crate::shading::{Color, factor};
 
 /// A value was wrong and its error has been recorded. Only [`Reader::error`]
 /// makes one, so a failed walk always has at least one diagnostic.
@@ -433,10 +433,17 @@ impl<'s> Reader<'s> {
         Ok(array)
     }
 
-    /// A point or vector `[x, y, z]`.
+    /// A point or vector `[x, y, z]`, each number within
+    /// ±[`magnitude::MAX_COORDINATE`].
     pub(super) fn vec3(&mut self, value: &Value<'_>, key: &str) -> Parsed<Vec3> {
-        self.numbers::<3>(value, key, Self::number)
+        self.numbers::<3>(value, key, Self::coordinate)
             .map(Vec3::from_array)
+    }
+
+    /// A finite number within ±[`magnitude::MAX_COORDINATE`].
+    pub(super) fn coordinate(&mut self, value: &Value<'_>, key: &str) -> Parsed<f64> {
+        let number = self.number(value, key)?;
+        magnitude::coordinate(number).map_err(|error| self.out_of_range(value, key, error))
     }
 
     /// A list of points `[[x, y, z], ...]`.
@@ -448,18 +455,42 @@ impl<'s> Reader<'s> {
     /// A non-zero vector `[x, y, z]`, normalised. Only `[0, 0, 0]` is
     /// refused: however short or long, any other vector has a direction.
     pub(super) fn direction(&mut self, value: &Value<'_>, key: &str) -> Parsed<Vec3> {
-        let v = self.vec3(value, key)?;
+        let v = Vec3::from_array(self.numbers::<3>(value, key, Self::number)?);
         unit(v)
             .ok_or_else(|| self.error(value.span, format!("`{key}` must not be the zero vector")))
     }
 
-    /// A colour: `[r, g, b]` or one number for a grey, never negative.
+    /// A factor of radiance: a number `>= 0` and at most
+    /// [`factor::MAX_FACTOR`].
+    pub(super) fn factor(&mut self, value: &Value<'_>, key: &str) -> Parsed<f64> {
+        let number = self.non_negative(value, key)?;
+        factor::factor(number).map_err(|error| self.out_of_range(value, key, error))
+    }
+
+    /// A number that divides radiance: `0`, or positive within
+    /// [`factor::divisor`]'s range.
+    pub(super) fn divisor(&mut self, value: &Value<'_>, key: &str) -> Parsed<f64> {
+        let number = self.non_negative(value, key)?;
+        factor::divisor(number).map_err(|error| self.out_of_range(value, key, error))
+    }
+
+    /// Records "`key` is out of range: `error`" at `value`.
+    fn out_of_range(
+        &mut self,
+        value: &Value<'_>,
+        key: &str,
+        error: impl std::fmt::Display,
+    ) -> Reported {
+        self.error(value.span, format!("`{key}` is out of range: {error}"))
+    }
+
+    /// A colour: `[r, g, b]` or one number for a grey, never negative, each
+    /// component a [`Reader::factor`].
     pub(super) fn color(&mut self, value: &Value<'_>, key: &str) -> Parsed<Color> {
         if value.as_array().is_some() {
-            self.numbers::<3>(value, key, Self::non_negative)
-                .map(Color::from)
+            self.numbers::<3>(value, key, Self::factor).map(Color::from)
         } else if value.as_integer().is_some() || value.as_float().is_some() {
-            self.non_negative(value, key).map(Color::splat)
+            self.factor(value, key).map(Color::splat)
         } else {
             Err(self.wrong_type(value, key, "a colour ([r, g, b] or a number)"))
         }

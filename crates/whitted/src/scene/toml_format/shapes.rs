@@ -34,7 +34,7 @@ use toml_span::Span;
 use toml_span::value::Value;
 
 use super::reader::{Fields, Parsed, Reader, Reported, both, list};
-use crate::math::{Transform, Vec3};
+use crate::math::{Transform, Vec3, magnitude};
 use crate::shape::{
     AxisBox, Cone, Cylinder, Disk, Parallelogram, Plane, Polygon, Shape, ShapeError, Sphere,
     Triangle, non_negative, positive,
@@ -149,7 +149,8 @@ fn refused(r: &mut Reader<'_>, f: &Fields<'_, '_>, fallback: Span, error: ShapeE
     let named = match &error {
         ShapeError::NotPositive { what, .. }
         | ShapeError::Negative { what, .. }
-        | ShapeError::NotFinite { what } => f.get(what),
+        | ShapeError::NotFinite { what }
+        | ShapeError::OutOfRange { what, .. } => f.get(what),
         ShapeError::Degenerate { .. } | ShapeError::NotPlanar { .. } => None,
     };
     let span = named.map_or(fallback, |value| r.span_of(value));
@@ -262,8 +263,8 @@ fn cylinder(r: &mut Reader<'_>, f: &Fields<'_, '_>, at: Span) -> Parsed<Placed> 
 
 fn cone(r: &mut Reader<'_>, f: &Fields<'_, '_>, at: Span) -> Parsed<Placed> {
     let axis = axis(r, f);
-    let base_radius = r.require(f, "base_radius", Reader::non_negative);
-    let top_radius = r.require(f, "top_radius", Reader::non_negative);
+    let base_radius = measure(r, f, "base_radius", non_negative);
+    let top_radius = measure(r, f, "top_radius", non_negative);
     let caps = r.or_default(f, "caps", true, Reader::boolean);
     let (base, axis) = axis?;
     let placement = frame(r, base, axis, at);
@@ -285,17 +286,25 @@ fn axis_box(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Placed> {
 }
 
 /// `base` and `top - base` of a cylinder or cone; an error at `top` when the
-/// two points coincide.
+/// two points coincide or the height between them is out of range.
 fn axis(r: &mut Reader<'_>, f: &Fields<'_, '_>) -> Parsed<(Vec3, Vec3)> {
     let base = r.require(f, "base", Reader::vec3);
     let top = r.require(f, "top", Reader::vec3);
     let (base, top) = (base?, top?);
     let axis = top - base;
-    if axis == Vec3::ZERO || !axis.is_finite() {
+    if axis == Vec3::ZERO {
         let span = r.value_span(f, "top");
         return Err(r.error(
             span,
             "`top` must differ from `base`: the shape has no height",
+        ));
+    }
+    let height = magnitude::norm(axis);
+    if let Err(error) = magnitude::length(height) {
+        let span = r.value_span(f, "top");
+        return Err(r.error(
+            span,
+            format!("the height from `base` to `top` is out of range: {error}"),
         ));
     }
     Ok((base, axis))
@@ -489,7 +498,7 @@ mod tests {
                 "`top` must differ from `base`: the shape has no height",
                 "radius must be a positive number, got 0",
                 "expected `true` or `false` for `caps`, found a string",
-                "`base_radius` must not be negative, got -1",
+                "base_radius must not be negative, got -1",
                 "degenerate cone: both radii are zero",
                 "degenerate box: min must be below max on every axis",
             ]
