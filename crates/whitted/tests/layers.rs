@@ -2,6 +2,10 @@
 //! name (`crate::x`) only modules of its own layer or of the layers before
 //! it. ARCHITECTURE.md draws the same list and says why.
 //!
+//! One more rule is checked on the same code: files are read only through
+//! `limits` (regular files, bounded by the memory budget), so that no
+//! reader can eat memory from a `/dev/zero` or a huge file.
+//!
 //! Test code is exempt (a test may build its inputs with anything): the
 //! `#[cfg(test)]` module at the end of a file, and files that are only test
 //! helpers. Plain comments are skipped; doc links are checked like code.
@@ -213,6 +217,49 @@ fn every_module_imports_only_from_its_layer_or_the_ones_below() {
     assert!(
         found.is_empty(),
         "imports against the layers (see ARCHITECTURE.md):\n{}",
+        found.join("\n")
+    );
+}
+
+/// Calls that read a file's contents; outside `limits/` the library reads
+/// through `limits::read_input` and `limits::read_input_text` instead.
+const UNBOUNDED_READS: &[&str] = &[
+    "fs::read(",
+    "fs::read_to_string(",
+    "File::open(",
+    "OpenOptions::new()",
+    ".read_to_end(",
+    ".read_to_string(",
+];
+
+/// Every unbounded read outside `limits/`, as `file: call`.
+fn unbounded_reads() -> Vec<String> {
+    let root = source_folder();
+    let mut files = Vec::new();
+    rust_files(&root, &mut files);
+    let mut found = Vec::new();
+    for file in files {
+        let relative = file.strip_prefix(&root).unwrap();
+        let name = file.file_name().unwrap().to_str().unwrap();
+        if relative.starts_with("limits") || TEST_FILES.contains(&name) {
+            continue;
+        }
+        let code = code_of(&std::fs::read_to_string(&file).unwrap());
+        for call in UNBOUNDED_READS {
+            if code.contains(call) {
+                found.push(format!("{}: {call}", relative.display()));
+            }
+        }
+    }
+    found
+}
+
+#[test]
+fn files_are_read_only_through_limits() {
+    let found = unbounded_reads();
+    assert!(
+        found.is_empty(),
+        "files read without the limits of `limits::read_input`:\n{}",
         found.join("\n")
     );
 }
