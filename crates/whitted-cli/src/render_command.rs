@@ -136,9 +136,9 @@ fn parse_aov(spec: &str) -> Result<(Aov, PathBuf), String> {
 /// Refuses, before any work, outputs that cannot be written (see
 /// [`check_destination`]: names that are no image file, missing or
 /// unwritable folders, files the user may not write) and two outputs to
-/// the same file (by canonical path and by file identity); says what the
-/// user should know about the files that will be replaced.
-fn check_destinations(output: &Path, aovs: &[(Aov, PathBuf)]) -> Result<(), String> {
+/// the same file (by canonical path and by file identity); unless `quiet`,
+/// says what the user should know about the files that will be replaced.
+fn check_destinations(output: &Path, aovs: &[(Aov, PathBuf)], quiet: bool) -> Result<(), String> {
     let image = check_destination(output).map_err(|e| e.to_string())?;
     let mut checked = vec![(format!("-o {}", output.display()), image)];
     for (aov, path) in aovs {
@@ -154,7 +154,7 @@ fn check_destinations(output: &Path, aovs: &[(Aov, PathBuf)]) -> Result<(), Stri
         }
         checked.push((option, destination));
     }
-    for (_, destination) in &checked {
+    for (_, destination) in checked.iter().filter(|_| !quiet) {
         for warning in destination.notes() {
             note!("warning: {warning}");
         }
@@ -196,7 +196,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         .iter()
         .map(|s| parse_aov(s))
         .collect::<Result<Vec<_>, _>>()?;
-    check_destinations(&args.output, &aov_outputs)?;
+    check_destinations(&args.output, &aov_outputs, args.quiet)?;
 
     let options = LoadOptions {
         camera: camera_override(args),
