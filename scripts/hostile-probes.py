@@ -23,37 +23,8 @@ import tempfile
 import time
 import zlib
 
-GLASS_IN_MIRRORS = """
-[render]
-width = 32
-height = 24
-[camera]
-eye = [0, 0, -0.9]
-look_at = [0, 0, 0]
-fov = 60
-[materials.mirror]
-diffuse = 0.1
-reflection = 1
-[materials.glass]
-diffuse = 0.0
-reflection = 1
-transmission = 1
-ior = 1.5
-[[lights]]
-type = "point"
-position = [0, 0.5, -0.5]
-intensity = 1
-[[objects]]
-shape = "box"
-min = [-1, -1, -1]
-max = [1, 1, 1]
-material = "mirror"
-[[objects]]
-shape = "sphere"
-center = [0, 0, 0]
-radius = 0.5
-material = "glass"
-"""
+REPOSITORY = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+GLASS_IN_MIRRORS = os.path.join(REPOSITORY, "crates/whitted/tests/hostile_scenes/glass_in_mirrors.toml")
 
 SCENE_HEAD = """
 [camera]
@@ -122,7 +93,8 @@ def setup_zero(d):
 
 
 def setup_mirrors(d):
-    write(d, "m.toml", GLASS_IN_MIRRORS)
+    with open(GLASS_IN_MIRRORS) as f:
+        write(d, "m.toml", f.read())
 
 
 def setup_usemtl(d):
@@ -227,7 +199,7 @@ PROBES = [
     ("5", "16384² with 4 AOVs", None, ["render", "--width", "16384", "--height", "16384", "--aov", "depth=d.exr",
                                         "--aov", "normal=n.exr", "--aov", "id=i.exr", "--aov", "cost=c.exr"], None),
     ("6", "--threads 100000", None, ["render", "--width", "64", "--height", "48", "--threads", "100000"], None),
-    ("7", "glass in mirrors, depth 40", setup_mirrors, ["render", "m.toml", "--max-depth", "40"], None),
+    ("7", "glass in mirrors, depth 40", setup_mirrors, ["render", "m.toml", "--width", "32", "--height", "24"], None),
     ("8", "200000 usemtl, --quiet", setup_usemtl, ["render", "many.obj", "--quiet", "--width", "32", "--height", "24"], None),
     ("10", "-o a.pfm --aov depth=./a.pfm", setup_outputs, ["render", "-o", "a.pfm", "--aov", "depth=./a.pfm"], None),
     ("11", "SIGINT while writing", None, ["render", "--width", "2000", "--height", "2000", "-o", "x.exr"], "sigint"),

@@ -356,40 +356,10 @@ fn a_hundred_thousand_threads_are_clamped_to_what_helps() {
 #[test]
 fn a_glass_ball_in_a_mirror_box_is_cut_at_the_ray_budget_with_one_warning() {
     let dir = tempfile::tempdir().unwrap();
-    write(
-        dir.path(),
-        "box.toml",
-        r#"[render]
-width = 8
-height = 8
-max_depth = 40
-[camera]
-eye = [0, 0, -1.8]
-look_at = [0, 0, 0]
-fov = 40
-[materials.mirror]
-reflection = 1
-[materials.glass]
-reflection = 1
-transmission = 1
-ior = 1.5
-[[lights]]
-type = "point"
-position = [0, 1, -1]
-[[objects]]
-shape = "box"
-min = [-2, -2, -2]
-max = [2, 2, 2]
-material = "mirror"
-[[objects]]
-shape = "sphere"
-center = [0, 0, 0]
-radius = 1.5
-material = "glass"
-"#,
-    );
     let start = Instant::now();
-    let p = probe(&["render", "box.toml"], dir.path());
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../whitted/tests/hostile_scenes/glass_in_mirrors.toml");
+    let p = probe(&["render", scene.to_str().unwrap()], dir.path());
     let elapsed = start.elapsed();
     assert_eq!(p.code(), Some(0), "{}", p.stderr);
     assert_eq!(p.stderr.matches("warning").count(), 1, "{}", p.stderr);

@@ -404,38 +404,14 @@ mod tests {
 
     /// A glass ball that reflects and transmits everything, in a mirror
     /// box: its ray tree grows at every bounce and no weight decays.
-    const GLASS_IN_MIRRORS: &str = r#"
-        [render]
-        width = 4
-        height = 4
-        max_depth = 40
-        [camera]
-        eye = [0, 0, -1.8]
-        look_at = [0, 0, 0]
-        fov = 40
-        [materials.mirror]
-        reflection = 1
-        [materials.glass]
-        reflection = 1
-        transmission = 1
-        ior = 1.5
-        [[lights]]
-        type = "point"
-        position = [0, 1, -1]
-        [[objects]]
-        shape = "box"
-        min = [-2, -2, -2]
-        max = [2, 2, 2]
-        material = "mirror"
-        [[objects]]
-        shape = "sphere"
-        center = [0, 0, 0]
-        radius = 1.5
-        material = "glass"
-    "#;
+    const GLASS_IN_MIRRORS: &str = include_str!("../../tests/hostile_scenes/glass_in_mirrors.toml");
 
     fn glass_in_mirrors() -> Scene {
-        crate::scene::parse_scene(GLASS_IN_MIRRORS, std::path::Path::new("box.toml")).unwrap()
+        let mut scene =
+            crate::scene::parse_scene(GLASS_IN_MIRRORS, std::path::Path::new("box.toml")).unwrap();
+        scene.settings.width = 4;
+        scene.settings.height = 4;
+        scene
     }
 
     #[test]
