@@ -13,8 +13,8 @@
 //! the lemon on its surface. Every crossing of the surface therefore enters
 //! or leaves the solid, as the medium stack expects. `R = 0` is the sphere
 //! of radius `r` (the quartic is then a square, its roots double, so it is
-//! traced as a sphere); a major radius below [`MIN_RATIO`] times the minor
-//! one, or a minor one below [`MIN_RATIO`] times the major, is refused: the
+//! traced as a sphere); a major radius below [`Torus::MIN_RATIO`] times the
+//! minor one, or a minor one below it times the major, is refused: the
 //! shell or the tube would be thinner than the quartic resolves.
 //!
 //! **Intersection.** The ray is carried into units of the bounding sphere
@@ -54,10 +54,6 @@ use std::f64::consts::TAU;
 use super::{LocalSurface, ShapeError, ShapeHit, non_negative, positive, quadratic};
 use crate::math::{Aabb, DVec2, Ray, Vec3, gamma, magnitude};
 
-/// The smallest ratio of the major to the minor radius (when the major one
-/// is not zero) and of the minor to the major radius.
-pub const MIN_RATIO: f64 = 1e-4;
-
 /// A torus around the y axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Torus {
@@ -73,6 +69,10 @@ pub struct Torus {
 }
 
 impl Torus {
+    /// The smallest ratio of the major to the minor radius (when the major
+    /// one is not zero) and of the minor to the major radius.
+    pub const MIN_RATIO: f64 = 1e-4;
+
     /// The torus of tube radius `minor` around the circle of radius `major`
     /// in the xz-plane; `minor` must be positive, `major` zero or positive.
     pub fn new(major: f64, minor: f64) -> Result<Self, ShapeError> {
@@ -83,14 +83,14 @@ impl Torus {
             what: "major",
             error,
         })?;
-        if major > 0.0 && major < MIN_RATIO * minor {
+        if major > 0.0 && major < Self::MIN_RATIO * minor {
             return Err(ShapeError::Degenerate {
                 shape: "torus",
                 why: "`major` is non-zero but below 1e-4 times `minor`: the shell between the \
                       lemon and the apple is too thin to trace (use 0 for a sphere)",
             });
         }
-        if minor < MIN_RATIO * major {
+        if minor < Self::MIN_RATIO * major {
             return Err(ShapeError::Degenerate {
                 shape: "torus",
                 why: "`minor` is below 1e-4 times `major`: the tube is too thin to trace",
