@@ -128,7 +128,8 @@ impl Torus {
         let nearest = -origin.dot(dir);
         let middle = origin + nearest * dir;
         let off_axis = middle.length_squared();
-        if !(off_axis <= 1.0 + 1e-12) {
+        // A NaN (from an infinite origin) is refused as well.
+        if off_axis.is_nan() || off_axis > 1.0 + 1e-12 {
             return None;
         }
         let to_t = |s: f64| (nearest + s) * (self.size / length);
@@ -136,7 +137,7 @@ impl Torus {
         let half_chord = (1.0 + 1e-12 - off_axis).sqrt();
         let lo = to_s(ray.t_min).max(-half_chord);
         let hi = to_s(ray.t_max).min(half_chord);
-        if !(lo < hi) {
+        if lo.is_nan() || hi.is_nan() || lo >= hi {
             return None;
         }
         let accept = |s: f64| ray.contains(to_t(s));

@@ -256,7 +256,8 @@ fn hits_agree_with_dense_sampling_on_random_rays() {
         }
     }
     assert!(tangent <= checked / 100, "{tangent} near-tangent rays");
-    println!("largest relative error in t over {checked} rays: {worst:e} ({tangent} near-tangent)");
+    // Measured: 1.2e-12 over 2,000 rays, none near tangency.
+    assert!(worst < 1e-11, "largest relative error in t: {worst:e}");
 }
 
 #[test]
@@ -284,7 +285,8 @@ fn a_camera_1e4_sizes_away_sees_the_same_hits_as_one_3_sizes_away() {
         }
     }
     assert!(differ <= 5, "{differ} rays hit from one distance only");
-    println!("largest relative difference in t: {worst:e}");
+    // Measured: 1.5e-15.
+    assert!(worst < 1e-13, "largest relative difference in t: {worst:e}");
 }
 
 #[test]
