@@ -12,6 +12,7 @@
 //! shape = "cylinder"       # base, top, radius, caps = true
 //! shape = "cone"           # base, base_radius, top, top_radius, caps = true
 //! shape = "box"            # min, max
+//! shape = "torus"          # major, minor (around the y axis, centred at the origin)
 //! ```
 //!
 //! Disks, cylinders and cones are built in canonical position (standing on
@@ -36,7 +37,7 @@ use toml_span::value::Value;
 use super::reader::{Fields, Parsed, Reader, Reported, both, list};
 use crate::math::{Transform, Vec3, magnitude};
 use crate::shape::{
-    AxisBox, Cone, Cylinder, Disk, Parallelogram, Plane, Polygon, Shape, ShapeError, Sphere,
+    AxisBox, Cone, Cylinder, Disk, Parallelogram, Plane, Polygon, Shape, ShapeError, Sphere, Torus,
     Triangle, non_negative, positive,
 };
 
@@ -116,6 +117,11 @@ pub(super) const SHAPE_KINDS: &[ShapeKind] = &[
         name: "box",
         keys: &["min", "max"],
         build: axis_box,
+    },
+    ShapeKind {
+        name: "torus",
+        keys: &["major", "minor"],
+        build: torus,
     },
 ];
 
@@ -283,6 +289,20 @@ fn axis_box(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Placed> {
     let at = r.value_span(f, "max");
     let axis_box = AxisBox::new(min?, max?).map_err(|e| refused(r, f, at, e))?;
     Ok(Placed::in_place(Shape::AxisBox(axis_box)))
+}
+
+fn torus(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Placed> {
+    let major = measure(r, f, "major", non_negative);
+    let minor = measure(r, f, "minor", positive);
+    let (major, minor) = (major?, minor?);
+    let thin = if minor < major * Torus::MIN_RATIO {
+        "minor"
+    } else {
+        "major"
+    };
+    let at = r.value_span(f, thin);
+    let torus = Torus::new(major, minor).map_err(|e| refused(r, f, at, e))?;
+    Ok(Placed::in_place(Shape::Torus(torus)))
 }
 
 /// `base` and `top - base` of a cylinder or cone; an error at `top` when the
