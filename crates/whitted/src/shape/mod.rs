@@ -29,6 +29,7 @@ mod parallelogram;
 mod plane;
 mod polygon;
 mod quadratic;
+mod quadric;
 mod sphere;
 mod triangle;
 mod triangle_clip;
@@ -42,6 +43,7 @@ pub use disk::Disk;
 pub use parallelogram::Parallelogram;
 pub use plane::Plane;
 pub use polygon::Polygon;
+pub use quadric::Quadric;
 pub use sphere::Sphere;
 pub use triangle::{RayShear, Triangle, watertight};
 pub(crate) use triangle_clip::clipped_triangle_bounds;
@@ -230,6 +232,8 @@ pub enum Shape {
     Cone(Cone),
     /// A box aligned with the axes.
     AxisBox(AxisBox),
+    /// A quadric surface, clipped to a box unless it is an ellipsoid.
+    Quadric(Quadric),
 }
 
 const _: () = assert!(std::mem::size_of::<Shape>() <= 80);
@@ -246,6 +250,7 @@ macro_rules! dispatch {
             Shape::Cylinder($s) => $body,
             Shape::Cone($s) => $body,
             Shape::AxisBox($s) => $body,
+            Shape::Quadric($s) => $body,
         }
     };
 }
@@ -285,6 +290,7 @@ impl Shape {
             Shape::Cylinder(_) => "cylinder",
             Shape::Cone(_) => "cone",
             Shape::AxisBox(_) => "box",
+            Shape::Quadric(_) => "quadric",
         }
     }
 }
