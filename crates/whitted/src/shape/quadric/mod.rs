@@ -58,9 +58,6 @@ use self::form::{Extent, Form};
 use super::{LocalSurface, ShapeError, ShapeHit, quadratic};
 use crate::math::{Aabb, DVec2, Ray, Vec3, gamma, magnitude};
 
-/// The names of the coefficients, in order.
-pub const COEFFICIENT_NAMES: [&str; 10] = ["a", "b", "c", "d", "e", "f", "g", "h", "i", "j"];
-
 /// A quadric surface, optionally clipped to a box. Its data is boxed to keep
 /// [`super::Shape`] small.
 #[derive(Clone, Debug, PartialEq)]
@@ -83,6 +80,9 @@ struct Data {
 }
 
 impl Quadric {
+    /// The names of the coefficients in scene files and messages, in order.
+    pub const COEFFICIENTS: [&str; 10] = ["a", "b", "c", "d", "e", "f", "g", "h", "i", "j"];
+
     /// The quadric with `coefficients` `[A, B, C, D, E, F, G, H, I, J]`,
     /// clipped to `clip` when given.
     ///
@@ -93,7 +93,7 @@ impl Quadric {
     /// quadric without a clipping box; an empty (or one-point) ellipsoid;
     /// a clipping box that misses the ellipsoid.
     pub fn new(coefficients: [f64; 10], clip: Option<Aabb>) -> Result<Self, ShapeError> {
-        for (what, value) in COEFFICIENT_NAMES.into_iter().zip(coefficients) {
+        for (what, value) in Self::COEFFICIENTS.into_iter().zip(coefficients) {
             if !value.is_finite() {
                 return Err(ShapeError::NotFinite { what });
             }
