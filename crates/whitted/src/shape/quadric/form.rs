@@ -164,10 +164,9 @@ mod tests {
     fn value_and_gradient_follow_the_coefficients() {
         let f = form([1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0]);
         let p = Vec3::new(1.0, -2.0, 0.5);
-        let expected = 1.0 + 2.0 * 4.0 + 3.0 * 0.25 + 4.0 * -2.0 + 5.0 * 0.5 + 6.0 * -1.0 + 7.0
-            - 16.0
-            + 4.5
-            + 10.0;
+        // A x², B y², C z², D xy, E xz, F yz, G x, H y, I z, J.
+        let terms = [1.0, 8.0, 0.75, -8.0, 2.5, -6.0, 7.0, -16.0, 4.5, 10.0];
+        let expected: f64 = terms.iter().sum();
         assert_eq!(f.value(p), expected);
         let h = 1e-6;
         for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
