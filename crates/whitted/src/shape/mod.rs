@@ -29,6 +29,7 @@ mod parallelogram;
 mod plane;
 mod polygon;
 mod quadratic;
+mod quadric;
 mod sphere;
 mod torus;
 mod triangle;
@@ -43,6 +44,7 @@ pub use disk::Disk;
 pub use parallelogram::Parallelogram;
 pub use plane::Plane;
 pub use polygon::Polygon;
+pub use quadric::Quadric;
 pub use sphere::Sphere;
 pub use torus::Torus;
 pub use triangle::{RayShear, Triangle, watertight};
@@ -234,6 +236,8 @@ pub enum Shape {
     AxisBox(AxisBox),
     /// A torus around the y axis (canonical: centred at the origin).
     Torus(Torus),
+    /// A quadric surface, clipped to a box unless it is an ellipsoid.
+    Quadric(Quadric),
 }
 
 const _: () = assert!(std::mem::size_of::<Shape>() <= 80);
@@ -251,6 +255,7 @@ macro_rules! dispatch {
             Shape::Cone($s) => $body,
             Shape::AxisBox($s) => $body,
             Shape::Torus($s) => $body,
+            Shape::Quadric($s) => $body,
         }
     };
 }
@@ -291,6 +296,7 @@ impl Shape {
             Shape::Cone(_) => "cone",
             Shape::AxisBox(_) => "box",
             Shape::Torus(_) => "torus",
+            Shape::Quadric(_) => "quadric",
         }
     }
 }

@@ -224,6 +224,16 @@ pub fn toml_scene(rng: &mut Rng) -> String {
             "shape = \"box\"\nmin = [-1, -1, -1]\nmax = [{}]",
             several(rng, 3, ", ", positive)
         ),
+        format!(
+            "shape = \"quadric\"\na = {}\nc = {}\nd = {}\ne = {}\nh = -1\nj = {}\n\
+             bounds = [[-1, -1, -1], [{}]]",
+            p(rng),
+            p(rng),
+            w(rng),
+            number(rng),
+            number(rng),
+            several(rng, 3, ", ", positive)
+        ),
     ];
     for shape in shapes {
         let material = ["a", "b"][rng.below(2) as usize];

@@ -13,6 +13,7 @@
 //! shape = "cone"           # base, base_radius, top, top_radius, caps = true
 //! shape = "box"            # min, max
 //! shape = "torus"          # major, minor (around the y axis, centred at the origin)
+//! shape = "quadric"        # a … j = 0, bounds = [[..], [..]] (unless an ellipsoid)
 //! ```
 //!
 //! Disks, cylinders and cones are built in canonical position (standing on
@@ -35,10 +36,10 @@ use toml_span::Span;
 use toml_span::value::Value;
 
 use super::reader::{Fields, Parsed, Reader, Reported, both, list};
-use crate::math::{Transform, Vec3, magnitude};
+use crate::math::{Aabb, Transform, Vec3, magnitude};
 use crate::shape::{
-    AxisBox, Cone, Cylinder, Disk, Parallelogram, Plane, Polygon, Shape, ShapeError, Sphere, Torus,
-    Triangle, non_negative, positive,
+    AxisBox, Cone, Cylinder, Disk, Parallelogram, Plane, Polygon, Quadric, Shape, ShapeError,
+    Sphere, Torus, Triangle, non_negative, positive,
 };
 
 /// A shape in its object space and where that space sits before the
@@ -122,6 +123,11 @@ pub(super) const SHAPE_KINDS: &[ShapeKind] = &[
         name: "torus",
         keys: &["major", "minor"],
         build: torus,
+    },
+    ShapeKind {
+        name: "quadric",
+        keys: &["a", "b", "c", "d", "e", "f", "g", "h", "i", "j", "bounds"],
+        build: quadric,
     },
 ];
 
@@ -303,6 +309,36 @@ fn torus(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Placed> {
     let at = r.value_span(f, thin);
     let torus = Torus::new(major, minor).map_err(|e| refused(r, f, at, e))?;
     Ok(Placed::in_place(Shape::Torus(torus)))
+}
+
+fn quadric(r: &mut Reader<'_>, f: &Fields<'_, '_>, at: Span) -> Parsed<Placed> {
+    let read = Quadric::COEFFICIENTS.map(|key| r.or_default(f, key, 0.0, Reader::coordinate));
+    let clip = r.optional(f, "bounds", clipping_box);
+    let mut coefficients = [0.0; 10];
+    for (coefficient, value) in coefficients.iter_mut().zip(read) {
+        *coefficient = value?;
+    }
+    let quadric = Quadric::new(coefficients, clip?).map_err(|e| refused(r, f, at, e))?;
+    Ok(Placed::in_place(Shape::Quadric(quadric)))
+}
+
+/// A quadric's `bounds`: two corners, the first below the second on every
+/// axis.
+fn clipping_box(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Aabb> {
+    let points = r.points(value, key)?;
+    let Ok([min, max]) = <[Vec3; 2]>::try_from(points) else {
+        return Err(r.error(
+            value.span,
+            format!("expected 2 points for `{key}`: [[x0, y0, z0], [x1, y1, z1]]"),
+        ));
+    };
+    if !min.cmplt(max).all() {
+        return Err(r.error(
+            value.span,
+            format!("the first corner of `{key}` must be below the second on every axis"),
+        ));
+    }
+    Ok(Aabb { min, max })
 }
 
 /// `base` and `top - base` of a cylinder or cone; an error at `top` when the
@@ -602,6 +638,63 @@ mod tests {
                 "radius must be a positive number, got 0",
             ]
         );
+    }
+
+    #[test]
+    fn quadrics_are_read_with_zero_coefficients_by_default() {
+        let sphere = [1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0];
+        assert_eq!(
+            shape("shape = 'quadric'\na = 1\nb = 1\nc = 1\nj = -1"),
+            Shape::Quadric(Quadric::new(sphere, None).unwrap())
+        );
+        let clip = Aabb::new(Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 2.0));
+        assert_eq!(
+            shape("shape = 'quadric'\na = 1\nb = 1\nj = -1\nbounds = [[-1, -1, 0], [1, 1, 2]]"),
+            Shape::Quadric(
+                Quadric::new(
+                    [1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0],
+                    Some(clip)
+                )
+                .unwrap()
+            )
+        );
+    }
+
+    #[test]
+    fn refused_quadrics_are_reported_at_the_culprit() {
+        let source = format!(
+            "{CAMERA}[[objects]]\nshape = 'quadric'\nj = 1\n\
+             [[objects]]\nshape = 'quadric'\na = 1\nb = 1\nj = -1\n\
+             [[objects]]\nshape = 'quadric'\na = 1\nb = 1\nc = 1\nj = 1\n\
+             [[objects]]\nshape = 'quadric'\na = 1\nb = 1\nj = -1\nbounds = [[0, 0, 0], [1, 0, 1]]\n\
+             [[objects]]\nshape = 'quadric'\na = 1\nb = 1\nj = -1\nbounds = [[0, 0, 0]]\n\
+             [[objects]]\nshape = 'quadric'\na = 1\nb = 1\nj = -1\nbounds = [[0, 0, 0], [1, 1, 1e31]]\n\
+             [[objects]]\nshape = 'quadric'\na = 1\nb = 1\nj = -1e40\nc = 'x'\n\
+             [[objects]]\nshape = 'quadric'\na = 1\nb = 1\nc = 1\nj = -1\nbounds = [[2, 2, 2], [3, 3, 3]]\n"
+        );
+        assert_eq!(
+            errors(&source),
+            [
+                "degenerate quadric: all of a to i are zero: the polynomial is a constant",
+                "degenerate quadric: it is unbounded (not an ellipsoid): give `bounds` to clip it",
+                "degenerate quadric: it is an ellipsoid with no real points (or a single one)",
+                "the first corner of `bounds` must be below the second on every axis",
+                "expected 2 points for `bounds`: [[x0, y0, z0], [x1, y1, z1]]",
+                "`bounds` is out of range: 1e31 is too large: at most 1e30 in magnitude is allowed",
+                "`j` is out of range: -1e40 is too large: at most 1e30 in magnitude is allowed",
+                "expected a number for `c`, found a string",
+                "degenerate quadric: the bounds do not meet the ellipsoid",
+            ]
+        );
+        let Err(crate::scene::SceneError::Invalid { diagnostics }) =
+            crate::scene::parse_scene(&source, std::path::Path::new("t.toml"))
+        else {
+            panic!("the quadrics were accepted");
+        };
+        let lines: Vec<&str> = diagnostics.iter().map(|d| d.source_line.as_str()).collect();
+        assert_eq!(lines[0], "shape = 'quadric'");
+        assert_eq!(lines[3], "bounds = [[0, 0, 0], [1, 0, 1]]");
+        assert_eq!(lines[6], "j = -1e40");
     }
 
     #[test]
