@@ -24,6 +24,7 @@ mod axis_box;
 mod cone;
 mod cylinder;
 mod disk;
+pub mod implicit;
 mod outline;
 mod parallelogram;
 mod plane;
@@ -39,6 +40,7 @@ pub use axis_box::AxisBox;
 pub use cone::Cone;
 pub use cylinder::Cylinder;
 pub use disk::Disk;
+pub use implicit::{Expression, ExpressionError, Implicit};
 pub use parallelogram::Parallelogram;
 pub use plane::Plane;
 pub use polygon::Polygon;
@@ -230,6 +232,8 @@ pub enum Shape {
     Cone(Cone),
     /// A box aligned with the axes.
     AxisBox(AxisBox),
+    /// An implicit surface `f(x, y, z) = 0` within a box.
+    Implicit(Implicit),
 }
 
 const _: () = assert!(std::mem::size_of::<Shape>() <= 80);
@@ -246,6 +250,7 @@ macro_rules! dispatch {
             Shape::Cylinder($s) => $body,
             Shape::Cone($s) => $body,
             Shape::AxisBox($s) => $body,
+            Shape::Implicit($s) => $body,
         }
     };
 }
@@ -285,6 +290,7 @@ impl Shape {
             Shape::Cylinder(_) => "cylinder",
             Shape::Cone(_) => "cone",
             Shape::AxisBox(_) => "box",
+            Shape::Implicit(_) => "implicit",
         }
     }
 }
