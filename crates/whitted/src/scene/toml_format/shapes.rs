@@ -12,6 +12,7 @@
 //! shape = "cylinder"       # base, top, radius, caps = true
 //! shape = "cone"           # base, base_radius, top, top_radius, caps = true
 //! shape = "box"            # min, max
+//! shape = "implicit"       # function, bounds = [[..], [..]], max_gradient
 //! ```
 //!
 //! Disks, cylinders and cones are built in canonical position (standing on
@@ -29,6 +30,8 @@
 //! shape. A check on several values together (a triangle's vertices, a
 //! disk's hole against its radius, a cone's two radii) runs when all the
 //! values it needs were read; the constructors stay the final authority.
+
+mod implicit;
 
 use toml_span::Span;
 use toml_span::value::Value;
@@ -116,6 +119,11 @@ pub(super) const SHAPE_KINDS: &[ShapeKind] = &[
         name: "box",
         keys: &["min", "max"],
         build: axis_box,
+    },
+    ShapeKind {
+        name: "implicit",
+        keys: &["function", "bounds", "max_gradient"],
+        build: implicit::implicit,
     },
 ];
 
