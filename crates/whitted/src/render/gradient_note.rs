@@ -110,7 +110,10 @@ mod tests {
             text.starts_with("the implicit surface `10*(x^2 + y^2 + z^2 - 1)` grew at up to"),
             "{text}"
         );
-        assert!(text.ends_with("(2 implicit surfaces beat their bound)"), "{text}");
+        assert!(
+            text.ends_with("(2 implicit surfaces beat their bound)"),
+            "{text}"
+        );
         forget(&objects);
         assert_eq!(report(&objects), None);
     }

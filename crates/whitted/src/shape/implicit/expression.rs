@@ -630,7 +630,10 @@ mod tests {
         ];
         for &(text, expected) in cases {
             let got = at(text, 0.5, -2.0, 1.5);
-            assert!((got - expected).abs() <= 1e-15, "{text}: {got} != {expected}");
+            assert!(
+                (got - expected).abs() <= 1e-15,
+                "{text}: {got} != {expected}"
+            );
         }
     }
 
@@ -673,10 +676,7 @@ mod tests {
                 "expected a number, a variable, a function or `(`, found `*`".into()
             )
         );
-        assert_eq!(
-            error("x y"),
-            (2, "expected an operator, found `y`".into())
-        );
+        assert_eq!(error("x y"), (2, "expected an operator, found `y`".into()));
         assert_eq!(error("x $ y"), (2, "unexpected character `$`".into()));
         assert_eq!(
             error("sqrt + 1"),

@@ -247,7 +247,10 @@ fn edge_cases_front_behind_miss_inside_tangent() {
     assert!((hit.t - 4.0).abs() < 1e-12, "{}", hit.t);
     assert!((s.surface(&front, &hit).normal + Vec3::Z).length() < 1e-9);
     // Behind and beside: nothing.
-    assert!(s.intersect(&Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::Z)).is_none());
+    assert!(
+        s.intersect(&Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::Z))
+            .is_none()
+    );
     let beside = Ray::new(Vec3::new(1.0 + 1e-4, 0.0, -5.0), Vec3::Z);
     assert!(s.intersect(&beside).is_none() && !s.occluded(&beside));
     // From inside: the far side, normal along the ray (outward).
@@ -256,7 +259,10 @@ fn edge_cases_front_behind_miss_inside_tangent() {
     assert!((hit.t - 0.5).abs() < 1e-12);
     assert!((s.surface(&inside, &hit).normal - Vec3::Y).length() < 1e-9);
     // Beyond t_max: nothing.
-    assert!(s.intersect(&Ray::segment(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, 3.9)).is_none());
+    assert!(
+        s.intersect(&Ray::segment(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, 3.9))
+            .is_none()
+    );
     // Tangent and grazing: whatever is found is finite, no NaN.
     for x in [1.0, 1.0 - 1e-9, 1.0 - 1e-6, 1.0 + 1e-12] {
         let ray = Ray::new(Vec3::new(x, 0.0, -5.0), Vec3::Z);
@@ -302,7 +308,10 @@ fn a_function_steeper_than_its_bound_is_reported() {
     let ray = Ray::new(Vec3::new(-5.0, 0.2, 0.1), Vec3::new(1.0, 0.1, 0.0));
     assert_eq!(s.intersect(&ray), None);
     let seen = s.largest_gradient_seen().unwrap();
-    assert!(seen > 1.0 && seen <= 10.0 * 2.0 * 2.0 * 3f64.sqrt(), "{seen}");
+    assert!(
+        seen > 1.0 && seen <= 10.0 * 2.0 * 2.0 * 3f64.sqrt(),
+        "{seen}"
+    );
     s.clone().forget_gradient();
     assert_eq!(s.largest_gradient_seen(), None);
 }
@@ -310,7 +319,12 @@ fn a_function_steeper_than_its_bound_is_reported() {
 #[test]
 fn undefined_values_count_as_outside() {
     // sqrt of a negative number is NaN below z = 0: outside, crossed.
-    let s = implicit("sqrt(z) - 0.5 + 0*x", Vec3::splat(-1.0), Vec3::splat(1.0), 10.0);
+    let s = implicit(
+        "sqrt(z) - 0.5 + 0*x",
+        Vec3::splat(-1.0),
+        Vec3::splat(1.0),
+        10.0,
+    );
     let ray = Ray::new(Vec3::new(0.1, 0.2, -3.0), Vec3::Z);
     let hit = s.intersect(&ray).unwrap();
     // NaN (outside) to sqrt(z) - 0.5 < 0 (inside) at z = 0.
@@ -359,6 +373,11 @@ fn the_shape_stays_small_and_comparable() {
     assert_eq!(unit_sphere(), unit_sphere());
     assert_ne!(
         unit_sphere(),
-        implicit("x^2 + y^2 + z^2 - 2", Vec3::splat(-1.5), Vec3::splat(1.5), 6.0)
+        implicit(
+            "x^2 + y^2 + z^2 - 2",
+            Vec3::splat(-1.5),
+            Vec3::splat(1.5),
+            6.0
+        )
     );
 }
