@@ -253,6 +253,11 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     {
         note!("warning: {cut}");
     }
+    if let Some(exceeded) = &output.gradient_exceeded
+        && !args.quiet
+    {
+        note!("warning: {exceeded}");
+    }
 
     // Every file is encoded first and renamed into place only when all
     // are ready: a failure leaves every destination as it was.

@@ -3,11 +3,13 @@
 //! picture is identical bit for bit whatever the number of threads.
 
 mod camera;
+mod gradient_note;
 mod resources;
 mod scene;
 mod settings;
 
 pub use camera::{Camera, CameraError};
+pub use gradient_note::GradientExceeded;
 pub use resources::{RayBudgetCut, ThreadClamp, memory_needed};
 pub use scene::Scene;
 pub use settings::{
@@ -64,6 +66,9 @@ pub struct RenderOutput {
     pub thread_clamp: Option<ThreadClamp>,
     /// The camera samples the budget of secondary rays cut short, if any.
     pub ray_budget_cut: Option<RayBudgetCut>,
+    /// The implicit surface whose function grew faster than its
+    /// `max_gradient` allows, if any.
+    pub gradient_exceeded: Option<GradientExceeded>,
 }
 
 /// Why a render could not start.
@@ -212,6 +217,7 @@ pub fn render(
             message: e.to_string(),
         })?;
 
+    gradient_note::forget(&scene.objects);
     let world = World::build(&scene.objects, settings.accel);
     let shading = Shading {
         materials: &scene.materials,
@@ -265,6 +271,7 @@ pub fn render(
         ray_kinds: integrator.ray_kinds(),
         thread_clamp,
         ray_budget_cut,
+        gradient_exceeded: gradient_note::report(&scene.objects),
     })
 }
 

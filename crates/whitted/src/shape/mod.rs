@@ -24,6 +24,7 @@ mod axis_box;
 mod cone;
 mod cylinder;
 mod disk;
+pub mod implicit;
 mod outline;
 mod parallelogram;
 mod plane;
@@ -41,6 +42,7 @@ pub use axis_box::AxisBox;
 pub use cone::Cone;
 pub use cylinder::Cylinder;
 pub use disk::Disk;
+pub use implicit::{Expression, ExpressionError, Implicit};
 pub use parallelogram::Parallelogram;
 pub use plane::Plane;
 pub use polygon::Polygon;
@@ -238,6 +240,8 @@ pub enum Shape {
     Torus(Torus),
     /// A quadric surface, clipped to a box unless it is an ellipsoid.
     Quadric(Quadric),
+    /// An implicit surface `f(x, y, z) = 0` within a box.
+    Implicit(Implicit),
 }
 
 const _: () = assert!(std::mem::size_of::<Shape>() <= 80);
@@ -256,6 +260,7 @@ macro_rules! dispatch {
             Shape::AxisBox($s) => $body,
             Shape::Torus($s) => $body,
             Shape::Quadric($s) => $body,
+            Shape::Implicit($s) => $body,
         }
     };
 }
@@ -297,6 +302,7 @@ impl Shape {
             Shape::AxisBox(_) => "box",
             Shape::Torus(_) => "torus",
             Shape::Quadric(_) => "quadric",
+            Shape::Implicit(_) => "implicit",
         }
     }
 }

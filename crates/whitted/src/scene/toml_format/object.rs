@@ -279,7 +279,7 @@ mod tests {
         let keys_of_any_shape = "shape, material, transform, center, radius, point, normal, \
                                  vertices, origin, edge_u, edge_v, inner_radius, base, top, \
                                  caps, base_radius, top_radius, min, max, major, minor, \
-                                 a, b, c, d, e, f, g, h, i, j, bounds";
+                                 a, b, c, d, e, f, g, h, i, j, bounds, function, max_gradient";
         assert_eq!(
             errors(&format!(
                 "{CAMERA}[materials.glass]\n\

@@ -168,6 +168,11 @@ impl<'s> Reader<'s> {
         }
     }
 
+    /// The text of the file at `span` (empty when out of bounds).
+    pub(super) fn raw(&self, span: Span) -> &'s str {
+        self.source.get(span.start..span.end).unwrap_or("")
+    }
+
     /// The span of a value as written: a string's span includes its quotes.
     pub(super) fn span_of(&self, value: &Value<'_>) -> Span {
         let span = value.span;

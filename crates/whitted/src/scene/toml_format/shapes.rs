@@ -14,6 +14,7 @@
 //! shape = "box"            # min, max
 //! shape = "torus"          # major, minor (around the y axis, centred at the origin)
 //! shape = "quadric"        # a … j = 0, bounds = [[..], [..]] (unless an ellipsoid)
+//! shape = "implicit"       # function, bounds = [[..], [..]], max_gradient
 //! ```
 //!
 //! Disks, cylinders and cones are built in canonical position (standing on
@@ -31,6 +32,8 @@
 //! shape. A check on several values together (a triangle's vertices, a
 //! disk's hole against its radius, a cone's two radii) runs when all the
 //! values it needs were read; the constructors stay the final authority.
+
+mod implicit;
 
 use toml_span::Span;
 use toml_span::value::Value;
@@ -128,6 +131,11 @@ pub(super) const SHAPE_KINDS: &[ShapeKind] = &[
         name: "quadric",
         keys: &["a", "b", "c", "d", "e", "f", "g", "h", "i", "j", "bounds"],
         build: quadric,
+    },
+    ShapeKind {
+        name: "implicit",
+        keys: &["function", "bounds", "max_gradient"],
+        build: implicit::implicit,
     },
 ];
 
