@@ -21,6 +21,7 @@
 //! produces NaN.
 
 mod axis_box;
+mod bezier_patch;
 mod cone;
 mod cylinder;
 mod disk;
@@ -36,6 +37,7 @@ mod triangle_clip;
 mod watertight_avx;
 
 pub use axis_box::AxisBox;
+pub use bezier_patch::BezierPatch;
 pub use cone::Cone;
 pub use cylinder::Cylinder;
 pub use disk::Disk;
@@ -230,6 +232,8 @@ pub enum Shape {
     Cone(Cone),
     /// A box aligned with the axes.
     AxisBox(AxisBox),
+    /// A bicubic Bézier patch.
+    BezierPatch(BezierPatch),
 }
 
 const _: () = assert!(std::mem::size_of::<Shape>() <= 80);
@@ -246,6 +250,7 @@ macro_rules! dispatch {
             Shape::Cylinder($s) => $body,
             Shape::Cone($s) => $body,
             Shape::AxisBox($s) => $body,
+            Shape::BezierPatch($s) => $body,
         }
     };
 }
@@ -285,6 +290,7 @@ impl Shape {
             Shape::Cylinder(_) => "cylinder",
             Shape::Cone(_) => "cone",
             Shape::AxisBox(_) => "box",
+            Shape::BezierPatch(_) => "bezier_patch",
         }
     }
 }
