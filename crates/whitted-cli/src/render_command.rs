@@ -29,9 +29,9 @@ use crate::report::note;
   whitted render bunny.obj --eye 0,0.1,0.3 --fov 40   a Wavefront OBJ model, seen from elsewhere
   whitted render scenes/whitted.toml -o out.exr --aov depth=depth.pfm --aov normal=normal.exr")]
 pub struct RenderArgs {
-    /// Scene file: .toml (ours), .nff (Neutral File Format) or .obj
-    /// (Wavefront, with its .mtl). Without one, the built-in scene is
-    /// rendered.
+    /// Scene file: .toml (ours), .nff (Neutral File Format), .obj
+    /// (Wavefront, with its .mtl) or .bpt (Bézier patches). Without one,
+    /// the built-in scene is rendered.
     scene: Option<PathBuf>,
 
     /// Output image: .png, .exr or .pfm.

@@ -116,7 +116,7 @@ fn a_scene_of_an_unknown_format_is_refused_naming_the_formats() {
     let out = whitted(&["render", "scene.rib"], dir.path());
     assert_eq!(out.status.code(), Some(1));
     assert!(
-        stderr(&out).contains("expected a file ending in .toml, .nff or .obj"),
+        stderr(&out).contains("expected a file ending in .toml, .nff, .obj or .bpt"),
         "{}",
         stderr(&out)
     );

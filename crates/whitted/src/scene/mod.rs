@@ -4,6 +4,7 @@
 //! `path:line:column`.
 
 mod bom;
+mod bpt;
 mod camera_override;
 mod diagnostic;
 mod nff;
@@ -12,6 +13,7 @@ mod toml_format;
 mod whole_number;
 
 pub use bom::{BYTE_ORDER_MARK, without_bom};
+pub use bpt::{load_bpt, load_bpt_patches, parse_bpt, parse_bpt_patches};
 pub use camera_override::CameraOverride;
 pub use diagnostic::{
     Diagnostic, MAX_DIAGNOSTICS, MAX_SHOWN_CHARS, SceneError, Severity, limit_warnings,
@@ -28,7 +30,7 @@ use crate::render::Scene;
 
 /// The scene formats [`load_any`] reads, by file extension (compared
 /// without regard to case).
-pub const SCENE_EXTENSIONS: &[&str] = &["toml", "nff", "obj"];
+pub const SCENE_EXTENSIONS: &[&str] = &["toml", "nff", "obj", "bpt"];
 
 /// A scene read from a file, with the warnings of its reader (things in
 /// the file that were ignored or replaced).
@@ -72,6 +74,8 @@ pub fn load_any_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene, 
         }
     } else if is("obj") {
         load_obj(path)?
+    } else if is("bpt") {
+        load_bpt(path)?
     } else {
         return Err(SceneError::UnknownFormat {
             path: path.to_path_buf(),
@@ -79,7 +83,7 @@ pub fn load_any_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene, 
     };
     let scene = &mut loaded.scene;
     scene.camera = options.camera.apply(&scene.camera)?;
-    if is("obj") {
+    if is("obj") || is("bpt") {
         scene.lights = vec![obj::headlight(&scene.camera)];
     }
     Ok(loaded)
@@ -125,7 +129,7 @@ mod tests {
         assert!(matches!(error, SceneError::UnknownFormat { .. }));
         assert_eq!(
             error.to_string(),
-            "cannot read `mesh.ply`: unknown scene format; expected a file ending in .toml, .nff or .obj"
+            "cannot read `mesh.ply`: unknown scene format; expected a file ending in .toml, .nff, .obj or .bpt"
         );
         assert!(load_any(Path::new("no_extension")).is_err());
     }

@@ -21,6 +21,7 @@
 //! produces NaN.
 
 mod axis_box;
+mod bezier_patch;
 mod cone;
 mod cylinder;
 mod disk;
@@ -39,6 +40,7 @@ mod triangle_clip;
 mod watertight_avx;
 
 pub use axis_box::AxisBox;
+pub use bezier_patch::BezierPatch;
 pub use cone::Cone;
 pub use cylinder::Cylinder;
 pub use disk::Disk;
@@ -242,6 +244,8 @@ pub enum Shape {
     Quadric(Quadric),
     /// An implicit surface `f(x, y, z) = 0` within a box.
     Implicit(Implicit),
+    /// A bicubic Bézier patch.
+    BezierPatch(BezierPatch),
 }
 
 const _: () = assert!(std::mem::size_of::<Shape>() <= 80);
@@ -261,6 +265,7 @@ macro_rules! dispatch {
             Shape::Torus($s) => $body,
             Shape::Quadric($s) => $body,
             Shape::Implicit($s) => $body,
+            Shape::BezierPatch($s) => $body,
         }
     };
 }
@@ -303,6 +308,7 @@ impl Shape {
             Shape::Torus(_) => "torus",
             Shape::Quadric(_) => "quadric",
             Shape::Implicit(_) => "implicit",
+            Shape::BezierPatch(_) => "bezier_patch",
         }
     }
 }

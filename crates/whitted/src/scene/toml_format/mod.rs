@@ -37,6 +37,7 @@
 mod light;
 mod material;
 mod object;
+mod patches;
 mod reader;
 mod shapes;
 

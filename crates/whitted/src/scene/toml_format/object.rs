@@ -21,7 +21,7 @@
 use toml_span::value::Value;
 
 use super::reader::{Parsed, Reader, all, list};
-use super::shapes;
+use super::{patches, shapes};
 use crate::math::{Transform, TransformError, Vec3, magnitude};
 use crate::shape::Shape;
 
@@ -49,16 +49,20 @@ pub(super) fn read_objects(
         return Ok(Vec::new());
     };
     let objects = r.array(value, "objects", "an array of tables ([[objects]])")?;
-    all(objects
+    let objects = all(objects
         .iter()
-        .map(|object| read_object(r, object, materials)))
+        .map(|object| read_object(r, object, materials)))?;
+    Ok(objects.into_iter().flatten().collect())
 }
 
-fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> Parsed<Object> {
+/// One object, or one per patch of a `shape = "patches"` file.
+fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> Parsed<Vec<Object>> {
     let f = r.table(value, "objects", "object")?;
-    let kind = r
-        .require(&f, "shape", Reader::string)
-        .and_then(|(name, span)| Ok((shapes::find(r, name, span)?, span)));
+    let is_patches = f.get("shape").and_then(|v| v.as_str()) == Some(patches::KIND);
+    let kind = (!is_patches).then(|| {
+        r.require(&f, "shape", Reader::string)
+            .and_then(|(name, span)| Ok((shapes::find(r, name, span)?, span)))
+    });
     let material = r.optional(&f, "material", |r, value, key| {
         let (name, span) = r.string(value, key)?;
         materials
@@ -67,6 +71,18 @@ fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> P
             .ok_or_else(|| r.error(span, unknown_material(name, materials)))
     });
     let transform = r.or_default(&f, "transform", Transform::IDENTITY, read_transform);
+    let Some(kind) = kind else {
+        let keys = r.check_keys(&f, &[COMMON_KEYS, patches::KEYS].concat());
+        let shapes = patches::read(r, &f);
+        let (material, transform) = (material?, transform?);
+        keys?;
+        let object = |shape| Object {
+            shape,
+            material,
+            transform,
+        };
+        return Ok(shapes?.into_iter().map(object).collect());
+    };
     let (kind, kind_span) = match kind {
         Ok(kind) => kind,
         Err(reported) => {
@@ -93,11 +109,11 @@ fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> P
             ));
         }
     }
-    Ok(Object {
+    Ok(vec![Object {
         shape: placed.shape,
         material: material?,
         transform,
-    })
+    }])
 }
 
 fn unknown_material(name: &str, materials: &[String]) -> String {
@@ -279,7 +295,8 @@ mod tests {
         let keys_of_any_shape = "shape, material, transform, center, radius, point, normal, \
                                  vertices, origin, edge_u, edge_v, inner_radius, base, top, \
                                  caps, base_radius, top_radius, min, max, major, minor, \
-                                 a, b, c, d, e, f, g, h, i, j, bounds, function, max_gradient";
+                                 a, b, c, d, e, f, g, h, i, j, bounds, function, max_gradient, \
+                                 points";
         assert_eq!(
             errors(&format!(
                 "{CAMERA}[materials.glass]\n\

@@ -145,6 +145,11 @@ impl<'s> Reader<'s> {
             .map_err(|error| self.error(span, error.to_string()))
     }
 
+    /// The file `name`, relative to the scene file's folder.
+    pub(super) fn beside(&self, name: &str) -> std::path::PathBuf {
+        self.path.parent().unwrap_or(Path::new("")).join(name)
+    }
+
     /// Records an error at `span`.
     pub(super) fn error(&mut self, span: Span, message: impl Into<String>) -> Reported {
         let (path, source) = (self.path, self.source);

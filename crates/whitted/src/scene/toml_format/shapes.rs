@@ -15,6 +15,7 @@
 //! shape = "torus"          # major, minor (around the y axis, centred at the origin)
 //! shape = "quadric"        # a … j = 0, bounds = [[..], [..]] (unless an ellipsoid)
 //! shape = "implicit"       # function, bounds = [[..], [..]], max_gradient
+//! shape = "bezier_patch"   # points = 4 rows of 4 [x, y, z], row i along u
 //! ```
 //!
 //! Disks, cylinders and cones are built in canonical position (standing on
@@ -41,8 +42,8 @@ use toml_span::value::Value;
 use super::reader::{Fields, Parsed, Reader, Reported, both, list};
 use crate::math::{Aabb, Transform, Vec3, magnitude};
 use crate::shape::{
-    AxisBox, Cone, Cylinder, Disk, Parallelogram, Plane, Polygon, Quadric, Shape, ShapeError,
-    Sphere, Torus, Triangle, non_negative, positive,
+    AxisBox, BezierPatch, Cone, Cylinder, Disk, Parallelogram, Plane, Polygon, Quadric, Shape,
+    ShapeError, Sphere, Torus, Triangle, non_negative, positive,
 };
 
 /// A shape in its object space and where that space sits before the
@@ -136,6 +137,11 @@ pub(super) const SHAPE_KINDS: &[ShapeKind] = &[
         name: "implicit",
         keys: &["function", "bounds", "max_gradient"],
         build: implicit::implicit,
+    },
+    ShapeKind {
+        name: "bezier_patch",
+        keys: &["points"],
+        build: bezier_patch,
     },
 ];
 
@@ -347,6 +353,32 @@ fn clipping_box(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Aabb
         ));
     }
     Ok(Aabb { min, max })
+}
+
+fn bezier_patch(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Placed> {
+    let net = r.require(f, "points", |r, value, key| {
+        let rows = r.array(value, key, "4 rows of 4 points [[[x, y, z], ...], ...]")?;
+        let rows = super::reader::all(rows.iter().map(|row| {
+            let points = r.points(row, key)?;
+            <[Vec3; 4]>::try_from(points).map_err(|points| {
+                let found = points.len();
+                r.error(
+                    row.span,
+                    format!("expected 4 points in each row of `{key}`, found {found}"),
+                )
+            })
+        }))?;
+        <[[Vec3; 4]; 4]>::try_from(rows).map_err(|rows| {
+            let found = rows.len();
+            r.error(
+                value.span,
+                format!("expected 4 rows of 4 points for `{key}`, found {found} rows"),
+            )
+        })
+    })?;
+    let at = r.value_span(f, "points");
+    let patch = BezierPatch::new(net).map_err(|e| refused(r, f, at, e))?;
+    Ok(Placed::in_place(Shape::BezierPatch(patch)))
 }
 
 /// `base` and `top - base` of a cylinder or cone; an error at `top` when the
