@@ -30,6 +30,7 @@ mod plane;
 mod polygon;
 mod quadratic;
 mod sphere;
+mod superellipsoid;
 mod triangle;
 mod triangle_clip;
 #[cfg(target_arch = "x86_64")]
@@ -43,6 +44,7 @@ pub use parallelogram::Parallelogram;
 pub use plane::Plane;
 pub use polygon::Polygon;
 pub use sphere::Sphere;
+pub use superellipsoid::{MAX_EXPONENT, MIN_EXPONENT, Superellipsoid, exponent};
 pub use triangle::{RayShear, Triangle, watertight};
 pub(crate) use triangle_clip::clipped_triangle_bounds;
 #[cfg(target_arch = "x86_64")]
@@ -230,6 +232,8 @@ pub enum Shape {
     Cone(Cone),
     /// A box aligned with the axes.
     AxisBox(AxisBox),
+    /// POV-Ray's superellipsoid.
+    Superellipsoid(Superellipsoid),
 }
 
 const _: () = assert!(std::mem::size_of::<Shape>() <= 80);
@@ -246,6 +250,7 @@ macro_rules! dispatch {
             Shape::Cylinder($s) => $body,
             Shape::Cone($s) => $body,
             Shape::AxisBox($s) => $body,
+            Shape::Superellipsoid($s) => $body,
         }
     };
 }
@@ -285,6 +290,7 @@ impl Shape {
             Shape::Cylinder(_) => "cylinder",
             Shape::Cone(_) => "cone",
             Shape::AxisBox(_) => "box",
+            Shape::Superellipsoid(_) => "superellipsoid",
         }
     }
 }
