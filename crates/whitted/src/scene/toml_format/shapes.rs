@@ -12,6 +12,7 @@
 //! shape = "cylinder"       # base, top, radius, caps = true
 //! shape = "cone"           # base, base_radius, top, top_radius, caps = true
 //! shape = "box"            # min, max
+//! shape = "superellipsoid" # e, n, center = [0, 0, 0], radius = 1
 //! ```
 //!
 //! Disks, cylinders and cones are built in canonical position (standing on
@@ -37,7 +38,7 @@ use super::reader::{Fields, Parsed, Reader, Reported, both, list};
 use crate::math::{Transform, Vec3, magnitude};
 use crate::shape::{
     AxisBox, Cone, Cylinder, Disk, Parallelogram, Plane, Polygon, Shape, ShapeError, Sphere,
-    Triangle, non_negative, positive,
+    Superellipsoid, Triangle, exponent, non_negative, positive,
 };
 
 /// A shape in its object space and where that space sits before the
@@ -116,6 +117,11 @@ pub(super) const SHAPE_KINDS: &[ShapeKind] = &[
         name: "box",
         keys: &["min", "max"],
         build: axis_box,
+    },
+    ShapeKind {
+        name: "superellipsoid",
+        keys: &["e", "n", "center", "radius"],
+        build: superellipsoid,
     },
 ];
 
@@ -283,6 +289,17 @@ fn axis_box(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Placed> {
     let at = r.value_span(f, "max");
     let axis_box = AxisBox::new(min?, max?).map_err(|e| refused(r, f, at, e))?;
     Ok(Placed::in_place(Shape::AxisBox(axis_box)))
+}
+
+fn superellipsoid(r: &mut Reader<'_>, f: &Fields<'_, '_>, at: Span) -> Parsed<Placed> {
+    let e = measure(r, f, "e", exponent);
+    let n = measure(r, f, "n", exponent);
+    let center = r.or_default(f, "center", Vec3::ZERO, Reader::vec3);
+    let radius = r.or_default(f, "radius", 1.0, |r, value, _| {
+        checked(r, value, "radius", positive)
+    });
+    let shape = Superellipsoid::new(center?, radius?, e?, n?).map_err(|e| refused(r, f, at, e))?;
+    Ok(Placed::in_place(Shape::Superellipsoid(shape)))
 }
 
 /// `base` and `top - base` of a cylinder or cone; an error at `top` when the
@@ -580,6 +597,24 @@ mod tests {
                 "inner_radius must not be negative, got -1",
                 "`top` must differ from `base`: the shape has no height",
                 "radius must be a positive number, got 0",
+            ]
+        );
+    }
+
+    #[test]
+    fn superellipsoids_are_read_and_bad_exponents_located() {
+        assert_eq!(
+            shape("shape = 'superellipsoid'\ne = 0.5\nn = 2"),
+            Shape::Superellipsoid(Superellipsoid::new(Vec3::ZERO, 1.0, 0.5, 2.0).unwrap())
+        );
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[[objects]]\nshape = 'superellipsoid'\ne = 0\nn = 20\nradius = -1\n"
+            )),
+            [
+                "e must be a positive number, got 0",
+                "degenerate superellipsoid: the exponents e and n must lie between 0.001 and 10",
+                "radius must be a positive number, got -1",
             ]
         );
     }
