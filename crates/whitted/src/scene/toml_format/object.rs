@@ -278,7 +278,7 @@ mod tests {
         let kinds = kinds.join(", ");
         let keys_of_any_shape = "shape, material, transform, center, radius, point, normal, \
                                  vertices, origin, edge_u, edge_v, inner_radius, base, top, \
-                                 caps, base_radius, top_radius, min, max";
+                                 caps, base_radius, top_radius, min, max, e, n";
         assert_eq!(
             errors(&format!(
                 "{CAMERA}[materials.glass]\n\
