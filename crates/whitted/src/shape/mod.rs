@@ -33,6 +33,7 @@ mod polygon;
 mod quadratic;
 mod quadric;
 mod sphere;
+mod superellipsoid;
 mod torus;
 mod triangle;
 mod triangle_clip;
@@ -50,6 +51,7 @@ pub use plane::Plane;
 pub use polygon::Polygon;
 pub use quadric::Quadric;
 pub use sphere::Sphere;
+pub use superellipsoid::{MAX_EXPONENT, MIN_EXPONENT, Superellipsoid, exponent};
 pub use torus::Torus;
 pub use triangle::{RayShear, Triangle, watertight};
 pub(crate) use triangle_clip::clipped_triangle_bounds;
@@ -246,6 +248,8 @@ pub enum Shape {
     Implicit(Implicit),
     /// A bicubic Bézier patch.
     BezierPatch(BezierPatch),
+    /// POV-Ray's superellipsoid.
+    Superellipsoid(Superellipsoid),
 }
 
 const _: () = assert!(std::mem::size_of::<Shape>() <= 80);
@@ -266,6 +270,7 @@ macro_rules! dispatch {
             Shape::Quadric($s) => $body,
             Shape::Implicit($s) => $body,
             Shape::BezierPatch($s) => $body,
+            Shape::Superellipsoid($s) => $body,
         }
     };
 }
@@ -309,6 +314,7 @@ impl Shape {
             Shape::Quadric(_) => "quadric",
             Shape::Implicit(_) => "implicit",
             Shape::BezierPatch(_) => "bezier_patch",
+            Shape::Superellipsoid(_) => "superellipsoid",
         }
     }
 }

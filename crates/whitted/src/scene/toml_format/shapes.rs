@@ -16,6 +16,7 @@
 //! shape = "quadric"        # a … j = 0, bounds = [[..], [..]] (unless an ellipsoid)
 //! shape = "implicit"       # function, bounds = [[..], [..]], max_gradient
 //! shape = "bezier_patch"   # points = 4 rows of 4 [x, y, z], row i along u
+//! shape = "superellipsoid" # e, n, center = [0, 0, 0], radius = 1
 //! ```
 //!
 //! Disks, cylinders and cones are built in canonical position (standing on
@@ -43,7 +44,7 @@ use super::reader::{Fields, Parsed, Reader, Reported, both, list};
 use crate::math::{Aabb, Transform, Vec3, magnitude};
 use crate::shape::{
     AxisBox, BezierPatch, Cone, Cylinder, Disk, Parallelogram, Plane, Polygon, Quadric, Shape,
-    ShapeError, Sphere, Torus, Triangle, non_negative, positive,
+    ShapeError, Sphere, Superellipsoid, Torus, Triangle, exponent, non_negative, positive,
 };
 
 /// A shape in its object space and where that space sits before the
@@ -142,6 +143,11 @@ pub(super) const SHAPE_KINDS: &[ShapeKind] = &[
         name: "bezier_patch",
         keys: &["points"],
         build: bezier_patch,
+    },
+    ShapeKind {
+        name: "superellipsoid",
+        keys: &["e", "n", "center", "radius"],
+        build: superellipsoid,
     },
 ];
 
@@ -379,6 +385,17 @@ fn bezier_patch(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Place
     let at = r.value_span(f, "points");
     let patch = BezierPatch::new(net).map_err(|e| refused(r, f, at, e))?;
     Ok(Placed::in_place(Shape::BezierPatch(patch)))
+}
+
+fn superellipsoid(r: &mut Reader<'_>, f: &Fields<'_, '_>, at: Span) -> Parsed<Placed> {
+    let e = measure(r, f, "e", exponent);
+    let n = measure(r, f, "n", exponent);
+    let center = r.or_default(f, "center", Vec3::ZERO, Reader::vec3);
+    let radius = r.or_default(f, "radius", 1.0, |r, value, _| {
+        checked(r, value, "radius", positive)
+    });
+    let shape = Superellipsoid::new(center?, radius?, e?, n?).map_err(|e| refused(r, f, at, e))?;
+    Ok(Placed::in_place(Shape::Superellipsoid(shape)))
 }
 
 /// `base` and `top - base` of a cylinder or cone; an error at `top` when the
@@ -735,6 +752,24 @@ mod tests {
         assert_eq!(lines[0], "shape = 'quadric'");
         assert_eq!(lines[3], "bounds = [[0, 0, 0], [1, 0, 1]]");
         assert_eq!(lines[6], "j = -1e40");
+    }
+
+    #[test]
+    fn superellipsoids_are_read_and_bad_exponents_located() {
+        assert_eq!(
+            shape("shape = 'superellipsoid'\ne = 0.5\nn = 2"),
+            Shape::Superellipsoid(Superellipsoid::new(Vec3::ZERO, 1.0, 0.5, 2.0).unwrap())
+        );
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[[objects]]\nshape = 'superellipsoid'\ne = 0\nn = 20\nradius = -1\n"
+            )),
+            [
+                "e must be a positive number, got 0",
+                "degenerate superellipsoid: the exponents e and n must lie between 0.001 and 10",
+                "radius must be a positive number, got -1",
+            ]
+        );
     }
 
     #[test]
