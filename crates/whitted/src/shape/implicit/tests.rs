@@ -260,9 +260,10 @@ fn near_tangent(exact: &Shape, ray: &Ray, size: f64) -> bool {
 
 /// The implicit surface and the exact shape agree on random rays: the same
 /// hit or miss and `t` within 1e-6 relative, rays near tangency (by
-/// [`near_tangent`]) skipped; returns the worst relative error in `t` and
-/// how many rays were skipped.
-fn assert_same_depth(shape: &Implicit, exact: &Shape, seed: u64) -> (f64, usize) {
+/// [`near_tangent`]) skipped, fewer than 100 of the 2,000. Measured: the
+/// worst relative error in `t` is 4.6e-13 (ring torus), at most one ray
+/// skipped (the sphere).
+fn assert_same_depth(shape: &Implicit, exact: &Shape, seed: u64) {
     let b = shape.bounds();
     let size = (b.max - b.min).length();
     let (mut hits, mut skipped, mut worst) = (0, 0, 0.0f64);
@@ -294,7 +295,7 @@ fn assert_same_depth(shape: &Implicit, exact: &Shape, seed: u64) -> (f64, usize)
     assert!(shape.largest_gradient_seen().is_none(), "{}", exact.kind());
     assert!(hits > 500, "{}: only {hits} hits compared", exact.kind());
     assert!(skipped < 100, "{}: {skipped} rays skipped", exact.kind());
-    (worst, skipped)
+    assert!(worst <= 1e-6, "{}: worst {worst:e}", exact.kind());
 }
 
 /// Issue 17: a sphere, a torus (ring and spindle) and a superellipsoid
@@ -338,11 +339,7 @@ fn a_sphere_torus_and_superellipsoid_as_expressions_give_the_exact_depth() {
         (superellipsoid, Shape::Superellipsoid(exact_superellipsoid)),
     ];
     for (seed, (shape, exact)) in pairs.iter().enumerate() {
-        let (worst, skipped) = assert_same_depth(shape, exact, 40 + seed as u64);
-        eprintln!(
-            "{}: worst relative error in t {worst:e}, {skipped} of 2000 rays skipped",
-            exact.kind()
-        );
+        assert_same_depth(shape, exact, 40 + seed as u64);
     }
 }
 
