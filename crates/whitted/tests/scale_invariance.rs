@@ -1,6 +1,8 @@
 //! No acne and no light leaks at any scale: the same scene built at scales
 //! 1e-3, 1 and 1e4 renders the same picture. Self-intersection from a fixed
-//! epsilon would speckle the small scene or leak at the large one.
+//! epsilon would speckle the small scene or leak at the large one. The
+//! scene holds one of each older shape but the plane, polygon, disk and
+//! cone, and a glass torus, a superellipsoid and an implicit ball.
 
 use whitted::image::Film;
 use whitted::image::encode_srgb8;
@@ -13,7 +15,10 @@ use whitted::shading::Material;
 use whitted::shading::Texture;
 use whitted::shading::texture::Checker;
 use whitted::shading::{Attenuation, Light};
-use whitted::shape::{AxisBox, Cylinder, Parallelogram, Shape, Sphere, Triangle};
+use whitted::shape::{
+    AxisBox, Cylinder, Expression, Implicit, Parallelogram, Shape, Sphere, Superellipsoid, Torus,
+    Triangle,
+};
 
 fn scene_at_scale(s: f64) -> Scene {
     let v = |x: f64, y: f64, z: f64| Vec3::new(x, y, z) * s;
@@ -62,6 +67,15 @@ fn scene_at_scale(s: f64) -> Scene {
     let post = Cylinder::new(0.3 * s, 1.5 * s, true).unwrap();
     let placed = Transform::frame(v(2.6, 0.0, -1.0), Vec3::Y).unwrap();
     scene.add_primitive(Shape::Cylinder(post), matte, placed);
+    let ring = Torus::new(0.5 * s, 0.15 * s).unwrap();
+    let flat = Transform::frame(v(-1.5, 0.15, -2.0), Vec3::Z).unwrap();
+    scene.add_primitive(Shape::Torus(ring), glass, flat);
+    let rounded = Superellipsoid::new(v(0.0, 0.4, 1.5), 0.4 * s, 0.4, 0.4).unwrap();
+    scene.add_primitive(Shape::Superellipsoid(rounded), matte, identity);
+    let ball = Expression::parse(&format!("x^2 + y^2 + z^2 - {}", (0.3 * s).powi(2))).unwrap();
+    let implicit = Implicit::new(ball, v(-0.35, -0.35, -0.35), v(0.35, 0.35, 0.35), 1.25 * s);
+    let above = Transform::translate(v(-2.0, 1.8, 1.0)).unwrap();
+    scene.add_primitive(Shape::Implicit(implicit.unwrap()), matte, above);
     scene.lights.push(Light::Point {
         position: v(-3.0, 6.0, -4.0),
         intensity: Color::splat(0.9),

@@ -320,4 +320,6 @@ impl Shape {
 }
 
 #[cfg(test)]
+mod closed_shapes_tests;
+#[cfg(test)]
 pub(crate) mod testing;

@@ -271,3 +271,38 @@ pub(crate) fn assert_tangents_follow_uv(shape: &Shape, seed: u64) -> usize {
     );
     checked
 }
+
+/// Follows `ray` through `shape` from crossing to crossing (each next ray
+/// from the offset origin of the last hit) and checks they alternate
+/// entering and leaving by the sign of the normal against the ray: the
+/// first enters (normal against the ray), the last leaves. Returns how
+/// many crossings there were.
+pub(crate) fn assert_crossings_alternate(shape: &Shape, ray: Ray) -> usize {
+    let mut ray = ray;
+    let mut crossings = 0;
+    while let Some(hit) = shape.intersect(&ray) {
+        let s = shape.surface(&ray, &hit);
+        let entering = crossings % 2 == 0;
+        let cos = s.normal.dot(ray.dir.normalize());
+        assert!(
+            if entering { cos < 0.0 } else { cos > 0.0 },
+            "{}: crossing {crossings} at {:?} should {} the solid, but normal {:?} · direction = {cos}",
+            shape.kind(),
+            s.point,
+            if entering { "enter" } else { "leave" },
+            s.normal
+        );
+        crossings += 1;
+        assert!(crossings <= 16, "{}: endless crossings", shape.kind());
+        ray = Ray::new(
+            offset_ray_origin(s.point, s.point_error, s.normal, ray.dir),
+            ray.dir,
+        );
+    }
+    assert!(
+        crossings % 2 == 0,
+        "{}: {crossings} crossings, the last one entering",
+        shape.kind()
+    );
+    crossings
+}

@@ -234,6 +234,42 @@ pub fn toml_scene(rng: &mut Rng) -> String {
             number(rng),
             several(rng, 3, ", ", positive)
         ),
+        format!(
+            "shape = \"torus\"\nmajor = {}\nminor = {}",
+            number(rng),
+            p(rng)
+        ),
+        format!(
+            "shape = \"implicit\"\nfunction = \"{}\"\n\
+             bounds = [[-1, -1, -1], [{}]]\nmax_gradient = {}",
+            [
+                format!("x^2 + y^2 + z^2 - {}", p(rng)),
+                format!("sin({}*x)*cos(y) + z - {}", p(rng), number(rng)),
+                format!("max(abs(x), abs(y)) + z^3 - {}", w(rng)),
+            ][rng.below(3) as usize],
+            several(rng, 3, ", ", positive),
+            p(rng)
+        ),
+        format!(
+            "shape = \"bezier_patch\"\npoints = [{}]",
+            (0..4)
+                .map(|i| format!(
+                    "[{}]",
+                    (0..4)
+                        .map(|j| format!("[{i}, {j}, {}]", number(rng)))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+        format!(
+            "shape = \"superellipsoid\"\ne = {}\nn = {}\ncenter = {}\nradius = {}",
+            p(rng),
+            p(rng),
+            v(rng),
+            p(rng)
+        ),
     ];
     for shape in shapes {
         let material = ["a", "b"][rng.below(2) as usize];
