@@ -469,8 +469,12 @@ fn grazing_ray(torus: &Torus, rng: &mut Rng) -> Ray {
 /// Accuracy of the shipped solver (recursive derivative intervals) and of
 /// Ferrari's closed form with Newton polishing on the same rays, against
 /// the dense-sampling reference: the table in docs/performance.md
-/// ("Torus solvers"); `--nocapture` prints it.
+/// ("Torus solvers"); `--nocapture` shows it.
 #[test]
+#[allow(
+    clippy::print_stderr,
+    reason = "the measurement's table, shown with --nocapture"
+)]
 fn the_shipped_solver_against_ferrari_on_the_same_rays() {
     let ordinary = &tori();
     let spindles = [(0.5, 1.0), (0.9, 1.0), (0.2, 1.0)].map(|(a, b)| Torus::new(a, b).unwrap());
@@ -513,7 +517,7 @@ fn the_shipped_solver_against_ferrari_on_the_same_rays() {
             ours.add(torus.intersect(ray).map(|h| h.t), want);
             ferrari.add(torus.intersect_by_ferrari(ray).map(|h| h.t), want);
         }
-        println!(
+        eprintln!(
             "{name:18} {:5} rays | monotone {:8.1e} {:3} missed {:3} spurious | ferrari {:8.1e} {:3} missed {:3} spurious",
             rays.len(),
             ours.worst,
