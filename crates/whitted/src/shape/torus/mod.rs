@@ -37,8 +37,11 @@
 //! It was chosen because it gives the roots in order (the closest hit is
 //! the first monotone piece with a sign change, later roots are not
 //! computed), cannot miss a simple root or return one outside the chord,
-//! and needs no special cases; Ferrari/Vieta with Newton refinement and
-//! Sturm sequences were not implemented, so no measurement compares them.
+//! and needs no special cases: chosen for that guarantee, not for speed.
+//! Measured against Ferrari's closed form with two Newton steps on the
+//! same quartic and rays, Ferrari is as accurate there and about 2.5 times
+//! faster: see docs/performance.md ("Torus solvers"). Sturm sequences (as
+//! POV-Ray) were not implemented.
 //!
 //! **(u, v)** are the natural angles: `u = φ / 2π` around the y axis and
 //! `v = θ / 2π` around the tube, with
@@ -47,6 +50,7 @@
 //! of a spindle torus's lemon has `R + r cos θ < 0`. `dpdu` and `dpdv` are
 //! the derivatives of that form, and `dpdu × dpdv` points along the normal.
 
+mod ferrari;
 mod monotone;
 #[cfg(test)]
 mod tests;
@@ -119,6 +123,20 @@ impl Torus {
 
     /// The closest hit in the ray's interval.
     pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+        self.intersect_by::<monotone::Monotone>(ray)
+    }
+
+    /// The closest hit found by Ferrari's closed form with Newton polishing
+    /// instead of [`Torus::intersect`]'s recursive derivative intervals, on
+    /// the same moved-origin quartic: for measurement only (the solver
+    /// comparison in docs/performance.md), not used when rendering.
+    #[doc(hidden)]
+    pub fn intersect_by_ferrari(&self, ray: &Ray) -> Option<ShapeHit> {
+        self.intersect_by::<ferrari::Ferrari>(ray)
+    }
+
+    /// The closest hit, with the quartic's roots found by `S`.
+    fn intersect_by<S: QuarticSolver>(&self, ray: &Ray) -> Option<ShapeHit> {
         let length = magnitude::norm(ray.dir);
         if !(length > 0.0 && length.is_finite()) {
             return None;
@@ -147,7 +165,7 @@ impl Torus {
             sphere_root(middle, dir, lo, hi, accept)
         } else {
             let c = self.quartic(middle, dir);
-            monotone::first_quartic_root(&c, lo, hi, accept)
+            S::first_root(&c, lo, hi, accept)
         }?;
         Some(ShapeHit::at(to_t(s)))
     }
@@ -228,6 +246,13 @@ impl Torus {
         let extent = Vec3::new(self.size, self.minor, self.size);
         Aabb::new(-extent, extent)
     }
+}
+
+/// A way to find the roots of the torus's quartic.
+trait QuarticSolver {
+    /// The first root of the quartic `c` (lowest degree first) in
+    /// `(lo, hi)` that `accept` takes, trying the roots in increasing order.
+    fn first_root(c: &[f64; 5], lo: f64, hi: f64, accept: impl FnMut(f64) -> bool) -> Option<f64>;
 }
 
 /// The angle of `(cos, sin)` in `[0, 2π)`.

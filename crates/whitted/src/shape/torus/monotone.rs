@@ -151,6 +151,15 @@ fn cubic_roots(c: &[f64; 4], lo: f64, hi: f64) -> ([f64; 3], usize) {
     (roots, count)
 }
 
+/// The torus's solver: [`first_quartic_root`].
+pub(super) struct Monotone;
+
+impl super::QuarticSolver for Monotone {
+    fn first_root(c: &[f64; 5], lo: f64, hi: f64, accept: impl FnMut(f64) -> bool) -> Option<f64> {
+        first_quartic_root(c, lo, hi, accept)
+    }
+}
+
 /// The first root of the quartic `c` in `(lo, hi)` that `accept` takes,
 /// trying the roots in increasing order.
 pub(super) fn first_quartic_root(
