@@ -88,6 +88,7 @@ fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> P
         Err(reported) => {
             let keys_of_kinds: Vec<&[&str]> = std::iter::once(COMMON_KEYS)
                 .chain(shapes::SHAPE_KINDS.iter().map(|kind| kind.keys))
+                .chain(std::iter::once(patches::KEYS))
                 .collect();
             r.check_keys_of_any_kind(&f, &keys_of_kinds, "shapes")?;
             return Err(reported);
@@ -291,12 +292,12 @@ mod tests {
     #[test]
     fn every_object_error_is_reported() {
         let kinds: Vec<&str> = SHAPE_KINDS.iter().map(|kind| kind.name).collect();
-        let kinds = kinds.join(", ");
+        let kinds = format!("{}, patches", kinds.join(", "));
         let keys_of_any_shape = "shape, material, transform, center, radius, point, normal, \
                                  vertices, origin, edge_u, edge_v, inner_radius, base, top, \
                                  caps, base_radius, top_radius, min, max, major, minor, \
                                  a, b, c, d, e, f, g, h, i, j, bounds, function, max_gradient, \
-                                 points, n";
+                                 points, n, file";
         assert_eq!(
             errors(&format!(
                 "{CAMERA}[materials.glass]\n\

@@ -157,7 +157,11 @@ pub(super) fn find(r: &mut Reader<'_>, name: &str, span: Span) -> Parsed<&'stati
         .iter()
         .find(|kind| kind.name == name)
         .ok_or_else(|| {
-            let names: Vec<&str> = SHAPE_KINDS.iter().map(|kind| kind.name).collect();
+            let names: Vec<&str> = SHAPE_KINDS
+                .iter()
+                .map(|kind| kind.name)
+                .chain([super::patches::KIND])
+                .collect();
             r.error(
                 span,
                 format!("unknown shape `{name}`; expected one of: {}", list(&names)),
