@@ -46,6 +46,9 @@ pub enum ImageFormat {
     Exr,
     /// Portable float map, 32-bit float, the values as they are.
     Pfm,
+    /// A partial image of a render split over machines (`.wpart`, see
+    /// `render::part`), merged into one of the others by `whitted merge`.
+    Part,
 }
 
 /// Why an image could not be written.
@@ -122,6 +125,7 @@ impl ImageFormat {
             Some("png") => Ok(Self::Png),
             Some("exr") => Ok(Self::Exr),
             Some("pfm") => Ok(Self::Pfm),
+            Some("wpart") => Ok(Self::Part),
             _ => Err(ImageError::UnknownFormat {
                 path: path.to_path_buf(),
             }),
@@ -199,17 +203,24 @@ impl Film {
     /// dropping the result removes the partial file.
     pub fn encode(&self, path: &Path) -> Result<PendingImage, ImageError> {
         let format = ImageFormat::from_path(path)?;
+        let encoder: Encoder = match format {
+            ImageFormat::Png => Self::encode_png,
+            ImageFormat::Pfm => Self::encode_pfm,
+            ImageFormat::Exr => Self::encode_exr,
+            ImageFormat::Part => {
+                return Err(ImageError::Unsupported {
+                    path: path.to_path_buf(),
+                    why: "a .wpart file holds a part of a render, not a film".to_string(),
+                });
+            }
+        };
         if format == ImageFormat::Png && self.channels != 1 && self.channels != 3 {
             return Err(ImageError::Unsupported {
                 path: path.to_path_buf(),
                 why: format!("PNG holds 1 or 3 channels, not {}", self.channels),
             });
         }
-        encode_to_partial(path, |out| match format {
-            ImageFormat::Png => self.encode_png(out),
-            ImageFormat::Pfm => self.encode_pfm(out),
-            ImageFormat::Exr => self.encode_exr(out),
-        })
+        encode_to_partial(path, |out| encoder(self, out))
     }
 
     fn encode_png(&self, out: &mut std::fs::File) -> std::io::Result<()> {
@@ -285,6 +296,9 @@ impl Film {
     }
 }
 
+/// A film's encoder into one format.
+type Encoder = fn(&Film, &mut std::fs::File) -> std::io::Result<()>;
+
 /// An encoded image waiting in a partial file beside its destination.
 #[derive(Debug)]
 pub struct PendingImage {
@@ -314,8 +328,10 @@ impl PendingImage {
     }
 }
 
-/// Encodes into a new partial file in the folder of `path`'s target.
-fn encode_to_partial(
+/// Encodes into a new partial file in the folder of `path`'s target, to
+/// be renamed into place by [`PendingImage::commit`]: the way to write any
+/// output file whole or not at all.
+pub fn encode_to_partial(
     path: &Path,
     encode: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
 ) -> Result<PendingImage, ImageError> {

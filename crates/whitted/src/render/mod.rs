@@ -4,14 +4,22 @@
 
 mod camera;
 mod gradient_note;
+mod merge;
+mod part;
 mod resources;
 mod scene;
+mod selection;
 mod settings;
 
 pub use camera::{Camera, CameraError};
 pub use gradient_note::GradientExceeded;
+pub use merge::{MergeError, Merged, merge_parts};
+pub use part::{
+    BUILT_IN_SCENE, Part, PartError, PartHeader, encode_part, parse_part, read_part, scene_sha256,
+};
 pub use resources::{RayBudgetCut, ThreadClamp, memory_needed};
 pub use scene::Scene;
+pub use selection::{PixelSelection, SelectionError, Share, Window};
 pub use settings::{
     Aov, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, RenderSettings, check_image_size,
 };
@@ -130,6 +138,9 @@ pub enum RenderError {
         /// The first one's row.
         y: u32,
     },
+    /// The pixels asked for are not in the image.
+    #[error(transparent)]
+    Selection(#[from] SelectionError),
     /// The thread pool could not be created.
     #[error("could not start {threads} worker threads: {message}")]
     Threads {
@@ -151,6 +162,8 @@ struct Tile {
     rays: RayCounts,
     /// Samples the ray budget cut short, by the material they were cut at.
     cuts: HashMap<MaterialId, u64>,
+    /// How many of its pixels were rendered (the others are black).
+    selected: u64,
 }
 
 /// The films of a render being filled in as tiles finish.
@@ -195,9 +208,22 @@ pub fn render(
     scene: &Scene,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<RenderOutput, RenderError> {
+    let whole = PixelSelection::whole(scene.settings.width, scene.settings.height);
+    render_selected(scene, &whole, progress)
+}
+
+/// Renders the pixels of `scene` that `selection` holds, as [`render`]
+/// does (each bit for bit as a whole render has it), and leaves the others
+/// black. Progress counts the selected pixels.
+pub fn render_selected(
+    scene: &Scene,
+    selection: &PixelSelection,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<RenderOutput, RenderError> {
     let settings = &scene.settings;
     let (width, height) = (settings.width, settings.height);
     settings.check()?;
+    selection.check(width, height)?;
     let primitives = scene.objects.primitive_count();
     if primitives > MAX_PRIMITIVES {
         return Err(RenderError::TooManyPrimitives(primitives));
@@ -205,9 +231,11 @@ pub fn render(
     resources::check_memory(settings, MemoryBudget::current())?;
     let tiles_x = width.div_ceil(TILE_SIZE);
     let tiles_y = height.div_ceil(TILE_SIZE);
+    let tiles: Vec<u32> = (0..tiles_x * tiles_y)
+        .filter(|&index| tile_is_selected(selection, index % tiles_x, index / tiles_x))
+        .collect();
     let cores = std::thread::available_parallelism().map_or(1, usize::from);
-    let (threads, thread_clamp) =
-        resources::useful_threads(settings.threads, (tiles_x * tiles_y) as usize, cores);
+    let (threads, thread_clamp) = resources::useful_threads(settings.threads, tiles.len(), cores);
     let pool = rayon::ThreadPoolBuilder::new()
         .stack_size(worker_stack_bytes(settings.max_depth))
         .num_threads(threads)
@@ -231,7 +259,7 @@ pub fn render(
         ray_budget: SECONDARY_RAY_BUDGET,
     };
     let integrator = Integrator::new(settings.integrator, &world, shading, limits);
-    let total = u64::from(width) * u64::from(height);
+    let total = selection.pixel_count();
     let done = AtomicU64::new(0);
     let films = Mutex::new(Films {
         image: Film::new(width, height, 3).with_color_space(scene.color_space),
@@ -244,15 +272,16 @@ pub fn render(
         cuts: HashMap::new(),
     });
     pool.install(|| {
-        (0..tiles_x * tiles_y).into_par_iter().for_each(|index| {
+        tiles.into_par_iter().for_each(|index| {
             let tile = render_tile(
                 &integrator,
                 &scene.camera,
                 settings,
+                selection,
                 index % tiles_x,
                 index / tiles_x,
             );
-            let pixels = u64::from(tile.width * tile.height);
+            let pixels = tile.selected;
             films
                 .lock()
                 .unwrap_or_else(PoisonError::into_inner)
@@ -314,11 +343,20 @@ fn check_finite(image: &Film) -> Result<(), RenderError> {
     })
 }
 
-/// Renders one tile of the image.
+/// Whether tile (`tile_x`, `tile_y`) has a selected pixel.
+fn tile_is_selected(selection: &PixelSelection, tile_x: u32, tile_y: u32) -> bool {
+    let w = selection.window;
+    let (x0, y0) = (tile_x * TILE_SIZE, tile_y * TILE_SIZE);
+    x0 < w.x1 && x0 + TILE_SIZE > w.x0 && (y0..y0 + TILE_SIZE).any(|y| selection.has_row(y))
+}
+
+/// Renders the selected pixels of one tile of the image (the others are
+/// left black).
 fn render_tile(
     integrator: &Integrator,
     camera: &Camera,
     settings: &RenderSettings,
+    selection: &PixelSelection,
     tile_x: u32,
     tile_y: u32,
 ) -> Tile {
@@ -340,10 +378,19 @@ fn render_tile(
             .collect(),
         rays: RayCounts::default(),
         cuts: HashMap::new(),
+        selected: 0,
     };
     let spp = settings.samples_per_pixel;
     for y in y0..y0 + height {
         for x in x0..x0 + width {
+            if !selection.contains(x, y) {
+                tile.color.extend_from_slice(&[0.0; 3]);
+                for (aov, data) in settings.aovs.iter().zip(&mut tile.aovs) {
+                    data.resize(data.len() + aov.channels(), 0.0);
+                }
+                continue;
+            }
+            tile.selected += 1;
             let pattern = hash64(u64::from(y) << 32 | u64::from(x)) as u32;
             let mut sum = Color::ZERO;
             let mut centre = None;
