@@ -5,11 +5,14 @@
 
 mod arguments;
 mod bench_command;
+mod merge_command;
+mod outputs;
 mod progress;
 mod render_command;
 mod report;
 #[cfg(unix)]
 mod signals;
+mod split;
 
 use std::process::ExitCode;
 
@@ -34,6 +37,7 @@ struct Cli {
 enum Command {
     Render(render_command::RenderArgs),
     Bench(bench_command::BenchArgs),
+    Merge(merge_command::MergeArgs),
 }
 
 fn main() -> ExitCode {
@@ -45,6 +49,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render_command::run(&args),
         Command::Bench(args) => bench_command::run(&args),
+        Command::Merge(args) => merge_command::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -5,16 +5,16 @@ use std::time::Instant;
 
 use clap::Args;
 use whitted::accel::AccelKind;
-use whitted::image::heat_map;
 use whitted::image::{ImageError, ImageFormat, check_destination};
 use whitted::limits::MemoryBudget;
 use whitted::math::Vec3;
-use whitted::render::{Aov, check_image_size, render};
+use whitted::render::{Aov, Share, Window, check_image_size, render, render_selected};
 use whitted::scene::{CameraOverride, LoadOptions, load_any_with};
 
 use crate::arguments;
 use crate::progress::ProgressReport;
 use crate::report::note;
+use crate::split::{self, PartRender};
 
 /// Render a scene to an image.
 ///
@@ -34,7 +34,8 @@ pub struct RenderArgs {
     /// the built-in scene is rendered.
     scene: Option<PathBuf>,
 
-    /// Output image: .png, .exr or .pfm.
+    /// Output image: .png, .exr or .pfm; or .wpart, a part of the image
+    /// for `whitted merge` (docs/cluster.md).
     #[arg(short, long, value_name = "OUT", default_value = "whitted.png")]
     output: PathBuf,
 
@@ -97,6 +98,16 @@ pub struct RenderArgs {
     #[arg(long, value_name = "SIZE", value_parser = whitted::limits::parse_size)]
     max_memory: Option<u64>,
 
+    /// Render only worker I's share (from 0) of N: every N-th row, into a
+    /// .wpart part for `whitted merge`.
+    #[arg(long, value_name = "I/N", value_parser = split::tile, allow_hyphen_values = true)]
+    tile: Option<Share>,
+
+    /// Render only the window X0,Y0,X1,Y1 (ends excluded), into a .wpart
+    /// part for `whitted merge`.
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = split::crop, allow_hyphen_values = true)]
+    crop: Option<Window>,
+
     /// Print nothing but errors.
     #[arg(short, long)]
     quiet: bool,
@@ -111,7 +122,7 @@ fn parse_accel(name: &str) -> Result<AccelKind, String> {
 }
 
 /// Parses `NAME=FILE` into an AOV and its destination.
-fn parse_aov(spec: &str) -> Result<(Aov, PathBuf), String> {
+pub fn parse_aov(spec: &str) -> Result<(Aov, PathBuf), String> {
     let names = Aov::ALL.map(|a| a.name()).join(", ");
     let (name, file) = spec
         .split_once('=')
@@ -138,7 +149,11 @@ fn parse_aov(spec: &str) -> Result<(Aov, PathBuf), String> {
 /// unwritable folders, files the user may not write) and two outputs to
 /// the same file (by canonical path and by file identity); unless `quiet`,
 /// says what the user should know about the files that will be replaced.
-fn check_destinations(output: &Path, aovs: &[(Aov, PathBuf)], quiet: bool) -> Result<(), String> {
+pub fn check_destinations(
+    output: &Path,
+    aovs: &[(Aov, PathBuf)],
+    quiet: bool,
+) -> Result<(), String> {
     let image = check_destination(output).map_err(|e| e.to_string())?;
     let mut checked = vec![(format!("-o {}", output.display()), image)];
     for (aov, path) in aovs {
@@ -191,11 +206,15 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     if let Some(bytes) = args.max_memory {
         MemoryBudget::given(bytes).set_current();
     }
-    let aov_outputs = args
-        .aov
-        .iter()
-        .map(|s| parse_aov(s))
-        .collect::<Result<Vec<_>, _>>()?;
+    let part = PartRender::from_args(&args.output, args.tile, args.crop, &args.aov)?;
+    let aov_outputs = match part {
+        Some(_) => Vec::new(),
+        None => args
+            .aov
+            .iter()
+            .map(|s| parse_aov(s))
+            .collect::<Result<Vec<_>, _>>()?,
+    };
     check_destinations(&args.output, &aov_outputs, args.quiet)?;
 
     let options = LoadOptions {
@@ -235,11 +254,24 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     settings.accel = args.accel.unwrap_or(settings.accel);
 
     scene.settings.threads = args.threads;
-    scene.settings.aovs = aov_outputs.iter().map(|(a, _)| *a).collect();
-    let total = u64::from(scene.settings.width) * u64::from(scene.settings.height);
+    scene.settings.aovs = match &part {
+        Some(part) => part.aovs.clone(),
+        None => aov_outputs.iter().map(|(a, _)| *a).collect(),
+    };
+    let selection = match &part {
+        Some(part) => Some(part.selection(scene.settings.width, scene.settings.height)?),
+        None => None,
+    };
+    let total = selection.map_or(
+        u64::from(scene.settings.width) * u64::from(scene.settings.height),
+        |s| s.pixel_count(),
+    );
     let bar = ProgressReport::new(total, args.quiet);
     let start = Instant::now();
-    let output = render(&scene, &|p| bar.update(p));
+    let output = match &selection {
+        Some(selection) => render_selected(&scene, selection, &|p| bar.update(p)),
+        None => render(&scene, &|p| bar.update(p)),
+    };
     bar.finish();
     let output = output.map_err(|e| e.to_string())?;
     let elapsed = start.elapsed().as_secs_f64();
@@ -259,21 +291,23 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         note!("warning: {exceeded}");
     }
 
-    // Every file is encoded first and renamed into place only when all
-    // are ready: a failure leaves every destination as it was.
-    let mut pending = vec![output.image.encode(&args.output)];
-    for ((aov, film), (_, path)) in output.aovs.iter().zip(&aov_outputs) {
-        pending.push(match ImageFormat::from_path(path) {
-            Ok(ImageFormat::Png) if *aov == Aov::Cost => heat_map(film).encode(path),
-            _ => film.encode(path),
-        });
-    }
-    let pending = pending
-        .into_iter()
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| e.to_string())?;
-    for file in pending {
-        file.commit().map_err(|e| e.to_string())?;
+    match selection {
+        Some(selection) => PartRender::write(
+            &args.output,
+            &scene,
+            args.scene.as_deref(),
+            selection,
+            &output,
+        )?,
+        None => {
+            let aovs: Vec<_> = output
+                .aovs
+                .iter()
+                .zip(&aov_outputs)
+                .map(|((aov, film), (_, path))| (*aov, film, path))
+                .collect();
+            crate::outputs::write_films(&output.image, &args.output, &aovs)?;
+        }
     }
 
     if !args.quiet {
