@@ -51,6 +51,9 @@ JobCompType=jobcomp/none
 MpiDefault=none
 ReturnToService=2
 SchedulerType=sched/backfill
+# Start a batch job as soon as it may run, not up to 3 s later (the
+# default): the test's jobs take a fraction of a second.
+SchedulerParameters=batch_sched_delay=0
 SelectType=select/cons_tres
 SelectTypeParameters=CR_CPU
 MinJobAge=600
