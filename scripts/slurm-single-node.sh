@@ -33,7 +33,7 @@ run mkdir -p /etc/slurm /var/spool/slurmctld /var/spool/slurmd /var/log/slurm /r
 conf=$(cat <<CONF
 # A one-node cluster for whitted's tests (scripts/slurm-single-node.sh).
 ClusterName=whitted-test
-SlurmctldHost=$host
+SlurmctldHost=$host(127.0.0.1)
 SlurmUser=root
 SlurmdUser=root
 AuthType=auth/munge
@@ -57,7 +57,7 @@ SchedulerParameters=batch_sched_delay=0
 SelectType=select/cons_tres
 SelectTypeParameters=CR_CPU
 MinJobAge=600
-NodeName=$host CPUs=$cpus State=UNKNOWN
+NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus State=UNKNOWN
 PartitionName=debug Nodes=$host Default=YES MaxTime=INFINITE State=UP
 CONF
 )
