@@ -37,3 +37,8 @@ fn png_and_jpeg_textures_never_panic() {
 fn ray_files_never_panic() {
     fuzz::fuzz(fuzz::targets::ray_files(), 5);
 }
+
+#[test]
+fn partial_images_never_panic() {
+    fuzz::fuzz(fuzz::targets::parts(), 6);
+}

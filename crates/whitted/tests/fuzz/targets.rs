@@ -13,7 +13,10 @@ use whitted::bench::{RayKind, trace_all};
 use whitted::math::{DVec2, Vec3};
 use whitted::render::Camera;
 use whitted::render::Scene;
-use whitted::render::{Aov, render};
+use whitted::render::{
+    Aov, PartHeader, PixelSelection, Share, Window, encode_part, merge_parts, parse_part, render,
+    render_selected,
+};
 use whitted::scene::{
     MAX_DIAGNOSTICS, MAX_SHOWN_CHARS, SceneError, parse_nff, parse_obj, parse_scene,
 };
@@ -393,5 +396,89 @@ pub fn ray_files() -> Target {
                 .collect(),
         },
         run: run_ray_files,
+    }
+}
+
+/// A part of the built-in scene at 12×9 holding `selection`, with `aovs`.
+fn part_of_built_in(selection: PixelSelection, aovs: &[Aov]) -> Vec<u8> {
+    let mut scene = whitted::scene::default_scene();
+    scene.settings.width = 12;
+    scene.settings.height = 9;
+    scene.settings.aovs = aovs.to_vec();
+    scene.settings.threads = Some(1);
+    let output = render_selected(&scene, &selection, &|_| {}).expect("a part renders");
+    let header = PartHeader::new(&scene, "built-in", "built-in", selection);
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let path = dir.path().join("part.wpart");
+    encode_part(&path, &header, &output)
+        .and_then(|pending| pending.commit())
+        .expect("a part written");
+    std::fs::read(path).expect("the part read back")
+}
+
+fn run_parts(workspace: &Workspace, parts: &[Vec<u8>], _: AccelKind) -> bool {
+    let path = workspace.path("case.wpart");
+    if parse_part(&parts[0], &path).is_err() {
+        return false;
+    }
+    std::fs::write(&path, &parts[0]).expect("part written");
+    // Accepted: it must merge, or be refused for its holes.
+    let _ = merge_parts(&[path]);
+    true
+}
+
+/// The pixels of a window, or one share of its rows.
+fn crop(x0: u32, y0: u32, x1: u32, y1: u32, share: Option<Share>) -> PixelSelection {
+    PixelSelection {
+        window: Window { x0, y0, x1, y1 },
+        share,
+    }
+}
+
+/// The partial images of a split render (`.wpart`).
+pub fn parts() -> Target {
+    let corpus = vec![
+        part_of_built_in(crop(0, 0, 12, 9, None), &[]),
+        part_of_built_in(
+            crop(0, 0, 12, 9, Some(Share { index: 1, count: 3 })),
+            &Aov::ALL,
+        ),
+        part_of_built_in(
+            crop(2, 3, 5, 8, Some(Share { index: 0, count: 2 })),
+            &[Aov::Normal],
+        ),
+    ];
+    let vocabulary = corpus::vocabulary(
+        &corpus,
+        &[
+            "crop",
+            "tile",
+            "pixels",
+            "data",
+            "-",
+            "0,0,65535,65535",
+            "4294967295/1",
+        ],
+    );
+    Target {
+        name: "parts",
+        text: false,
+        corpus: vec![corpus],
+        vocabulary,
+        generate: |rng, _| {
+            let x0 = rng.below(12);
+            let y0 = rng.below(9);
+            let count = 1 + rng.below(4);
+            let share = (rng.below(2) == 0).then(|| Share {
+                index: rng.below(count),
+                count,
+            });
+            let selection = crop(x0, y0, 12, 9, share);
+            if selection.check(12, 9).is_err() {
+                return part_of_built_in(crop(0, 0, 12, 9, None), &[Aov::Depth]);
+            }
+            part_of_built_in(selection, &[Aov::Id, Aov::Cost])
+        },
+        run: run_parts,
     }
 }
