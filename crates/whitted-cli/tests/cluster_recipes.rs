@@ -38,10 +38,13 @@ fn the_kubernetes_recipe_passes_its_field_check_and_its_commands_merge_bit_for_b
         .output()
         .is_ok_and(|o| o.status.success());
     if !has_yaml {
-        eprintln!(
-            "SKIPPED: python3 with PyYAML is missing, so deploy/kubernetes/ was not checked; \
-             install python3-yaml (Debian) or PyYAML (pip)"
+        let why = "SKIPPED: python3 with PyYAML is missing, so deploy/kubernetes/ was not checked; \
+             install python3-yaml (Debian) or PyYAML (pip)";
+        assert!(
+            std::env::var_os("WHITTED_REQUIRE_TOOLS").is_none(),
+            "{why} (WHITTED_REQUIRE_TOOLS is set, as .ci/run sets it: the tool must be there)"
         );
+        eprintln!("{why}");
         return;
     }
     let check = Command::new("python3")

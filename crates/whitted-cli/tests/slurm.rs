@@ -4,7 +4,8 @@
 //!
 //! Needs a running cluster (`scripts/slurm-single-node.sh` starts one on
 //! this machine; `.ci/run` does). Without `sbatch` the test says SKIPPED
-//! and why, and passes; with `sbatch` but no working cluster it fails.
+//! and why, and passes (unless `WHITTED_REQUIRE_TOOLS` is set, as `.ci/run`
+//! sets it); with `sbatch` but no working cluster it fails.
 
 use std::path::Path;
 use std::process::Command;
@@ -65,10 +66,13 @@ fn logs(dir: &Path) -> String {
 #[test]
 fn the_slurm_job_array_and_merge_job_give_the_direct_render_bit_for_bit() {
     if Command::new("sbatch").arg("--version").output().is_err() {
-        eprintln!(
-            "SKIPPED: sbatch is not installed, so the Slurm round trip was not tested; \
-             scripts/slurm-single-node.sh installs Slurm and starts a one-node cluster"
+        let why = "SKIPPED: sbatch is not installed, so the Slurm round trip was not tested; \
+             scripts/slurm-single-node.sh installs Slurm and starts a one-node cluster";
+        assert!(
+            std::env::var_os("WHITTED_REQUIRE_TOOLS").is_none(),
+            "{why} (WHITTED_REQUIRE_TOOLS is set, as .ci/run sets it: the tool must be there)"
         );
+        eprintln!("{why}");
         return;
     }
     let dir = tempfile::tempdir().unwrap();
