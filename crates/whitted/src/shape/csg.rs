@@ -15,10 +15,12 @@
 //! cutter sharing a face with the base, two boxes stacked face to face),
 //! rounding puts their crossings a hair apart in either order, which
 //! would leave a sliver of solid (or of space) and speckles. The rule:
-//! crossings closer than [`COINCIDENT`] times the CSG's size count as
-//! coincident; a stretch of solid or of space between coincident
-//! crossings is dropped (the cut face is cut away, the stacked boxes are
-//! one solid); at exact ties the earlier child's crossing comes first.
+//! crossings of different children closer than [`COINCIDENT`] times the
+//! CSG's size are one place, taken at once, so no sliver arises (the cut
+//! face is cut away, the stacked boxes are one solid, a box minus itself
+//! is nothing); where the answer changes there, the surface is the first
+//! child's (in the order written) among those crossing the same way. A
+//! stretch of solid or of space shorter than that is dropped as well.
 //!
 //! **Normals and materials.** A surface that comes from a subtracted child
 //! (an odd number of times, through nested differences) has its normal
@@ -398,7 +400,7 @@ impl Data {
         {
             return lists.into_iter().find(|l| !l.is_empty()).unwrap_or_default();
         }
-        tidy(sweep(node.operation, &lists), tolerance)
+        tidy(sweep(node.operation, &lists, tolerance), tolerance)
     }
 
     fn leaf_boundaries(&self, i: u32, ray: &Ray) -> Vec<Boundary> {
@@ -420,36 +422,51 @@ impl Data {
 }
 
 /// Where `operation`'s answer over the children's boundary `lists`
-/// changes: the lists are walked together in order of `t`, the earlier
-/// child first at ties.
-fn sweep(operation: CsgOperation, lists: &[Vec<Boundary>]) -> Vec<Boundary> {
+/// changes. The lists are walked together in order of `t`; crossings of
+/// different children closer than `tolerance` to the first of them are
+/// taken at once, as one place, and where the answer changes there the
+/// earliest child whose crossing goes the same way gives the surface.
+fn sweep(operation: CsgOperation, lists: &[Vec<Boundary>], tolerance: f64) -> Vec<Boundary> {
     let mut next = vec![0usize; lists.len()];
     let mut inside = vec![false; lists.len()];
     let mut answer = false;
     let mut out = Vec::new();
+    // The crossings taken at one place: (child, boundary).
+    let mut group: Vec<(usize, Boundary)> = Vec::new();
     loop {
-        let mut earliest: Option<(usize, f64)> = None;
+        let earliest = lists
+            .iter()
+            .enumerate()
+            .filter_map(|(k, list)| list.get(next[k]))
+            .map(|b| b.hit.t)
+            .fold(f64::INFINITY, f64::min);
+        if earliest == f64::INFINITY {
+            return out;
+        }
+        group.clear();
         for (k, list) in lists.iter().enumerate() {
-            if let Some(b) = list.get(next[k])
-                && earliest.is_none_or(|(_, t)| b.hit.t < t)
+            while let Some(b) = list.get(next[k])
+                && b.hit.t - earliest < tolerance.max(0.0) + f64::MIN_POSITIVE
             {
-                earliest = Some((k, b.hit.t));
+                group.push((k, *b));
+                inside[k] = b.entering;
+                next[k] += 1;
             }
         }
-        let Some((k, _)) = earliest else {
-            return out;
-        };
-        let b = lists[k][next[k]];
-        next[k] += 1;
-        inside[k] = b.entering;
         let now = operation.combine(&inside);
-        if now != answer {
-            answer = now;
-            out.push(Boundary {
-                entering: now,
-                ..b
-            });
+        if now == answer {
+            continue;
         }
+        answer = now;
+        let subtracted = |k: usize| operation == CsgOperation::Difference && k > 0;
+        let (_, b) = group
+            .iter()
+            .find(|&&(k, b)| (b.entering != subtracted(k)) == now)
+            .unwrap_or(&group[0]);
+        out.push(Boundary {
+            entering: now,
+            ..*b
+        });
     }
 }
 
