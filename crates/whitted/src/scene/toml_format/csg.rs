@@ -141,3 +141,71 @@ fn read_child(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> Pa
         material: object.material.map(|index| index as u32),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{CAMERA, errors, scene};
+    use crate::math::{Ray, Vec3};
+    use crate::shape::Shape;
+    use crate::world::{MaterialId, World};
+
+    #[test]
+    fn a_csg_object_is_read_with_its_children_materials_and_transforms() {
+        // A box minus a sphere moved to its top face, nested in a union
+        // with a sphere standing to the side; the whole moved up by 1.
+        let s = scene(&format!(
+            "{CAMERA}[materials.ivory]\n[materials.ink]\n\
+             [[objects]]\ncsg = 'union'\nmaterial = 'ivory'\n\
+             transform = {{ translate = [0, 1, 0] }}\nchildren = [\n\
+               {{ csg = 'difference', children = [\n\
+                 {{ shape = 'box', min = [-1, -1, -1], max = [1, 1, 1] }},\n\
+                 {{ shape = 'sphere', radius = 0.5, material = 'ink', \
+                    transform = {{ translate = [0, 1, 0] }} }},\n\
+               ] }},\n\
+               {{ shape = 'sphere', center = [3, 0, 0], radius = 0.5 }},\n\
+             ]\n"
+        ));
+        let [p] = s.objects.primitives.as_slice() else {
+            panic!("one object")
+        };
+        assert!(matches!(&p.shape, Shape::Csg(c) if c.leaf_count() == 3));
+        assert_eq!(p.material, MaterialId(0));
+        let world = World::new(&s.objects);
+        let down = |x: f64| Ray::new(Vec3::new(x, 5.0, 0.0), -Vec3::Y);
+        // Into the pocket: the sphere's lower half, 0.5 below the top face
+        // at y = 2, in the child's own material.
+        let hit = world.intersect(&down(0.0)).unwrap();
+        let surface = world.surface(&down(0.0), &hit);
+        assert!((surface.point.y - 1.5).abs() < 1e-12, "{}", surface.point);
+        assert!(surface.normal.y > 0.99);
+        assert_eq!(surface.material, MaterialId(1));
+        let hit = world.intersect(&down(0.9)).unwrap();
+        assert!((hit.t() - 3.0).abs() < 1e-12);
+        assert_eq!(world.surface(&down(0.9), &hit).material, MaterialId(0));
+        let hit = world.intersect(&down(3.0)).unwrap();
+        assert!((hit.t() - 3.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn open_children_lone_children_and_unknown_operations_are_refused() {
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[[objects]]\ncsg = 'difference'\nchildren = [\n\
+                 {{ shape = 'sphere', radius = 1 }},\n\
+                 {{ shape = 'disk', center = [0, 0, 0], normal = [0, 1, 0], radius = 1 }},\n]\n\
+                 [[objects]]\ncsg = 'union'\nchildren = [{{ shape = 'sphere', radius = 1 }}]\n\
+                 [[objects]]\ncsg = 'merge'\nchildren = 3\n"
+            )),
+            [
+                "a disk cannot be a CSG child, which must be a closed solid: a flat shape has \
+                 no inside; closed solids are spheres, boxes, cylinders and cones with caps, \
+                 tori, quadrics without bounds that are ellipsoids, superellipsoids, implicit \
+                 surfaces and CSG objects",
+                "a CSG union needs at least two children, this one has 1; write the child as \
+                 an object of its own",
+                "unknown CSG operation `merge`; expected one of: union, intersection, difference",
+                "expected a list of objects for `children`, found an integer",
+            ]
+        );
+    }
+}
