@@ -59,7 +59,7 @@ impl Shape {
             Shape::Cylinder(c) if c.caps() => Solidity::Closed,
             Shape::Cone(c) if c.caps() => Solidity::Closed,
             Shape::Cylinder(_) | Shape::Cone(_) => {
-                Solidity::Open("without `caps = true` its ends are open")
+                Solidity::Open("with `caps = false` its ends are open")
             }
             Shape::Quadric(q) => {
                 if q.clip().is_some() {

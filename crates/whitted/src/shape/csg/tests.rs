@@ -318,7 +318,7 @@ fn open_children_and_lone_children_are_refused() {
         )
         .unwrap_err()
         .to_string(),
-        "child 0 (cylinder) is not a closed solid: without `caps = true` its ends are open"
+        "child 0 (cylinder) is not a closed solid: with `caps = false` its ends are open"
     );
     assert_eq!(
         Csg::new(CsgOperation::Intersection, vec![child(unit_box(), None)])
