@@ -360,7 +360,8 @@ impl Data {
             }
             Part::Node(i) => {
                 let node = &self.nodes[i as usize];
-                let inside: Vec<bool> = node.children.iter().map(|&c| self.contains(c, p)).collect();
+                let inside: Vec<bool> =
+                    node.children.iter().map(|&c| self.contains(c, p)).collect();
                 node.operation.combine(&inside)
             }
         }
@@ -396,9 +397,13 @@ impl Data {
             }
             lists.push(list);
         }
-        if node.operation == CsgOperation::Union && lists.iter().filter(|l| !l.is_empty()).count() < 2
+        if node.operation == CsgOperation::Union
+            && lists.iter().filter(|l| !l.is_empty()).count() < 2
         {
-            return lists.into_iter().find(|l| !l.is_empty()).unwrap_or_default();
+            return lists
+                .into_iter()
+                .find(|l| !l.is_empty())
+                .unwrap_or_default();
         }
         tidy(sweep(node.operation, &lists, tolerance), tolerance)
     }

@@ -75,10 +75,9 @@ impl Shape {
                 }
             }
             Shape::Plane(_) => Solidity::Open("a plane is a surface with no inside"),
-            Shape::Triangle(_)
-            | Shape::Parallelogram(_)
-            | Shape::Polygon(_)
-            | Shape::Disk(_) => Solidity::Open("a flat shape has no inside"),
+            Shape::Triangle(_) | Shape::Parallelogram(_) | Shape::Polygon(_) | Shape::Disk(_) => {
+                Solidity::Open("a flat shape has no inside")
+            }
             Shape::BezierPatch(_) => Solidity::Open("a patch is a surface with no inside"),
         }
     }
@@ -180,7 +179,16 @@ fn far_outside(shape: &Shape) -> Vec3 {
 fn quadric_value(q: &super::Quadric, p: Vec3) -> f64 {
     let (x, y, z) = (p.x, p.y, p.z);
     let [a, b, c, d, e, f, g, h, i, j] = q.coefficients();
-    a * x * x + b * y * y + c * z * z + d * x * y + e * x * z + f * y * z + g * x + h * y + i * z + j
+    a * x * x
+        + b * y * y
+        + c * z * z
+        + d * x * y
+        + e * x * z
+        + f * y * z
+        + g * x
+        + h * y
+        + i * z
+        + j
 }
 
 #[cfg(test)]
@@ -235,8 +243,7 @@ mod tests {
             ),
             // A negative definite quadric: the bubble, everything outside.
             Shape::Quadric(
-                Quadric::new([-1.0, -1.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0], None)
-                    .unwrap(),
+                Quadric::new([-1.0, -1.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0], None).unwrap(),
             ),
         ];
         for shape in open {

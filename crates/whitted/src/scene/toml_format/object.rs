@@ -141,7 +141,11 @@ pub(super) fn unknown_material(name: &str, materials: &[String]) -> String {
 const STEPS: &[&str] = &["translate", "rotate", "scale", "matrix"];
 
 /// A list of steps (or one step), composed so the first acts first.
-pub(super) fn read_transform(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Transform> {
+pub(super) fn read_transform(
+    r: &mut Reader<'_>,
+    value: &Value<'_>,
+    key: &str,
+) -> Parsed<Transform> {
     let steps = if value.as_table().is_some() {
         std::slice::from_ref(value)
     } else {

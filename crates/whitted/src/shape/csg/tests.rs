@@ -15,14 +15,15 @@ use crate::world::{MaterialId, Objects, World};
 /// A CSG tree as written, for the reference: evaluated as given, not as
 /// [`Csg`] flattens it.
 enum Spec {
-    Leaf(Shape, Option<Transform>),
+    Leaf(Box<(Shape, Option<Transform>)>),
     Op(CsgOperation, Vec<Spec>),
 }
 
 impl Spec {
     fn inside(&self, p: Vec3) -> bool {
         match self {
-            Spec::Leaf(shape, t) => {
+            Spec::Leaf(leaf) => {
+                let (shape, t) = &**leaf;
                 shape.contains(t.map_or(p, |t| t.object_from_world().transform_point3(p)))
             }
             Spec::Op(op, children) => {
@@ -39,9 +40,9 @@ impl Spec {
 
     fn child(&self) -> CsgChild {
         match self {
-            Spec::Leaf(shape, transform) => CsgChild {
-                shape: shape.clone(),
-                transform: *transform,
+            Spec::Leaf(leaf) => CsgChild {
+                shape: leaf.0.clone(),
+                transform: leaf.1,
                 material: None,
             },
             Spec::Op(..) => CsgChild {
@@ -63,17 +64,28 @@ impl Spec {
 fn random_leaf(rng: &mut Rng) -> Spec {
     let shape = match rng.below(5) {
         0 => Shape::Sphere(
-            Sphere::new(rng.point_in(Vec3::splat(-0.5), Vec3::splat(0.5)), rng.range(0.4, 1.0))
-                .unwrap(),
+            Sphere::new(
+                rng.point_in(Vec3::splat(-0.5), Vec3::splat(0.5)),
+                rng.range(0.4, 1.0),
+            )
+            .unwrap(),
         ),
         1 => {
             let a = rng.point_in(Vec3::splat(-1.0), Vec3::splat(0.0));
             let b = a + rng.point_in(Vec3::splat(0.3), Vec3::splat(1.5));
             Shape::AxisBox(AxisBox::new(a, b).unwrap())
         }
-        2 => Shape::Cylinder(Cylinder::new(rng.range(0.2, 0.7), rng.range(0.5, 1.5), true).unwrap()),
+        2 => {
+            Shape::Cylinder(Cylinder::new(rng.range(0.2, 0.7), rng.range(0.5, 1.5), true).unwrap())
+        }
         3 => Shape::Cone(
-            Cone::new(rng.range(0.0, 0.7), rng.range(0.2, 0.7), rng.range(0.5, 1.5), true).unwrap(),
+            Cone::new(
+                rng.range(0.0, 0.7),
+                rng.range(0.2, 0.7),
+                rng.range(0.5, 1.5),
+                true,
+            )
+            .unwrap(),
         ),
         _ => Shape::Torus(Torus::new(rng.range(0.4, 0.8), rng.range(0.1, 0.35)).unwrap()),
     };
@@ -85,7 +97,7 @@ fn random_leaf(rng: &mut Rng) -> Spec {
                 &Transform::scale(rng.point_in(Vec3::splat(0.6), Vec3::splat(1.4))).unwrap(),
             )
     });
-    Spec::Leaf(shape, transform)
+    Spec::Leaf(Box::new((shape, transform)))
 }
 
 fn random_spec(rng: &mut Rng, op: CsgOperation, depth: u32) -> Spec {
@@ -151,19 +163,29 @@ fn every_operation_finds_the_first_boundary_that_point_sampling_finds() {
                 let sampled = first_change(&spec, &ray, length, n);
                 rays += 1;
                 let Some(hit) = shape.intersect(&ray) else {
-                    assert!(sampled.is_none(), "{op:?}: missed a boundary in {sampled:?}");
+                    assert!(
+                        sampled.is_none(),
+                        "{op:?}: missed a boundary in {sampled:?}"
+                    );
                     continue;
                 };
                 hits += 1;
                 let t = hit.t;
                 let before = spec.inside(ray.at(t - delta));
-                assert_ne!(before, spec.inside(ray.at(t + delta)), "{op:?}: no boundary at {t}");
+                assert_ne!(
+                    before,
+                    spec.inside(ray.at(t + delta)),
+                    "{op:?}: no boundary at {t}"
+                );
                 // Not beyond the first change sampling sees; before it only
                 // into a feature thinner than the step, left again unseen,
                 // so from the state sampling starts in.
                 let start = spec.inside(ray.at(step / 2.0));
                 if let Some((lo, hi)) = sampled {
-                    assert!(t <= hi + delta, "{op:?}: hit at {t}, sampling changes in ({lo}, {hi}]");
+                    assert!(
+                        t <= hi + delta,
+                        "{op:?}: hit at {t}, sampling changes in ({lo}, {hi}]"
+                    );
                 }
                 if sampled.is_none_or(|(lo, _)| t <= lo - delta) {
                     assert!(t < step || before == start, "{op:?}: hit at {t}");
@@ -180,7 +202,10 @@ fn every_operation_finds_the_first_boundary_that_point_sampling_finds() {
         }
         assert!(hits > rays / 4, "{op:?}: {hits} of {rays}");
         // Near a child's edge the step off the surface may land elsewhere.
-        assert!(normals_out * 100 > hits * 98, "{op:?}: {normals_out} of {hits}");
+        assert!(
+            normals_out * 100 > hits * 98,
+            "{op:?}: {normals_out} of {hits}"
+        );
     }
 }
 
@@ -228,7 +253,10 @@ fn a_cutter_sharing_a_face_with_the_base_leaves_no_speckles() {
     // turn, so rounding puts its face above, on or below the base's.
     let pocket = Vec3::new(0.3, 0.3, 0.7);
     let cutters = [
-        child(Shape::AxisBox(AxisBox::new(pocket, Vec3::new(0.7, 0.7, 1.0)).unwrap()), None),
+        child(
+            Shape::AxisBox(AxisBox::new(pocket, Vec3::new(0.7, 0.7, 1.0)).unwrap()),
+            None,
+        ),
         child(
             unit_box(),
             Some(
@@ -250,11 +278,18 @@ fn a_cutter_sharing_a_face_with_the_base_leaves_no_speckles() {
     let mut rng = Rng::new(3);
     for cutter in cutters {
         let shape = Shape::Csg(
-            Csg::new(CsgOperation::Difference, vec![child(unit_box(), None), cutter]).unwrap(),
+            Csg::new(
+                CsgOperation::Difference,
+                vec![child(unit_box(), None), cutter],
+            )
+            .unwrap(),
         );
         for _ in 0..2000 {
             let at = rng.point_in(Vec3::new(0.31, 0.31, 2.0), Vec3::new(0.69, 0.69, 2.0));
-            let tilt = rng.point_in(Vec3::new(-0.005, -0.005, -1.0), Vec3::new(0.005, 0.005, -1.0));
+            let tilt = rng.point_in(
+                Vec3::new(-0.005, -0.005, -1.0),
+                Vec3::new(0.005, 0.005, -1.0),
+            );
             let hit = shape.intersect(&Ray::new(at, tilt)).unwrap();
             let ray = Ray::new(at, tilt);
             let z = ray.at(hit.t).z;
@@ -287,9 +322,7 @@ fn coincident_faces_join_or_cancel_and_the_first_child_wins_ties() {
     }
     // A box minus itself is empty; a box intersected with itself is the
     // box, its faces the first child's.
-    let same = |op| {
-        Csg::new(op, vec![child(unit_box(), None), child(unit_box(), None)]).unwrap()
-    };
+    let same = |op| Csg::new(op, vec![child(unit_box(), None), child(unit_box(), None)]).unwrap();
     let ray = Ray::new(Vec3::new(0.5, 0.5, 3.0), -Vec3::Z);
     assert_eq!(same(CsgOperation::Difference).intersect(&ray), None);
     let hit = same(CsgOperation::Intersection).intersect(&ray).unwrap();
@@ -367,7 +400,11 @@ fn children_keep_their_materials_and_others_take_their_parents() {
     for (x, material) in [(0.5, 1), (3.0, 3), (5.0, 2), (7.0, 9)] {
         let ray = Ray::new(Vec3::new(x, 0.5, 5.0), -Vec3::Z);
         let hit = world.intersect(&ray).unwrap();
-        assert_eq!(world.surface(&ray, &hit).material, MaterialId(material), "{x}");
+        assert_eq!(
+            world.surface(&ray, &hit).material,
+            MaterialId(material),
+            "{x}"
+        );
     }
 }
 
@@ -442,7 +479,10 @@ fn a_lens_of_two_spheres_focuses_where_the_thick_lens_equation_says() {
         let t = -ray.origin.x / ray.dir.x;
         let crossing = ray.at(t).z - d / 2.0;
         let efl = h / (-ray.dir.x / ray.dir.z);
-        assert!((crossing / bfd - 1.0).abs() < 0.01, "h = {h}: {crossing} vs {bfd}");
+        assert!(
+            (crossing / bfd - 1.0).abs() < 0.01,
+            "h = {h}: {crossing} vs {bfd}"
+        );
         assert!((efl / f - 1.0).abs() < 0.01, "h = {h}: {efl} vs {f}");
     }
 }
