@@ -23,6 +23,7 @@
 mod axis_box;
 mod bezier_patch;
 mod cone;
+mod csg;
 mod cylinder;
 mod disk;
 pub mod implicit;
@@ -32,6 +33,7 @@ mod plane;
 mod polygon;
 mod quadratic;
 mod quadric;
+mod solid;
 mod sphere;
 mod superellipsoid;
 mod torus;
@@ -43,6 +45,7 @@ mod watertight_avx;
 pub use axis_box::AxisBox;
 pub use bezier_patch::BezierPatch;
 pub use cone::Cone;
+pub use csg::{COINCIDENT, Csg, CsgChild, CsgError, CsgOperation, MAX_LEAVES};
 pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use implicit::{Expression, ExpressionError, Implicit};
@@ -50,6 +53,7 @@ pub use parallelogram::Parallelogram;
 pub use plane::Plane;
 pub use polygon::Polygon;
 pub use quadric::Quadric;
+pub use solid::{Crossing, Solidity};
 pub use sphere::Sphere;
 pub use superellipsoid::{MAX_EXPONENT, MIN_EXPONENT, Superellipsoid, exponent};
 pub use torus::Torus;
@@ -250,6 +254,8 @@ pub enum Shape {
     BezierPatch(BezierPatch),
     /// POV-Ray's superellipsoid.
     Superellipsoid(Superellipsoid),
+    /// A union, intersection or difference of closed solids.
+    Csg(Csg),
 }
 
 const _: () = assert!(std::mem::size_of::<Shape>() <= 80);
@@ -271,6 +277,7 @@ macro_rules! dispatch {
             Shape::Implicit($s) => $body,
             Shape::BezierPatch($s) => $body,
             Shape::Superellipsoid($s) => $body,
+            Shape::Csg($s) => $body,
         }
     };
 }
@@ -315,6 +322,16 @@ impl Shape {
             Shape::Implicit(_) => "implicit",
             Shape::BezierPatch(_) => "bezier_patch",
             Shape::Superellipsoid(_) => "superellipsoid",
+            Shape::Csg(_) => "csg",
+        }
+    }
+
+    /// The material of the part of the shape a hit is on, where that part
+    /// has its own (a CSG child's); `None` for the shape's material.
+    pub fn material(&self, hit: &ShapeHit) -> Option<u32> {
+        match self {
+            Shape::Csg(c) => c.material(hit),
+            _ => None,
         }
     }
 }

@@ -510,7 +510,11 @@ impl<'a> World<'a> {
                 let transform = self.transform(p.transform);
                 let object_ray = transform.map_or(*ray, |t| t.ray_to_object(ray));
                 let s = p.shape.surface(&object_ray, &hit.shape_hit);
-                (s, s.normal, p.material, transform)
+                let material = p
+                    .shape
+                    .material(&hit.shape_hit)
+                    .map_or(p.material, MaterialId);
+                (s, s.normal, material, transform)
             }
             PrimitiveRef::Triangle { instance, triangle } => {
                 let m = &self.objects.mesh_instances[instance as usize];

@@ -34,6 +34,7 @@
 //! out of range, unknown names, and shapes, transforms or cameras their
 //! constructors refuse.
 
+mod csg;
 mod light;
 mod material;
 mod object;

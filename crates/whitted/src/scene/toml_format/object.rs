@@ -21,7 +21,7 @@
 use toml_span::value::Value;
 
 use super::reader::{Parsed, Reader, all, list};
-use super::{patches, shapes};
+use super::{csg, patches, shapes};
 use crate::math::{Transform, TransformError, Vec3, magnitude};
 use crate::shape::Shape;
 
@@ -56,7 +56,14 @@ pub(super) fn read_objects(
 }
 
 /// One object, or one per patch of a `shape = "patches"` file.
-fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> Parsed<Vec<Object>> {
+pub(super) fn read_object(
+    r: &mut Reader<'_>,
+    value: &Value<'_>,
+    materials: &[String],
+) -> Parsed<Vec<Object>> {
+    if value.as_table().is_some_and(|t| t.get(csg::KEY).is_some()) {
+        return csg::read(r, value, materials).map(|object| vec![object]);
+    }
     let f = r.table(value, "objects", "object")?;
     let is_patches = f.get("shape").and_then(|v| v.as_str()) == Some(patches::KIND);
     let kind = (!is_patches).then(|| {
@@ -117,7 +124,7 @@ fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> P
     }])
 }
 
-fn unknown_material(name: &str, materials: &[String]) -> String {
+pub(super) fn unknown_material(name: &str, materials: &[String]) -> String {
     if materials.is_empty() {
         format!(
             "unknown material `{name}`; no materials are defined (add a [materials.{name}] table)"
@@ -134,7 +141,11 @@ fn unknown_material(name: &str, materials: &[String]) -> String {
 const STEPS: &[&str] = &["translate", "rotate", "scale", "matrix"];
 
 /// A list of steps (or one step), composed so the first acts first.
-fn read_transform(r: &mut Reader<'_>, value: &Value<'_>, key: &str) -> Parsed<Transform> {
+pub(super) fn read_transform(
+    r: &mut Reader<'_>,
+    value: &Value<'_>,
+    key: &str,
+) -> Parsed<Transform> {
     let steps = if value.as_table().is_some() {
         std::slice::from_ref(value)
     } else {
