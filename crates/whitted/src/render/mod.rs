@@ -4,12 +4,14 @@
 
 mod camera;
 mod gradient_note;
+mod photon_pass;
 mod resources;
 mod scene;
 mod settings;
 
 pub use camera::{Camera, CameraError};
 pub use gradient_note::GradientExceeded;
+pub use photon_pass::PhotonReport;
 pub use resources::{RayBudgetCut, ThreadClamp, memory_needed};
 pub use scene::Scene;
 pub use settings::{
@@ -69,6 +71,8 @@ pub struct RenderOutput {
     /// The implicit surface whose function grew faster than its
     /// `max_gradient` allows, if any.
     pub gradient_exceeded: Option<GradientExceeded>,
+    /// What the photon pass did, when caustics were asked for.
+    pub photons: Option<PhotonReport>,
 }
 
 /// Why a render could not start.
@@ -110,6 +114,9 @@ pub enum RenderError {
         "the scene has {0} primitives (every placement of a mesh counted): at most {MAX_PRIMITIVES} are allowed"
     )]
     TooManyPrimitives(usize),
+    /// The photon settings are out of range.
+    #[error(transparent)]
+    Photons(#[from] crate::integrator::photon_map::PhotonSettingsError),
     /// The films would exceed the memory budget.
     #[error(transparent)]
     Memory(#[from] MemoryError),
@@ -230,7 +237,9 @@ pub fn render(
         min_weight: settings.min_weight,
         ray_budget: SECONDARY_RAY_BUDGET,
     };
-    let integrator = Integrator::new(settings.integrator, &world, shading, limits);
+    let caustics = pool.install(|| photon_pass::build(&world, &shading, settings))?;
+    let integrator = Integrator::new(settings.integrator, &world, shading, limits)
+        .with_caustics(caustics.as_ref().map(|(map, _)| map));
     let total = u64::from(width) * u64::from(height);
     let done = AtomicU64::new(0);
     let films = Mutex::new(Films {
@@ -272,6 +281,7 @@ pub fn render(
         thread_clamp,
         ray_budget_cut,
         gradient_exceeded: gradient_note::report(&scene.objects),
+        photons: caustics.map(|(_, report)| report),
     })
 }
 
