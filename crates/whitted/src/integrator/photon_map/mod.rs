@@ -3,8 +3,10 @@
 //! follow.
 //!
 //! Before the render, a photon pass ([`trace`]) shoots
-//! [`PhotonSettings::count`] photons from the lights and keeps those that
-//! land on a diffuse surface after at least one specular bounce: the
+//! [`PhotonSettings::count`] photons from the lights (a directional
+//! light's at the objects that can start a caustic, [`aim`]) and keeps
+//! those that land on a diffuse surface after at least one specular
+//! bounce: the
 //! caustic map, a balanced kd-tree ([`kd_tree`]) built once. While
 //! rendering, the Whitted integrator adds at every diffuse point it shades
 //! (seen directly or through mirrors and glass) the irradiance the map
@@ -31,6 +33,7 @@
 //! radius = 0.05      # largest gathering distance, in scene units
 //! ```
 
+mod aim;
 mod kd_tree;
 mod settings;
 mod trace;
@@ -135,7 +138,8 @@ impl CausticMap {
             "shoot fewer photons",
         )?;
         let bounds = world.bounds();
-        let emitters = trace::share(shading.lights, &bounds, settings.count);
+        let aimed = aim::caustic_bounds(world.objects(), shading.materials, bounds);
+        let emitters = trace::share(shading.lights, &aimed, settings.count);
         let tasks = settings.count.div_ceil(PHOTONS_PER_TASK);
         let parts: Vec<Vec<Photon>> = (0..tasks)
             .into_par_iter()
@@ -143,7 +147,7 @@ impl CausticMap {
                 let start = task * PHOTONS_PER_TASK;
                 let end = (start + PHOTONS_PER_TASK).min(settings.count);
                 let mut kept = Vec::new();
-                trace::shoot(world, shading, &emitters, &bounds, start..end, &mut kept);
+                trace::shoot(world, shading, &emitters, &aimed, start..end, &mut kept);
                 kept
             })
             .collect();

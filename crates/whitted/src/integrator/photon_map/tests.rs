@@ -277,3 +277,42 @@ fn shadow_rays_stop_only_at_surfaces_that_bend_light() {
     };
     assert_eq!(shadow_pass_through(&leaf, uv), leaf.pass_through(uv));
 }
+
+#[test]
+fn aiming_at_the_glass_loses_no_caustic_light() {
+    // The ball over a bounded matte table 400 times its size: the sun's
+    // photons are aimed at the ball alone, and carry the same flux as test
+    // 0's; a mirror-less, glass-less scene shoots none at all.
+    let (radius, sun) = (0.5, Color::new(1.0, 2.0, 3.0));
+    let mut setup = ball_over_floor(radius, 1.5, sun, 2.0);
+    setup.objects.primitives.pop();
+    let table = setup.material(matte());
+    setup.add(
+        Shape::AxisBox(
+            crate::shape::AxisBox::new(Vec3::new(-100.0, -2.0, -100.0), Vec3::new(100.0, -1.0, 100.0))
+                .unwrap(),
+        ),
+        table,
+    );
+    let map = setup.map(10_000, 50, 0.1);
+    let expected = sun * (PI * radius * radius);
+    let got = total_power(&map);
+    assert!(within(got, expected, 0.01), "{got} vs {expected}");
+    // Half the photons (the ball's share of its covering disk) are kept.
+    assert!(map.photons().len() > 4_500, "{}", map.photons().len());
+    let mut dull = setup;
+    dull.materials[0] = matte();
+    assert!(dull.map(10_000, 50, 0.1).photons().is_empty());
+}
+
+#[test]
+fn mirrors_and_bending_glass_start_caustics_windows_do_not() {
+    let mirror = Material {
+        reflection: Texture::Constant(Color::splat(0.5)),
+        ..matte()
+    };
+    assert!(aim::starts_caustics(&mirror));
+    assert!(aim::starts_caustics(&clear_glass(1.33)));
+    assert!(!aim::starts_caustics(&clear_glass(1.0)));
+    assert!(!aim::starts_caustics(&matte()));
+}
