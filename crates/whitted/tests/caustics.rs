@@ -39,7 +39,10 @@ fn a_caustic_render_converges_as_photons_are_added() {
     assert!(errors[2] < 0.75 * errors[1], "{errors:?}");
     // And the caustic is there at all: the photons change the picture.
     let without = image(&glass_ball_on_a_table(0));
-    assert!(difference(&without, &reference) > 4.0 * errors[2], "{errors:?}");
+    assert!(
+        difference(&without, &reference) > 4.0 * errors[2],
+        "{errors:?}"
+    );
 }
 
 #[test]
@@ -59,7 +62,11 @@ fn photons_off_leave_the_picture_as_it_was() {
     let (render_table, rest) = source.split_at(source.find("[camera]").unwrap());
     let mut plain: String = render_table
         .lines()
-        .filter(|l| !["photons", "gather", "radius"].iter().any(|k| l.starts_with(k)))
+        .filter(|l| {
+            !["photons", "gather", "radius"]
+                .iter()
+                .any(|k| l.starts_with(k))
+        })
         .map(|l| format!("{l}\n"))
         .collect();
     assert_eq!(plain.lines().count() + 3, render_table.lines().count());

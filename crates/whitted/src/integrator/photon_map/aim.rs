@@ -27,11 +27,7 @@ pub(super) fn starts_caustics(material: &Material) -> bool {
 /// around everything, `scene`, when one of them is unbounded (an infinite
 /// mirror plane). Empty when there is none.
 pub(super) fn caustic_bounds(objects: &Objects, materials: &[Material], scene: Aabb) -> Aabb {
-    let starts = |id: MaterialId| {
-        materials
-            .get(id.0 as usize)
-            .is_some_and(starts_caustics)
-    };
+    let starts = |id: MaterialId| materials.get(id.0 as usize).is_some_and(starts_caustics);
     let mut bounds = Aabb::EMPTY;
     for p in objects.primitives.iter().filter(|p| starts(p.material)) {
         let local = p.shape.bounds();

@@ -202,7 +202,9 @@ fn build_range<T: Located + Send>(items: &mut [T], axes: &mut [u8]) {
         .fold(Aabb::EMPTY, |b, item| b.union_point(item.position()));
     let axis = bounds.extent().max_position();
     let mid = items.len() / 2;
-    items.select_nth_unstable_by(mid, |a, b| a.position()[axis].total_cmp(&b.position()[axis]));
+    items.select_nth_unstable_by(mid, |a, b| {
+        a.position()[axis].total_cmp(&b.position()[axis])
+    });
     axes[mid] = axis as u8;
     let (left, rest) = items.split_at_mut(mid);
     let right = &mut rest[1..];

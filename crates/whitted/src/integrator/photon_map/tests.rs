@@ -70,7 +70,10 @@ fn ball_over_floor(radius: f64, ior: f64, sun: Color, depth: f64) -> Setup {
     let mut setup = Setup::default();
     let glass = setup.material(clear_glass(ior));
     let floor = setup.material(matte());
-    setup.add(Shape::Sphere(Sphere::new(Vec3::ZERO, radius).unwrap()), glass);
+    setup.add(
+        Shape::Sphere(Sphere::new(Vec3::ZERO, radius).unwrap()),
+        glass,
+    );
     setup.add(
         Shape::Plane(Plane::new(Vec3::new(0.0, -depth, 0.0), Vec3::Y).unwrap()),
         floor,
@@ -134,7 +137,10 @@ fn a_mirror_sends_the_flux_of_its_solid_angle_to_the_floor() {
         ),
         mirror,
     );
-    setup.add(Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Y).unwrap()), floor);
+    setup.add(
+        Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Y).unwrap()),
+        floor,
+    );
     let intensity = Color::new(3.0, 1.0, 2.0);
     setup.lights.push(Light::Point {
         position: Vec3::new(0.0, 1.0, 0.0),
@@ -289,8 +295,11 @@ fn aiming_at_the_glass_loses_no_caustic_light() {
     let table = setup.material(matte());
     setup.add(
         Shape::AxisBox(
-            crate::shape::AxisBox::new(Vec3::new(-100.0, -2.0, -100.0), Vec3::new(100.0, -1.0, 100.0))
-                .unwrap(),
+            crate::shape::AxisBox::new(
+                Vec3::new(-100.0, -2.0, -100.0),
+                Vec3::new(100.0, -1.0, 100.0),
+            )
+            .unwrap(),
         ),
         table,
     );
