@@ -210,7 +210,7 @@ fn build_range<T: Located + Send>(items: &mut [T], axes: &mut [u8]) {
     let right = &mut rest[1..];
     let (left_axes, rest_axes) = axes.split_at_mut(mid);
     let right_axes = &mut rest_axes[1..];
-    if items_len_is_large(left.len() + right.len()) {
+    if left.len() + right.len() >= PARALLEL_BUILD {
         rayon::join(
             || build_range(left, left_axes),
             || build_range(right, right_axes),
@@ -219,10 +219,6 @@ fn build_range<T: Located + Send>(items: &mut [T], axes: &mut [u8]) {
         build_range(left, left_axes);
         build_range(right, right_axes);
     }
-}
-
-fn items_len_is_large(len: usize) -> bool {
-    len >= PARALLEL_BUILD
 }
 
 #[cfg(test)]

@@ -19,11 +19,11 @@ pub(super) const PHOTON_KEYS: [&str; 3] = ["photons", "gather", "radius"];
 pub(super) fn read_photons(r: &mut Reader<'_>, f: &Fields<'_, '_>) -> Parsed<PhotonSettings> {
     let d = PhotonSettings::default();
     let max_photons = u32::try_from(MAX_PHOTONS).unwrap_or(u32::MAX);
-    let count = r.or_default(&f, "photons", 0, |r, v, k| r.count(v, k, 0, max_photons));
-    let gather = r.or_default(&f, "gather", d.gather, |r, v, k| {
+    let count = r.or_default(f, "photons", 0, |r, v, k| r.count(v, k, 0, max_photons));
+    let gather = r.or_default(f, "gather", d.gather, |r, v, k| {
         r.count(v, k, 1, MAX_GATHER)
     });
-    let radius = r.optional(&f, "radius", Reader::positive);
+    let radius = r.optional(f, "radius", Reader::positive);
     Ok(PhotonSettings {
         count: u64::from(count?),
         gather: gather?,
