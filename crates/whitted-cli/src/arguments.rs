@@ -5,6 +5,7 @@
 //! `allow_negative_numbers` (or `allow_hyphen_values`), so that `-1`
 //! reaches the parser instead of being taken for an option.
 
+use whitted::integrator::photon_map::MAX_PHOTONS;
 use whitted::math::Vec3;
 use whitted::render::{MAX_DEPTH, MAX_SAMPLES, MAX_SIDE};
 use whitted::scene::{WholeNumberError, parse_whole_number};
@@ -73,6 +74,16 @@ pub fn depth(text: &str) -> Result<u32, String> {
         limit: "the deepest recursion a worker's stack is sized for",
     };
     range.parse(text).map(|n| n as u32)
+}
+
+/// Photons to shoot for caustics: 0 (off) to [`MAX_PHOTONS`].
+pub fn photons(text: &str) -> Result<u64, String> {
+    let range = Range {
+        min: 0,
+        max: MAX_PHOTONS,
+        limit: "ten times what a caustic needs",
+    };
+    range.parse(text)
 }
 
 /// A number of worker threads: at least 1.

@@ -57,6 +57,11 @@ pub struct RenderArgs {
     #[arg(long, value_name = "D", value_parser = arguments::depth, allow_negative_numbers = true)]
     max_depth: Option<u32>,
 
+    /// Photons to shoot for caustics (overrides the scene's `photons`; 0 =
+    /// off, the default; at most 100000000).
+    #[arg(long, value_name = "N", value_parser = arguments::photons, allow_negative_numbers = true)]
+    photons: Option<u64>,
+
     /// Acceleration structure over the objects (overrides the scene's
     /// `accel`); every structure gives the same picture.
     #[arg(long, value_name = "NAME", value_parser = parse_accel)]
@@ -252,6 +257,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     settings.samples_per_pixel = args.spp.unwrap_or(settings.samples_per_pixel);
     settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
     settings.accel = args.accel.unwrap_or(settings.accel);
+    settings.photons.count = args.photons.unwrap_or(settings.photons.count);
 
     scene.settings.threads = args.threads;
     scene.settings.aovs = match &part {
@@ -289,6 +295,11 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         && !args.quiet
     {
         note!("warning: {exceeded}");
+    }
+    if let Some(photons) = &output.photons
+        && !args.quiet
+    {
+        note!("{photons}");
     }
 
     match selection {

@@ -307,3 +307,45 @@ fn a_stopped_worker_leaves_no_part_and_its_tile_can_be_rendered_again() {
         std::fs::read(dir.path().join("m.png")).unwrap()
     );
 }
+
+#[test]
+fn with_photons_every_worker_builds_the_same_map_and_the_merge_is_the_single_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/caustics.toml");
+    let scene = scene.to_str().unwrap();
+    let picture = ["--width", "48", "--height", "30", "-q", "--photons"];
+    let mut single = vec!["render", scene, "-o", "single.pfm"];
+    single.extend(picture);
+    single.push("20000");
+    succeeds(&single, dir.path());
+    for (i, photons) in [(0, "20000"), (1, "20000"), (1, "10000")] {
+        let part = format!("{i}-{photons}.wpart");
+        let tile = format!("{i}/2");
+        let mut args = vec!["render", scene, "--tile", &tile, "-o", &part];
+        args.extend(picture);
+        args.push(photons);
+        succeeds(&args, dir.path());
+    }
+    succeeds(
+        &[
+            "merge",
+            "-q",
+            "0-20000.wpart",
+            "1-20000.wpart",
+            "-o",
+            "merged.pfm",
+        ],
+        dir.path(),
+    );
+    let single = std::fs::read(dir.path().join("single.pfm")).unwrap();
+    let merged = std::fs::read(dir.path().join("merged.pfm")).unwrap();
+    assert!(
+        single == merged,
+        "the merged caustics differ from the single render"
+    );
+    let refused = fails(
+        &["merge", "0-20000.wpart", "1-10000.wpart", "-o", "mixed.pfm"],
+        dir.path(),
+    );
+    assert!(refused.contains("1-10000.wpart"), "{refused}");
+}

@@ -8,9 +8,11 @@
 //! traces by kind ([`RayCounts`]); [`Integrator::ray_kinds`] says which
 //! kinds it can trace.
 
+pub mod photon_map;
 mod ray_counts;
 mod whitted;
 
+pub use photon_map::{CausticMap, PhotonSettings};
 pub use ray_counts::{RayCounts, RayKind};
 pub use whitted::Whitted;
 
@@ -94,6 +96,14 @@ impl<'a> Integrator<'a> {
     ) -> Self {
         match kind {
             IntegratorKind::Whitted => Integrator::Whitted(Whitted::new(world, shading, limits)),
+        }
+    }
+
+    /// Adds the caustic map's light at every diffuse point it shades, if
+    /// there is a map (see [`photon_map`]).
+    pub fn with_caustics(self, caustics: Option<&'a CausticMap>) -> Self {
+        match self {
+            Integrator::Whitted(w) => Integrator::Whitted(w.with_caustics(caustics)),
         }
     }
 

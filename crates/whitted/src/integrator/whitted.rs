@@ -25,6 +25,7 @@
 //!   ([`super::SECONDARY_RAY_BUDGET`]); the sample then says at which
 //!   material it was cut.
 
+use crate::integrator::photon_map::{self, CausticMap};
 use crate::integrator::{PrimarySample, RayCounts, RayKind, RecursionLimits, Shading};
 use crate::math::{Ray, Vec3, offset_ray_origin};
 use crate::shading::optics::reflect;
@@ -69,6 +70,7 @@ pub struct Whitted<'a> {
     shading: Shading<'a>,
     limits: RecursionLimits,
     any_transmissive: bool,
+    caustics: Option<&'a CausticMap>,
 }
 
 impl<'a> Whitted<'a> {
@@ -83,7 +85,15 @@ impl<'a> Whitted<'a> {
             shading,
             limits,
             any_transmissive: shading.materials.iter().any(Material::is_transmissive),
+            caustics: None,
         }
+    }
+
+    /// Adds the caustic map's irradiance at every diffuse point it shades
+    /// and stops shadow rays at surfaces that bend light (the map carries
+    /// that light); `None` leaves it as it was.
+    pub fn with_caustics(self, caustics: Option<&'a CausticMap>) -> Self {
+        Self { caustics, ..self }
     }
 
     /// The world it traces in.
@@ -181,6 +191,12 @@ impl<'a> Whitted<'a> {
                 let direct = phong(diffuse, specular, m.shininess, n, sample.to_light, view);
                 local += shadow * sample.intensity * direct;
             }
+        }
+        if let Some(caustics) = self.caustics
+            && alpha != Color::ZERO
+            && diffuse != Color::ZERO
+        {
+            local += diffuse * caustics.irradiance(s.point, n);
         }
         let mut color = alpha * local;
 
@@ -284,7 +300,10 @@ impl<'a> Whitted<'a> {
             };
             let blocker = self.world.surface(&ray, &hit);
             let m = &self.shading.materials[blocker.material.0 as usize];
-            through *= m.pass_through(blocker.uv);
+            through *= match self.caustics {
+                Some(_) => photon_map::shadow_pass_through(m, blocker.uv),
+                None => m.pass_through(blocker.uv),
+            };
             if through.max_element() <= 0.0 {
                 return Color::ZERO;
             }

@@ -6,6 +6,7 @@ mod camera;
 mod gradient_note;
 mod merge;
 mod part;
+mod photon_pass;
 mod resources;
 mod scene;
 mod selection;
@@ -17,6 +18,7 @@ pub use merge::{MergeError, Merged, merge_parts};
 pub use part::{
     BUILT_IN_SCENE, Part, PartError, PartHeader, encode_part, parse_part, read_part, scene_sha256,
 };
+pub use photon_pass::PhotonReport;
 pub use resources::{RayBudgetCut, ThreadClamp, memory_needed};
 pub use scene::Scene;
 pub use selection::{PixelSelection, SelectionError, Share, Window};
@@ -77,6 +79,8 @@ pub struct RenderOutput {
     /// The implicit surface whose function grew faster than its
     /// `max_gradient` allows, if any.
     pub gradient_exceeded: Option<GradientExceeded>,
+    /// What the photon pass did, when caustics were asked for.
+    pub photons: Option<PhotonReport>,
 }
 
 /// Why a render could not start.
@@ -118,6 +122,9 @@ pub enum RenderError {
         "the scene has {0} primitives (every placement of a mesh counted): at most {MAX_PRIMITIVES} are allowed"
     )]
     TooManyPrimitives(usize),
+    /// The photon settings are out of range.
+    #[error(transparent)]
+    Photons(#[from] crate::integrator::photon_map::PhotonSettingsError),
     /// The films would exceed the memory budget.
     #[error(transparent)]
     Memory(#[from] MemoryError),
@@ -258,7 +265,9 @@ pub fn render_selected(
         min_weight: settings.min_weight,
         ray_budget: SECONDARY_RAY_BUDGET,
     };
-    let integrator = Integrator::new(settings.integrator, &world, shading, limits);
+    let caustics = pool.install(|| photon_pass::build(&world, &shading, settings))?;
+    let integrator = Integrator::new(settings.integrator, &world, shading, limits)
+        .with_caustics(caustics.as_ref().map(|(map, _)| map));
     let total = selection.pixel_count();
     let done = AtomicU64::new(0);
     let films = Mutex::new(Films {
@@ -301,6 +310,7 @@ pub fn render_selected(
         thread_clamp,
         ray_budget_cut,
         gradient_exceeded: gradient_note::report(&scene.objects),
+        photons: caustics.map(|(_, report)| report),
     })
 }
 

@@ -4,7 +4,7 @@
 
 use super::RenderError;
 use crate::accel::AccelKind;
-use crate::integrator::IntegratorKind;
+use crate::integrator::{IntegratorKind, PhotonSettings};
 
 /// The deepest recursion a render accepts. Each level takes a few
 /// kilobytes of a worker's stack, which is sized for it.
@@ -101,6 +101,8 @@ pub struct RenderSettings {
     pub accel: AccelKind,
     /// The algorithm that computes the colour along each camera ray.
     pub integrator: IntegratorKind,
+    /// Photon-mapped caustics: off unless photons are asked for.
+    pub photons: PhotonSettings,
     /// Worker threads; `None` uses every core. The picture is the same for
     /// any count.
     pub threads: Option<usize>,
@@ -122,6 +124,7 @@ impl RenderSettings {
         if self.max_depth > MAX_DEPTH {
             return Err(RenderError::DepthTooLarge(self.max_depth));
         }
+        self.photons.check()?;
         Ok(())
     }
 }
@@ -136,6 +139,7 @@ impl Default for RenderSettings {
             min_weight: 1e-3,
             accel: AccelKind::default(),
             integrator: IntegratorKind::default(),
+            photons: PhotonSettings::default(),
             threads: None,
             aovs: Vec::new(),
         }

@@ -375,6 +375,11 @@ impl<'a> World<'a> {
         }
     }
 
+    /// The objects it was built from.
+    pub fn objects(&self) -> &'a Objects {
+        self.objects
+    }
+
     /// The box around every bounded primitive.
     pub fn bounds(&self) -> Aabb {
         self.bounds

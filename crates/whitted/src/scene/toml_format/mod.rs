@@ -39,6 +39,7 @@ mod light;
 mod material;
 mod object;
 mod patches;
+mod photons;
 mod reader;
 mod shapes;
 
@@ -166,6 +167,9 @@ const RENDER_KEYS: &[&str] = &[
     "ambient",
     "accel",
     "colours",
+    photons::PHOTON_KEYS[0],
+    photons::PHOTON_KEYS[1],
+    photons::PHOTON_KEYS[2],
 ];
 
 fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
@@ -196,6 +200,7 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
     let ambient = r.or_default(&f, "ambient", Color::ZERO, Reader::color);
     let accel = r.or_default(&f, "accel", d.accel, read_accel);
     let color_space = r.or_default(&f, "colours", ColorSpace::Linear, read_color_space);
+    let photons = photons::read_photons(r, &f);
     keys?;
     let (width, height) = size?;
     Ok(Render {
@@ -206,6 +211,7 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
             max_depth: max_depth?,
             min_weight: min_weight?,
             accel: accel?,
+            photons: photons?,
             ..d
         },
         background: background?,
@@ -356,7 +362,7 @@ pub(super) mod tests {
                 "expected 3 numbers for `background`, found 2",
                 "`ambient` must not be negative, got -1",
                 "unknown key `size` in [render]; expected one of: width, height, samples, \
-                 max_depth, min_weight, background, ambient, accel, colours",
+                 max_depth, min_weight, background, ambient, accel, colours, photons, gather, radius",
                 "unknown acceleration structure `octree`; expected one of: bvh, kdtree, grid, linear",
                 "unknown colour convention `srgb` for `colours`; expected one of: linear, display",
             ]
