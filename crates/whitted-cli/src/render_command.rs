@@ -61,6 +61,16 @@ pub struct RenderArgs {
     #[arg(long, value_name = "NAME", value_parser = parse_accel)]
     accel: Option<AccelKind>,
 
+    /// Structure over what the scene places itself (instances, shapes),
+    /// if not `--accel`'s (overrides the scene's `accel_top`).
+    #[arg(long, value_name = "NAME", value_parser = parse_accel)]
+    accel_top: Option<AccelKind>,
+
+    /// Structure of each definition and each mesh kept as an instance, if
+    /// not `--accel`'s (overrides the scene's `accel_bottom`).
+    #[arg(long, value_name = "NAME", value_parser = parse_accel)]
+    accel_bottom: Option<AccelKind>,
+
     /// Worker threads (default: all cores). The picture is the same for any
     /// number.
     #[arg(long, value_name = "T", value_parser = arguments::threads, allow_negative_numbers = true)]
@@ -233,6 +243,8 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     settings.samples_per_pixel = args.spp.unwrap_or(settings.samples_per_pixel);
     settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
     settings.accel = args.accel.unwrap_or(settings.accel);
+    settings.accel_top = args.accel_top.or(settings.accel_top);
+    settings.accel_bottom = args.accel_bottom.or(settings.accel_bottom);
 
     scene.settings.threads = args.threads;
     scene.settings.aovs = aov_outputs.iter().map(|(a, _)| *a).collect();

@@ -110,6 +110,10 @@ pub enum RenderError {
         "the scene has {0} primitives (every placement of a mesh counted): at most {MAX_PRIMITIVES} are allowed"
     )]
     TooManyPrimitives(usize),
+    /// Instances a world cannot be built from (a scene built in code; the
+    /// readers refuse them with a located message).
+    #[error("the scene's instances are invalid: {0}")]
+    Instances(#[from] crate::world::InstanceError),
     /// The films would exceed the memory budget.
     #[error(transparent)]
     Memory(#[from] MemoryError),
@@ -198,6 +202,7 @@ pub fn render(
     let settings = &scene.settings;
     let (width, height) = (settings.width, settings.height);
     settings.check()?;
+    scene.objects.check_instances()?;
     let primitives = scene.objects.primitive_count();
     if primitives > MAX_PRIMITIVES {
         return Err(RenderError::TooManyPrimitives(primitives));
@@ -218,7 +223,11 @@ pub fn render(
         })?;
 
     gradient_note::forget(&scene.objects);
-    let world = World::build(&scene.objects, settings.accel);
+    let world = World::build_levels(
+        &scene.objects,
+        settings.accel_top.unwrap_or(settings.accel),
+        settings.accel_bottom.unwrap_or(settings.accel),
+    );
     let shading = Shading {
         materials: &scene.materials,
         lights: &scene.lights,
@@ -392,7 +401,19 @@ fn render_tile(
                         data.extend_from_slice(&[n.x as f32, n.y as f32, n.z as f32]);
                     }
                     (Aov::Normal, None) => data.extend_from_slice(&[0.0; 3]),
-                    (Aov::Id, Some((hit, _))) => data.push(hit.primitive.0 as f32),
+                    (Aov::Id, Some((hit, _))) => data.push(
+                        integrator
+                            .world()
+                            .placement(hit.primitive)
+                            .map_or(hit.primitive.0, |(_, p)| p) as f32,
+                    ),
+                    (Aov::Instance, Some((hit, _))) => data.push(
+                        integrator
+                            .world()
+                            .placement(hit.primitive)
+                            .map_or(-1.0, |(k, _)| k as f32),
+                    ),
+                    (Aov::Instance, None) => data.push(-1.0),
                     (Aov::Id, None) => data.push(-1.0),
                     (Aov::Cost, _) => {
                         let counters = integrator.traversal_cost(&ray);

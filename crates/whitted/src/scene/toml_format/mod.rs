@@ -34,6 +34,7 @@
 //! out of range, unknown names, and shapes, transforms or cameras their
 //! constructors refuse.
 
+mod definition;
 mod light;
 mod material;
 mod object;
@@ -100,7 +101,14 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
 }
 
 /// The keys allowed at the top level.
-const SECTIONS: &[&str] = &["render", "camera", "materials", "lights", "objects"];
+const SECTIONS: &[&str] = &[
+    "render",
+    "camera",
+    "materials",
+    "lights",
+    "objects",
+    "definitions",
+];
 
 /// Walks the whole document.
 fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
@@ -120,6 +128,7 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
     let materials = material::read_materials(r, top.get("materials"));
     let lights = light::read_lights(r, top.get("lights"));
     let objects = object::read_objects(r, top.get("objects"), &materials.names);
+    let definitions = definition::read_definitions(r, top.get("definitions"), &materials.names);
     keys?;
     let render = render?;
     let mut scene = Scene::new(camera?);
@@ -131,17 +140,12 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
     for (material, name) in materials.list?.into_iter().zip(&materials.names) {
         scene.add_named_material(name, material);
     }
-    let objects = objects?;
+    let (objects, definitions) = (objects?, definitions?);
     let default_material = MaterialId(scene.materials.len() as u32);
-    if objects.iter().any(|object| object.material.is_none()) {
+    if definition::needs_default_material(&objects, &definitions) {
         scene.add_material(Material::default());
     }
-    for object in objects {
-        let material = object
-            .material
-            .map_or(default_material, |index| MaterialId(index as u32));
-        scene.add_primitive(object.shape, material, object.transform);
-    }
+    definition::place_all(r, &mut scene, objects, definitions, default_material)?;
     Ok(scene)
 }
 
@@ -164,6 +168,8 @@ const RENDER_KEYS: &[&str] = &[
     "background",
     "ambient",
     "accel",
+    "accel_top",
+    "accel_bottom",
     "colours",
 ];
 
@@ -194,6 +200,8 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
     let background = r.or_default(&f, "background", Color::ZERO, Reader::color);
     let ambient = r.or_default(&f, "ambient", Color::ZERO, Reader::color);
     let accel = r.or_default(&f, "accel", d.accel, read_accel);
+    let accel_top = r.optional(&f, "accel_top", read_accel);
+    let accel_bottom = r.optional(&f, "accel_bottom", read_accel);
     let color_space = r.or_default(&f, "colours", ColorSpace::Linear, read_color_space);
     keys?;
     let (width, height) = size?;
@@ -205,6 +213,8 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
             max_depth: max_depth?,
             min_weight: min_weight?,
             accel: accel?,
+            accel_top: accel_top?,
+            accel_bottom: accel_bottom?,
             ..d
         },
         background: background?,

@@ -20,6 +20,7 @@
 
 use toml_span::value::Value;
 
+use super::definition::{INSTANCE_KEY, Item, read_placement};
 use super::reader::{Parsed, Reader, all, list};
 use super::{patches, shapes};
 use crate::math::{Transform, TransformError, Vec3, magnitude};
@@ -44,7 +45,7 @@ pub(super) fn read_objects(
     r: &mut Reader<'_>,
     value: Option<&Value<'_>>,
     materials: &[String],
-) -> Parsed<Vec<Object>> {
+) -> Parsed<Vec<Item>> {
     let Some(value) = value else {
         return Ok(Vec::new());
     };
@@ -55,11 +56,12 @@ pub(super) fn read_objects(
     Ok(objects.into_iter().flatten().collect())
 }
 
-/// One object, or one per patch of a `shape = "patches"` file.
-fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> Parsed<Vec<Object>> {
+/// One object, or one per patch of a `shape = "patches"` file, or an
+/// instance of a definition.
+fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> Parsed<Vec<Item>> {
     let f = r.table(value, "objects", "object")?;
     let is_patches = f.get("shape").and_then(|v| v.as_str()) == Some(patches::KIND);
-    let kind = (!is_patches).then(|| {
+    let kind = (!is_patches && f.get(INSTANCE_KEY).is_none()).then(|| {
         r.require(&f, "shape", Reader::string)
             .and_then(|(name, span)| Ok((shapes::find(r, name, span)?, span)))
     });
@@ -71,6 +73,9 @@ fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> P
             .ok_or_else(|| r.error(span, unknown_material(name, materials)))
     });
     let transform = r.or_default(&f, "transform", Transform::IDENTITY, read_transform);
+    if f.get(INSTANCE_KEY).is_some() {
+        return read_placement(r, &f, material, transform).map(|item| vec![item]);
+    }
     let Some(kind) = kind else {
         let keys = r.check_keys(&f, &[COMMON_KEYS, patches::KEYS].concat());
         let shapes = patches::read(r, &f);
@@ -81,7 +86,7 @@ fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> P
             material,
             transform,
         };
-        return Ok(shapes?.into_iter().map(object).collect());
+        return Ok(shapes?.into_iter().map(object).map(Item::Object).collect());
     };
     let (kind, kind_span) = match kind {
         Ok(kind) => kind,
@@ -110,11 +115,11 @@ fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> P
             ));
         }
     }
-    Ok(vec![Object {
+    Ok(vec![Item::Object(Object {
         shape: placed.shape,
         material: material?,
         transform,
-    }])
+    })])
 }
 
 fn unknown_material(name: &str, materials: &[String]) -> String {
