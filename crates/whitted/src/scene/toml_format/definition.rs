@@ -164,6 +164,10 @@ fn read_mesh(
             let message = format!("the model `{name}` is invalid:\n{}", problems(&diagnostics));
             return Err(r.error(span, message));
         }
+        Err(SceneError::Io { path, source }) => {
+            let message = format!("cannot read the model `{}`: {source}", path.display());
+            return Err(r.error(span, message));
+        }
         Err(other) => return Err(r.error(span, other.to_string())),
     };
     if !loaded.warnings.is_empty() {
@@ -418,5 +422,62 @@ fn unknown_definition(name: &str, known: &[&str]) -> String {
             "unknown definition `{name}`; the definitions are: {}",
             known.join(", ")
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{CAMERA, scene};
+    use crate::world::{DefinitionId, MaterialId};
+
+    #[test]
+    fn definitions_are_added_children_first_and_placed_with_their_overrides() {
+        let s = scene(&format!(
+            "{CAMERA}[materials.gold]\n\
+             [[definitions.tree.objects]]\nshape = 'sphere'\nradius = 1\n\
+             [[definitions.tree.objects]]\ninstance = 'leaf'\nmaterial = 'gold'\n\
+             transform = {{ translate = [0, 1, 0] }}\n\
+             [definitions.leaf]\nobjects = [{{ shape = 'sphere', radius = 0.1 }}]\n\
+             [[objects]]\ninstance = 'tree'\n\
+             [[objects]]\ninstance = 'tree'\ntransform = {{ scale = 2 }}\n\
+             [[objects]]\nshape = 'sphere'\nradius = 3\nmaterial = 'gold'\n"
+        ));
+        let o = &s.objects;
+        assert_eq!(o.definitions.len(), 2);
+        // `leaf` is placed by `tree`, so it comes first.
+        assert_eq!(o.definitions[0].primitives[0].shape.bounds().max.x, 0.1);
+        let tree = &o.definitions[1];
+        assert_eq!(tree.instances[0].definition, DefinitionId(0));
+        assert_eq!(tree.instances[0].material, Some(MaterialId(0)));
+        assert!(tree.instances[0].transform.is_some());
+        // Objects without a material share the default one.
+        assert_eq!(tree.primitives[0].material, MaterialId(1));
+        assert_eq!(o.instances.len(), 2);
+        assert!(o.instances.iter().all(|i| i.definition == DefinitionId(1)));
+        assert!(o.instances[0].transform.is_none() && o.instances[1].transform.is_some());
+        assert_eq!(o.primitives.len(), 1);
+        assert_eq!(o.primitive_count(), 1 + 2 * 2);
+    }
+
+    #[test]
+    fn a_mesh_definition_brings_the_model_and_its_materials() {
+        let folder = std::env::temp_dir().join(format!("whitted-def-{}", std::process::id()));
+        std::fs::create_dir_all(&folder).unwrap();
+        std::fs::write(
+            folder.join("quad.obj"),
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n",
+        )
+        .unwrap();
+        let source = format!(
+            "{CAMERA}[definitions.quad]\nmesh = 'quad.obj'\n\
+             [[objects]]\ninstance = 'quad'\n"
+        );
+        let s = crate::scene::parse_scene(&source, &folder.join("scene.toml")).unwrap();
+        std::fs::remove_dir_all(&folder).unwrap();
+        let quad = &s.objects.definitions[0];
+        assert_eq!(quad.meshes.len(), 1);
+        assert_eq!(quad.meshes[0].len(), 2);
+        assert_eq!(s.materials.len(), 1);
+        assert_eq!(s.objects.primitive_count(), 2);
     }
 }

@@ -365,7 +365,7 @@ pub(super) mod tests {
                 "expected 3 numbers for `background`, found 2",
                 "`ambient` must not be negative, got -1",
                 "unknown key `size` in [render]; expected one of: width, height, samples, \
-                 max_depth, min_weight, background, ambient, accel, colours",
+                 max_depth, min_weight, background, ambient, accel, accel_top, accel_bottom, colours",
                 "unknown acceleration structure `octree`; expected one of: bvh, kdtree, grid, linear",
                 "unknown colour convention `srgb` for `colours`; expected one of: linear, display",
             ]
@@ -440,7 +440,7 @@ pub(super) mod tests {
             errors(&format!("title = 'x'\n{CAMERA}")),
             [
                 "unknown key `title` in the top level; expected one of: render, camera, \
-              materials, lights, objects"
+              materials, lights, objects, definitions"
             ]
         );
     }
