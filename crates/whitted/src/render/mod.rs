@@ -62,6 +62,8 @@ pub struct RenderOutput {
     pub rays: RayCounts,
     /// The kinds of rays the integrator traces, in report order.
     pub ray_kinds: &'static [RayKind],
+    /// Seconds spent building the world (its acceleration structures).
+    pub build_seconds: f64,
     /// The thread count asked for, when it was lowered to what helps.
     pub thread_clamp: Option<ThreadClamp>,
     /// The camera samples the budget of secondary rays cut short, if any.
@@ -223,11 +225,13 @@ pub fn render(
         })?;
 
     gradient_note::forget(&scene.objects);
+    let build_start = std::time::Instant::now();
     let world = World::build_levels(
         &scene.objects,
         settings.accel_top.unwrap_or(settings.accel),
         settings.accel_bottom.unwrap_or(settings.accel),
     );
+    let build_seconds = build_start.elapsed().as_secs_f64();
     let shading = Shading {
         materials: &scene.materials,
         lights: &scene.lights,
@@ -278,6 +282,7 @@ pub fn render(
         aovs: films.aovs,
         rays: films.rays,
         ray_kinds: integrator.ray_kinds(),
+        build_seconds,
         thread_clamp,
         ray_budget_cut,
         gradient_exceeded: gradient_note::report(&scene.objects),
