@@ -1048,6 +1048,43 @@ mod tests {
     }
 
     #[test]
+    fn the_work_of_both_levels_is_counted() {
+        // Brute force at both levels: a ray through the instance tests the
+        // instance entry and then every triangle of the definition, nested
+        // one level deeper still.
+        let mut rng = Rng::new(3);
+        let mut leaf = Objects::default();
+        let positions: Vec<Vec3> = (0..150)
+            .map(|_| rng.point_in(Vec3::splat(-1.0), Vec3::splat(1.0)))
+            .collect();
+        let triangles: Vec<[u32; 3]> = (0..50).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        let mesh = leaf.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
+        leaf.add_mesh_instance(mesh, MaterialId(0), Transform::IDENTITY);
+        let mut objects = Objects::default();
+        let leaf = objects.add_definition(leaf);
+        let mut group = Objects::default();
+        group.add_instance(leaf, None, Transform::scale(Vec3::splat(2.0)).unwrap());
+        let group = objects.add_definition(group);
+        objects.add_instance(group, None, Transform::translate(Vec3::X).unwrap());
+        let world = World::build(&objects, AccelKind::Linear);
+        let ray = Ray::new(Vec3::new(1.0, 0.0, -10.0), Vec3::Z);
+        // The leaf alone, with the ray carried into its space.
+        let alone = World::build(&objects.definitions[0], AccelKind::Linear);
+        let local = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z * 0.5);
+        let mut leaf_ctx = QueryContext::default();
+        assert!(alone.intersect_with(&local, &mut leaf_ctx).is_some());
+        assert!(leaf_ctx.counters.primitives > 1);
+        let mut ctx = QueryContext::default();
+        assert!(world.intersect_with(&ray, &mut ctx).is_some());
+        // The group's entry, the leaf's entry, then the leaf's triangles.
+        assert_eq!(ctx.counters.primitives, 2 + leaf_ctx.counters.primitives);
+        assert_eq!(ctx.counters.nodes, 2 + leaf_ctx.counters.nodes);
+        let mut ctx = QueryContext::default();
+        assert!(world.occluded_with(&ray, &mut ctx));
+        assert!(ctx.counters.primitives > 2);
+    }
+
+    #[test]
     fn packets_give_every_lane_the_single_ray_answer() {
         let mut rng = Rng::new(40);
         let mut objects = Objects::default();
