@@ -67,6 +67,16 @@ pub struct RenderArgs {
     #[arg(long, value_name = "NAME", value_parser = parse_accel)]
     accel: Option<AccelKind>,
 
+    /// Structure over what the scene places itself (instances, shapes),
+    /// if not `--accel`'s (overrides the scene's `accel_top`).
+    #[arg(long, value_name = "NAME", value_parser = parse_accel)]
+    accel_top: Option<AccelKind>,
+
+    /// Structure of each definition and each mesh kept as an instance, if
+    /// not `--accel`'s (overrides the scene's `accel_bottom`).
+    #[arg(long, value_name = "NAME", value_parser = parse_accel)]
+    accel_bottom: Option<AccelKind>,
+
     /// Worker threads (default: all cores). The picture is the same for any
     /// number.
     #[arg(long, value_name = "T", value_parser = arguments::threads, allow_negative_numbers = true)]
@@ -258,6 +268,8 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
     settings.accel = args.accel.unwrap_or(settings.accel);
     settings.photons.count = args.photons.unwrap_or(settings.photons.count);
+    settings.accel_top = args.accel_top.or(settings.accel_top);
+    settings.accel_bottom = args.accel_bottom.or(settings.accel_bottom);
 
     scene.settings.threads = args.threads;
     scene.settings.aovs = match &part {
@@ -330,12 +342,14 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             .collect::<Vec<_>>()
             .join(", ");
         note!(
-            "{}: {}x{}, {} spp in {:.3} s; rays: {by_kind}; {:.2} Mrays/s",
+            "{}: {}x{}, {} spp in {:.3} s (world built in {:.3} s); rays: {by_kind}; \
+             {:.2} Mrays/s",
             args.output.display(),
             scene.settings.width,
             scene.settings.height,
             scene.settings.samples_per_pixel,
             elapsed,
+            output.build_seconds,
             rays.total() as f64 / elapsed / 1e6,
         );
     }

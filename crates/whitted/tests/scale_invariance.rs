@@ -19,6 +19,7 @@ use whitted::shape::{
     AxisBox, Cylinder, Expression, Implicit, Parallelogram, Shape, Sphere, Superellipsoid, Torus,
     Triangle,
 };
+use whitted::world::Objects;
 
 fn scene_at_scale(s: f64) -> Scene {
     let v = |x: f64, y: f64, z: f64| Vec3::new(x, y, z) * s;
@@ -85,22 +86,63 @@ fn scene_at_scale(s: f64) -> Scene {
 }
 
 fn picture(s: f64) -> Vec<u8> {
-    let film: Film = render(&scene_at_scale(s), &|_| {}).unwrap().image;
+    pixels(&scene_at_scale(s))
+}
+
+fn pixels(scene: &Scene) -> Vec<u8> {
+    let film: Film = render(scene, &|_| {}).unwrap().image;
     film.data().iter().map(|&v| encode_srgb8(v)).collect()
+}
+
+/// The scene at scale `s` with its objects built at scale 1 in a
+/// definition, placed (scaled by 2) in a second definition, placed at the
+/// top scaled by `s / 2`: instance transforms carry every point, normal
+/// and error bound.
+fn instanced_picture(s: f64) -> Vec<u8> {
+    let mut scene = scene_at_scale(s);
+    let mut objects = Objects::default();
+    let inner = objects.add_definition(scene_at_scale(1.0).objects);
+    let mut doubled = Objects::default();
+    doubled.add_instance(inner, None, Transform::scale(Vec3::splat(2.0)).unwrap());
+    let doubled = objects.add_definition(doubled);
+    objects.add_instance(
+        doubled,
+        None,
+        Transform::scale(Vec3::splat(s / 2.0)).unwrap(),
+    );
+    scene.objects = objects;
+    pixels(&scene)
+}
+
+/// How many pixels of `other` differ from `reference` by more than 2 levels.
+fn differing(reference: &[u8], other: &[u8]) -> usize {
+    reference
+        .chunks(3)
+        .zip(other.chunks(3))
+        .filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 2))
+        .count()
 }
 
 #[test]
 fn same_scene_at_scales_1e_minus_3_1_and_1e4_renders_the_same_picture() {
     let reference = picture(1.0);
     for s in [1e-3, 1e4] {
-        let other = picture(s);
-        let differing = reference
-            .chunks(3)
-            .zip(other.chunks(3))
-            .filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 2))
-            .count();
+        let differing = differing(&reference, &picture(s));
         // Pixels whose centre ray grazes an edge may legitimately flip with
         // the rounding of scaled coordinates; acne would touch hundreds.
+        assert!(
+            differing <= 3,
+            "scale {s}: {differing} of {} pixels differ",
+            reference.len() / 3
+        );
+    }
+}
+
+#[test]
+fn the_scene_placed_as_nested_instances_renders_the_same_picture_at_every_scale() {
+    let reference = picture(1.0);
+    for s in [1e-3, 1.0, 1e4] {
+        let differing = differing(&reference, &instanced_picture(s));
         assert!(
             differing <= 3,
             "scale {s}: {differing} of {} pixels differ",

@@ -72,6 +72,8 @@ pub struct RenderOutput {
     pub rays: RayCounts,
     /// The kinds of rays the integrator traces, in report order.
     pub ray_kinds: &'static [RayKind],
+    /// Seconds spent building the world (its acceleration structures).
+    pub build_seconds: f64,
     /// The thread count asked for, when it was lowered to what helps.
     pub thread_clamp: Option<ThreadClamp>,
     /// The camera samples the budget of secondary rays cut short, if any.
@@ -125,6 +127,10 @@ pub enum RenderError {
     /// The photon settings are out of range.
     #[error(transparent)]
     Photons(#[from] crate::integrator::photon_map::PhotonSettingsError),
+    /// Instances a world cannot be built from (a scene built in code; the
+    /// readers refuse them with a located message).
+    #[error("the scene's instances are invalid: {0}")]
+    Instances(#[from] crate::world::InstanceError),
     /// The films would exceed the memory budget.
     #[error(transparent)]
     Memory(#[from] MemoryError),
@@ -231,6 +237,7 @@ pub fn render_selected(
     let (width, height) = (settings.width, settings.height);
     settings.check()?;
     selection.check(width, height)?;
+    scene.objects.check_instances()?;
     let primitives = scene.objects.primitive_count();
     if primitives > MAX_PRIMITIVES {
         return Err(RenderError::TooManyPrimitives(primitives));
@@ -253,7 +260,13 @@ pub fn render_selected(
         })?;
 
     gradient_note::forget(&scene.objects);
-    let world = World::build(&scene.objects, settings.accel);
+    let build_start = std::time::Instant::now();
+    let world = World::build_levels(
+        &scene.objects,
+        settings.accel_top.unwrap_or(settings.accel),
+        settings.accel_bottom.unwrap_or(settings.accel),
+    );
+    let build_seconds = build_start.elapsed().as_secs_f64();
     let shading = Shading {
         materials: &scene.materials,
         lights: &scene.lights,
@@ -307,6 +320,7 @@ pub fn render_selected(
         aovs: films.aovs,
         rays: films.rays,
         ray_kinds: integrator.ray_kinds(),
+        build_seconds,
         thread_clamp,
         ray_budget_cut,
         gradient_exceeded: gradient_note::report(&scene.objects),
@@ -449,7 +463,19 @@ fn render_tile(
                         data.extend_from_slice(&[n.x as f32, n.y as f32, n.z as f32]);
                     }
                     (Aov::Normal, None) => data.extend_from_slice(&[0.0; 3]),
-                    (Aov::Id, Some((hit, _))) => data.push(hit.primitive.0 as f32),
+                    (Aov::Id, Some((hit, _))) => data.push(
+                        integrator
+                            .world()
+                            .placement(hit.primitive)
+                            .map_or(hit.primitive.0, |(_, p)| p) as f32,
+                    ),
+                    (Aov::Instance, Some((hit, _))) => data.push(
+                        integrator
+                            .world()
+                            .placement(hit.primitive)
+                            .map_or(-1.0, |(k, _)| k as f32),
+                    ),
+                    (Aov::Instance, None) => data.push(-1.0),
                     (Aov::Id, None) => data.push(-1.0),
                     (Aov::Cost, _) => {
                         let counters = integrator.traversal_cost(&ray);

@@ -35,6 +35,7 @@
 //! constructors refuse.
 
 mod csg;
+mod definition;
 mod light;
 mod material;
 mod object;
@@ -102,7 +103,14 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
 }
 
 /// The keys allowed at the top level.
-const SECTIONS: &[&str] = &["render", "camera", "materials", "lights", "objects"];
+const SECTIONS: &[&str] = &[
+    "render",
+    "camera",
+    "materials",
+    "lights",
+    "objects",
+    "definitions",
+];
 
 /// Walks the whole document.
 fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
@@ -122,6 +130,7 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
     let materials = material::read_materials(r, top.get("materials"));
     let lights = light::read_lights(r, top.get("lights"));
     let objects = object::read_objects(r, top.get("objects"), &materials.names);
+    let definitions = definition::read_definitions(r, top.get("definitions"), &materials.names);
     keys?;
     let render = render?;
     let mut scene = Scene::new(camera?);
@@ -133,17 +142,12 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
     for (material, name) in materials.list?.into_iter().zip(&materials.names) {
         scene.add_named_material(name, material);
     }
-    let objects = objects?;
+    let (objects, definitions) = (objects?, definitions?);
     let default_material = MaterialId(scene.materials.len() as u32);
-    if objects.iter().any(|object| object.material.is_none()) {
+    if definition::needs_default_material(&objects, &definitions) {
         scene.add_material(Material::default());
     }
-    for object in objects {
-        let material = object
-            .material
-            .map_or(default_material, |index| MaterialId(index as u32));
-        scene.add_primitive(object.shape, material, object.transform);
-    }
+    definition::place_all(r, &mut scene, objects, definitions, default_material)?;
     Ok(scene)
 }
 
@@ -166,6 +170,8 @@ const RENDER_KEYS: &[&str] = &[
     "background",
     "ambient",
     "accel",
+    "accel_top",
+    "accel_bottom",
     "colours",
     photons::PHOTON_KEYS[0],
     photons::PHOTON_KEYS[1],
@@ -199,6 +205,8 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
     let background = r.or_default(&f, "background", Color::ZERO, Reader::color);
     let ambient = r.or_default(&f, "ambient", Color::ZERO, Reader::color);
     let accel = r.or_default(&f, "accel", d.accel, read_accel);
+    let accel_top = r.optional(&f, "accel_top", read_accel);
+    let accel_bottom = r.optional(&f, "accel_bottom", read_accel);
     let color_space = r.or_default(&f, "colours", ColorSpace::Linear, read_color_space);
     let photons = photons::read_photons(r, &f);
     keys?;
@@ -212,6 +220,8 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
             min_weight: min_weight?,
             accel: accel?,
             photons: photons?,
+            accel_top: accel_top?,
+            accel_bottom: accel_bottom?,
             ..d
         },
         background: background?,
@@ -362,7 +372,8 @@ pub(super) mod tests {
                 "expected 3 numbers for `background`, found 2",
                 "`ambient` must not be negative, got -1",
                 "unknown key `size` in [render]; expected one of: width, height, samples, \
-                 max_depth, min_weight, background, ambient, accel, colours, photons, gather, radius",
+                 max_depth, min_weight, background, ambient, accel, accel_top, accel_bottom, colours, \
+                 photons, gather, radius",
                 "unknown acceleration structure `octree`; expected one of: bvh, kdtree, grid, linear",
                 "unknown colour convention `srgb` for `colours`; expected one of: linear, display",
             ]
@@ -437,7 +448,7 @@ pub(super) mod tests {
             errors(&format!("title = 'x'\n{CAMERA}")),
             [
                 "unknown key `title` in the top level; expected one of: render, camera, \
-              materials, lights, objects"
+              materials, lights, objects, definitions"
             ]
         );
     }

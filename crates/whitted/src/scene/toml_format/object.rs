@@ -20,6 +20,7 @@
 
 use toml_span::value::Value;
 
+use super::definition::{INSTANCE_KEY, Item, read_placement};
 use super::reader::{Parsed, Reader, all, list};
 use super::{csg, patches, shapes};
 use crate::math::{Transform, TransformError, Vec3, magnitude};
@@ -44,7 +45,7 @@ pub(super) fn read_objects(
     r: &mut Reader<'_>,
     value: Option<&Value<'_>>,
     materials: &[String],
-) -> Parsed<Vec<Object>> {
+) -> Parsed<Vec<Item>> {
     let Some(value) = value else {
         return Ok(Vec::new());
     };
@@ -55,18 +56,19 @@ pub(super) fn read_objects(
     Ok(objects.into_iter().flatten().collect())
 }
 
-/// One object, or one per patch of a `shape = "patches"` file.
+/// One object, or one per patch of a `shape = "patches"` file, or an
+/// instance of a definition.
 pub(super) fn read_object(
     r: &mut Reader<'_>,
     value: &Value<'_>,
     materials: &[String],
-) -> Parsed<Vec<Object>> {
+) -> Parsed<Vec<Item>> {
     if value.as_table().is_some_and(|t| t.get(csg::KEY).is_some()) {
-        return csg::read(r, value, materials).map(|object| vec![object]);
+        return csg::read(r, value, materials).map(|object| vec![Item::Object(object)]);
     }
     let f = r.table(value, "objects", "object")?;
     let is_patches = f.get("shape").and_then(|v| v.as_str()) == Some(patches::KIND);
-    let kind = (!is_patches).then(|| {
+    let kind = (!is_patches && f.get(INSTANCE_KEY).is_none()).then(|| {
         r.require(&f, "shape", Reader::string)
             .and_then(|(name, span)| Ok((shapes::find(r, name, span)?, span)))
     });
@@ -78,6 +80,9 @@ pub(super) fn read_object(
             .ok_or_else(|| r.error(span, unknown_material(name, materials)))
     });
     let transform = r.or_default(&f, "transform", Transform::IDENTITY, read_transform);
+    if f.get(INSTANCE_KEY).is_some() {
+        return read_placement(r, &f, material, transform).map(|item| vec![item]);
+    }
     let Some(kind) = kind else {
         let keys = r.check_keys(&f, &[COMMON_KEYS, patches::KEYS].concat());
         let shapes = patches::read(r, &f);
@@ -88,7 +93,7 @@ pub(super) fn read_object(
             material,
             transform,
         };
-        return Ok(shapes?.into_iter().map(object).collect());
+        return Ok(shapes?.into_iter().map(object).map(Item::Object).collect());
     };
     let (kind, kind_span) = match kind {
         Ok(kind) => kind,
@@ -117,11 +122,11 @@ pub(super) fn read_object(
             ));
         }
     }
-    Ok(vec![Object {
+    Ok(vec![Item::Object(Object {
         shape: placed.shape,
         material: material?,
         transform,
-    }])
+    })])
 }
 
 pub(super) fn unknown_material(name: &str, materials: &[String]) -> String {
