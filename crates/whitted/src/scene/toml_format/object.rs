@@ -20,9 +20,9 @@
 
 use toml_span::value::Value;
 
-use super::reader::{Parsed, Reader, all, list};
+use super::reader::{Fields, Parsed, Reader, all, list};
 use super::{patches, shapes};
-use crate::math::{Transform, TransformError, Vec3, magnitude};
+use crate::math::{Aabb, Transform, TransformError, Vec3, magnitude};
 use crate::shape::Shape;
 
 /// An object read from the file.
@@ -76,12 +76,17 @@ fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> P
         let shapes = patches::read(r, &f);
         let (material, transform) = (material?, transform?);
         keys?;
+        let shapes = shapes?;
+        let bounds = shapes
+            .iter()
+            .fold(Aabb::EMPTY, |all, shape| all.union(&shape.bounds()));
+        check_reach(r, &f, &transform, &bounds)?;
         let object = |shape| Object {
             shape,
             material,
             transform,
         };
-        return Ok(shapes?.into_iter().map(object).collect());
+        return Ok(shapes.into_iter().map(object).collect());
     };
     let (kind, kind_span) = match kind {
         Ok(kind) => kind,
@@ -99,22 +104,34 @@ fn read_object(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> P
     keys?;
     let placed = placed?;
     let transform = transform?.then_after(&placed.placement);
-    let world = transform.bounds_to_world(&placed.shape.bounds());
+    check_reach(r, &f, &transform, &placed.shape.bounds())?;
+    Ok(vec![Object {
+        shape: placed.shape,
+        material: material?,
+        transform,
+    }])
+}
+
+/// Refuses, at the object's `transform`, an object whose `bounds` carried
+/// by `transform` into the world reach beyond ±[`magnitude::MAX_COORDINATE`].
+fn check_reach(
+    r: &mut Reader<'_>,
+    f: &Fields<'_, '_>,
+    transform: &Transform,
+    bounds: &Aabb,
+) -> Parsed<()> {
+    let world = transform.bounds_to_world(bounds);
     if world.is_finite() {
         let reach = world.min.abs().max(world.max.abs()).max_element();
         if let Err(error) = magnitude::coordinate(reach) {
-            let span = r.value_span(&f, "transform");
+            let span = r.value_span(f, "transform");
             return Err(r.error(
                 span,
                 format!("the object reaches out of range in the world: {error}"),
             ));
         }
     }
-    Ok(vec![Object {
-        shape: placed.shape,
-        material: material?,
-        transform,
-    }])
+    Ok(())
 }
 
 fn unknown_material(name: &str, materials: &[String]) -> String {
