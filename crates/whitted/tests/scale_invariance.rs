@@ -81,22 +81,38 @@ fn scene_at_scale(s: f64, left_out: Option<&str>) -> Scene {
     let above = Transform::translate(v(-2.0, 1.8, 1.0)).unwrap();
     let radii = [0.3, 0.5, 0.3].map(|r: f64| (r * s).powi(-2));
     let egg = Quadric::new(
-        [radii[0], radii[1], radii[2], 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0],
+        [
+            radii[0], radii[1], radii[2], 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0,
+        ],
         None,
     );
     let egg_place = Transform::translate(v(2.0, 1.4, 1.5)).unwrap();
     let saddle = BezierPatch::new(std::array::from_fn(|i| {
         std::array::from_fn(|j| {
             let (u, w) = (i as f64 / 3.0, j as f64 / 3.0);
-            v(-0.5 + u, 1.6 + 0.8 * w, 2.8 + 0.3 * (2.0 * u - 1.0) * (2.0 * w - 1.0))
+            v(
+                -0.5 + u,
+                1.6 + 0.8 * w,
+                2.8 + 0.3 * (2.0 * u - 1.0) * (2.0 * w - 1.0),
+            )
         })
     }));
     let newer = [
         ("torus", Shape::Torus(ring), glass, flat),
-        ("superellipsoid", Shape::Superellipsoid(rounded), matte, identity),
+        (
+            "superellipsoid",
+            Shape::Superellipsoid(rounded),
+            matte,
+            identity,
+        ),
         ("implicit", Shape::Implicit(implicit.unwrap()), matte, above),
         ("quadric", Shape::Quadric(egg.unwrap()), mirror, egg_place),
-        ("patch", Shape::BezierPatch(saddle.unwrap()), matte, identity),
+        (
+            "patch",
+            Shape::BezierPatch(saddle.unwrap()),
+            matte,
+            identity,
+        ),
     ];
     for (name, shape, material, placement) in newer {
         if Some(name) != left_out {
