@@ -5,14 +5,16 @@ which whitted reads as meshes), with the same camera and light, so that
 `whitted bench` measures "as fast as a mesh of the same look" side by side.
 
     python3 scripts/shape-mesh-bench-scenes.py OUT_DIR
-    for s in spheres tori superellipsoids implicit-tori quadrics teapot; do
+    for s in spheres quadrics tori implicit-tori superellipsoids teapot-12 teapot-32; do
         whitted bench --accel bvh --width 512 --height 512 OUT_DIR/$s.toml
         whitted bench --accel bvh --width 512 --height 512 OUT_DIR/$s-mesh.nff
     done
 
 Each family is 125 shapes (seed 17) in a cube of side 10 seen from 20 away,
-each some 30 to 80 pixels across at 512x512; the teapot is the 32 patches of
-scenes/teapot.bpt filling the view. Every mesh is tessellated per object so
+each some 30 to 80 pixels across at 512x512 (the implicit tori are the tori
+written as the distance function `sqrt((sqrt(x^2 + z^2) - R)^2 + y^2) - r`);
+the teapot is the 32 patches of scenes/teapot.bpt, against meshes of 12x12
+quads per patch (the SPD's size factor) and 32x32. Every mesh is tessellated per object so
 that its chords stray at most a quarter of a pixel (at 512x512, at the
 object's distance) from the surface, which is "the same look" at that
 resolution: `--check OUT_DIR WHITTED [NAME ...]` prints how many pixels of depth images rendered from
