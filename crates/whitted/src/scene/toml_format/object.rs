@@ -21,9 +21,9 @@
 use toml_span::value::Value;
 
 use super::definition::{INSTANCE_KEY, Item, read_placement};
-use super::reader::{Parsed, Reader, all, list};
+use super::reader::{Fields, Parsed, Reader, all, list};
 use super::{csg, patches, shapes};
-use crate::math::{Transform, TransformError, Vec3, magnitude};
+use crate::math::{Aabb, Transform, TransformError, Vec3, magnitude};
 use crate::shape::Shape;
 
 /// An object read from the file.
@@ -88,12 +88,17 @@ pub(super) fn read_object(
         let shapes = patches::read(r, &f);
         let (material, transform) = (material?, transform?);
         keys?;
+        let shapes = shapes?;
+        let bounds = shapes
+            .iter()
+            .fold(Aabb::EMPTY, |all, shape| all.union(&shape.bounds()));
+        check_reach(r, &f, &transform, &bounds)?;
         let object = |shape| Object {
             shape,
             material,
             transform,
         };
-        return Ok(shapes?.into_iter().map(object).map(Item::Object).collect());
+        return Ok(shapes.into_iter().map(object).map(Item::Object).collect());
     };
     let (kind, kind_span) = match kind {
         Ok(kind) => kind,
@@ -111,22 +116,34 @@ pub(super) fn read_object(
     keys?;
     let placed = placed?;
     let transform = transform?.then_after(&placed.placement);
-    let world = transform.bounds_to_world(&placed.shape.bounds());
+    check_reach(r, &f, &transform, &placed.shape.bounds())?;
+    Ok(vec![Item::Object(Object {
+        shape: placed.shape,
+        material: material?,
+        transform,
+    })])
+}
+
+/// Refuses, at the object's `transform`, an object whose `bounds` carried
+/// by `transform` into the world reach beyond ±[`magnitude::MAX_COORDINATE`].
+fn check_reach(
+    r: &mut Reader<'_>,
+    f: &Fields<'_, '_>,
+    transform: &Transform,
+    bounds: &Aabb,
+) -> Parsed<()> {
+    let world = transform.bounds_to_world(bounds);
     if world.is_finite() {
         let reach = world.min.abs().max(world.max.abs()).max_element();
         if let Err(error) = magnitude::coordinate(reach) {
-            let span = r.value_span(&f, "transform");
+            let span = r.value_span(f, "transform");
             return Err(r.error(
                 span,
                 format!("the object reaches out of range in the world: {error}"),
             ));
         }
     }
-    Ok(vec![Item::Object(Object {
-        shape: placed.shape,
-        material: material?,
-        transform,
-    })])
+    Ok(())
 }
 
 pub(super) fn unknown_material(name: &str, materials: &[String]) -> String {
