@@ -3,12 +3,15 @@
 //! picture is identical bit for bit whatever the number of threads.
 
 mod camera;
+mod explain;
 mod gradient_note;
 mod resources;
+mod sample_ray;
 mod scene;
 mod settings;
 
 pub use camera::{Camera, CameraError};
+pub use explain::{ExplainError, PixelExplanation, explain_pixel};
 pub use gradient_note::GradientExceeded;
 pub use resources::{RayBudgetCut, ThreadClamp, memory_needed};
 pub use scene::Scene;
@@ -27,10 +30,9 @@ use crate::integrator::{
     Integrator, RayCounts, RayKind, RecursionLimits, SECONDARY_RAY_BUDGET, Shading,
 };
 use crate::limits::{MemoryBudget, MemoryError};
-use crate::math::random::hash64;
-use crate::math::sampling::pixel_sample;
 use crate::shading::Color;
 use crate::world::{MAX_PRIMITIVES, MaterialId, World};
+use sample_ray::{pixel_pattern, sample_ray};
 
 /// Side of the square tiles the image is cut into, in pixels.
 const TILE_SIZE: u32 = 16;
@@ -344,17 +346,11 @@ fn render_tile(
     let spp = settings.samples_per_pixel;
     for y in y0..y0 + height {
         for x in x0..x0 + width {
-            let pattern = hash64(u64::from(y) << 32 | u64::from(x)) as u32;
+            let pattern = pixel_pattern(x, y);
             let mut sum = Color::ZERO;
             let mut centre = None;
             for s in 0..spp {
-                let offset = pixel_sample(s, spp, pattern);
-                let ray = camera.ray(
-                    settings.width,
-                    settings.height,
-                    f64::from(x) + offset.x,
-                    f64::from(y) + offset.y,
-                );
+                let ray = sample_ray(camera, settings, (x, y), pattern, s);
                 let sample = integrator.trace_primary(&ray, &mut tile.rays);
                 if let Some(material) = sample.cut_at {
                     *tile.cuts.entry(material).or_default() += 1;
