@@ -9,6 +9,7 @@ mod resources;
 mod sample_ray;
 mod scene;
 mod settings;
+mod sources;
 
 pub use camera::{Camera, CameraError};
 pub use explain::{ExplainError, PixelExplanation, explain_pixel};
@@ -18,6 +19,7 @@ pub use scene::Scene;
 pub use settings::{
     Aov, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, RenderSettings, check_image_size,
 };
+pub use sources::{ObjectSource, ObjectSources, PrimitiveDescription, SourceLocation};
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};

@@ -52,7 +52,7 @@ use crate::image::ColorSpace;
 use crate::math::Vec3;
 use crate::render::{Camera, CameraError};
 use crate::render::{MAX_DEPTH, MAX_SAMPLES, MAX_SIDE, check_image_size};
-use crate::render::{RenderSettings, Scene};
+use crate::render::{ObjectSource, RenderSettings, Scene};
 use crate::scene::{Diagnostic, SceneError, without_bom};
 use crate::shading::Color;
 use crate::shading::Material;
@@ -133,14 +133,20 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
     }
     let objects = objects?;
     let default_material = MaterialId(scene.materials.len() as u32);
-    if objects.iter().any(|object| object.material.is_none()) {
+    if objects.iter().any(|(_, object)| object.material.is_none()) {
         scene.add_material(Material::default());
     }
-    for object in objects {
+    let tables = top.get("objects").and_then(|value| value.as_array());
+    for (table, object) in objects {
         let material = object
             .material
             .map_or(default_material, |index| MaterialId(index as u32));
         scene.add_primitive(object.shape, material, object.transform);
+        let span = tables.and_then(|tables| tables.get(table)).map(|t| t.span);
+        scene.sources.primitives.push(ObjectSource {
+            label: format!("objects[{table}]"),
+            location: span.map(|span| r.location(span)),
+        });
     }
     Ok(scene)
 }
