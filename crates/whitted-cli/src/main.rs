@@ -5,9 +5,14 @@
 
 mod arguments;
 mod bench_command;
+mod explain_command;
+mod explain_json;
+mod explain_svg;
+mod explain_text;
 mod progress;
 mod render_command;
 mod report;
+mod scene_arguments;
 #[cfg(unix)]
 mod signals;
 
@@ -34,6 +39,7 @@ struct Cli {
 enum Command {
     Render(render_command::RenderArgs),
     Bench(bench_command::BenchArgs),
+    Explain(explain_command::ExplainArgs),
 }
 
 fn main() -> ExitCode {
@@ -45,6 +51,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render_command::run(&args),
         Command::Bench(args) => bench_command::run(&args),
+        Command::Explain(args) => explain_command::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -212,7 +212,18 @@ impl Film {
         })
     }
 
-    fn encode_png(&self, out: &mut std::fs::File) -> std::io::Result<()> {
+    /// The film encoded as PNG, in memory (to embed in another file).
+    pub fn png_bytes(&self) -> Result<Vec<u8>, ImageError> {
+        let mut bytes = Vec::new();
+        self.encode_png(&mut bytes)
+            .map_err(|source| ImageError::Io {
+                path: PathBuf::from("(memory)"),
+                source,
+            })?;
+        Ok(bytes)
+    }
+
+    fn encode_png(&self, out: impl std::io::Write) -> std::io::Result<()> {
         let mut encoder = png::Encoder::new(BufWriter::new(out), self.width, self.height);
         encoder.set_color(if self.channels == 1 {
             png::ColorType::Grayscale
@@ -315,6 +326,13 @@ impl PendingImage {
 }
 
 /// Encodes into a new partial file in the folder of `path`'s target.
+/// Writes `text` into a partial file beside `path`, to be renamed into
+/// place by [`PendingImage::commit`] like an image (for drawings and
+/// reports written beside the pictures).
+pub fn encode_text(path: &Path, text: &str) -> Result<PendingImage, ImageError> {
+    encode_to_partial(path, |out| std::io::Write::write_all(out, text.as_bytes()))
+}
+
 fn encode_to_partial(
     path: &Path,
     encode: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
