@@ -142,7 +142,9 @@ fn hit_text(out: &mut String, scene: &Scene, file: Option<&Path>, hit: &HitNode,
         "{at}  shading normal {}, {side}",
         vector(hit.shading_normal)
     );
-    if let Some([from, to]) = hit.indices {
+    if let Some([from, to]) = hit.indices
+        && from != to
+    {
         let _ = writeln!(out, "{at}  index of refraction {from} -> {to}");
     }
     let terms = &hit.terms;
