@@ -19,7 +19,7 @@ pub use scene::Scene;
 pub use settings::{
     Aov, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, RenderSettings, check_image_size,
 };
-pub use sources::{ObjectSource, ObjectSources, PrimitiveDescription, SourceLocation};
+pub use sources::{LineIndex, ObjectSource, ObjectSources, PrimitiveDescription, SourceLocation};
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};

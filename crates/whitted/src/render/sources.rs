@@ -33,6 +33,39 @@ impl SourceLocation {
     }
 }
 
+/// The lines of a text, to find the line and column of many offsets in
+/// it without reading it again for each (a file of many objects).
+#[derive(Clone, Debug)]
+pub struct LineIndex<'s> {
+    source: &'s str,
+    /// The byte offset where each line starts.
+    starts: Vec<usize>,
+}
+
+impl<'s> LineIndex<'s> {
+    /// The lines of `source`.
+    pub fn new(source: &'s str) -> Self {
+        let breaks = source.match_indices('\n').map(|(i, _)| i + 1);
+        Self {
+            source,
+            starts: std::iter::once(0).chain(breaks).collect(),
+        }
+    }
+
+    /// The line and column of byte `offset` ([`SourceLocation::at`]).
+    pub fn location(&self, offset: usize) -> SourceLocation {
+        let mut offset = offset.min(self.source.len());
+        while !self.source.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        let line = self.starts.partition_point(|&start| start <= offset) - 1;
+        SourceLocation {
+            line: (line + 1) as u32,
+            column: (self.source[self.starts[line]..offset].chars().count() + 1) as u32,
+        }
+    }
+}
+
 /// How a scene file names one placed object, and where it defines it.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct ObjectSource {
@@ -128,6 +161,14 @@ mod tests {
             SourceLocation { line: 3, column: 9 }
         );
         assert_eq!(SourceLocation::at(text, 999).line, 3);
+        let index = LineIndex::new(text);
+        for offset in 0..=text.len() + 2 {
+            assert_eq!(
+                index.location(offset),
+                SourceLocation::at(text, offset),
+                "{offset}"
+            );
+        }
     }
 
     use crate::scene::{parse_nff, parse_scene};

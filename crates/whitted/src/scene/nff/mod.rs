@@ -47,7 +47,7 @@ use self::shapes::{Placed, flat_shape, read_cone, read_polygon, read_sphere};
 use self::view::{View, read_view};
 use crate::image::ColorSpace;
 use crate::math::{Transform, Vec3};
-use crate::render::{ObjectSource, ObjectSources, RenderSettings, Scene, SourceLocation};
+use crate::render::{LineIndex, ObjectSource, ObjectSources, RenderSettings, Scene};
 use crate::scene::{SceneError, without_bom};
 use crate::shading::Color;
 use crate::shading::Material;
@@ -228,6 +228,7 @@ impl Document {
 /// Where each shape and each run of patches of `document` (read from
 /// `source`) is defined: `s 3` is the file's third sphere.
 fn object_sources(source: &str, document: &Document) -> ObjectSources {
+    let lines = LineIndex::new(source);
     let mut seen: HashMap<&str, usize> = HashMap::new();
     let primitives = document
         .object_entities
@@ -237,7 +238,7 @@ fn object_sources(source: &str, document: &Document) -> ObjectSources {
             *count += 1;
             ObjectSource {
                 label: format!("{entity} {count}"),
-                location: Some(SourceLocation::at(source, start)),
+                location: Some(lines.location(start)),
             }
         })
         .collect();
@@ -248,7 +249,7 @@ fn object_sources(source: &str, document: &Document) -> ObjectSources {
         .chunk_by(|a, b| a.material == b.material)
         .map(|run| ObjectSource {
             label: format!("pp ({} patches)", run.len()),
-            location: Some(SourceLocation::at(source, run[0].span.start)),
+            location: Some(lines.location(run[0].span.start)),
         })
         .collect();
     ObjectSources {

@@ -33,7 +33,7 @@ use self::mtl::read_library;
 use self::reader::{NONE, ObjData, read_obj};
 use crate::math::{Aabb, Transform};
 use crate::render::Camera;
-use crate::render::{ObjectSource, RenderSettings, Scene, SourceLocation};
+use crate::render::{LineIndex, ObjectSource, RenderSettings, Scene};
 use crate::scene::{
     Diagnostic, LoadedScene, SceneError, Severity, limit_warnings, push_limited, without_bom,
 };
@@ -144,6 +144,7 @@ fn build_scene(
     scene.settings = settings;
     scene.ambient = Color::splat(AMBIENT);
     scene.lights = vec![headlight(&scene.camera)];
+    let lines = LineIndex::new(source);
     for (slot, mesh) in meshes {
         let material = if slot == NONE {
             Material::default()
@@ -170,7 +171,7 @@ fn build_scene(
             label: used.map_or("the faces before any usemtl".into(), |(name, _)| {
                 format!("the faces of usemtl {name}")
             }),
-            location: used.map(|(_, span)| SourceLocation::at(source, span.start)),
+            location: used.map(|(_, span)| lines.location(span.start)),
         });
     }
     warnings.sort_by_key(|d| (d.path.clone(), d.line, d.column));

@@ -137,6 +137,7 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
         scene.add_material(Material::default());
     }
     let tables = top.get("objects").and_then(|value| value.as_array());
+    let lines = r.line_index();
     for (table, object) in objects {
         let material = object
             .material
@@ -145,7 +146,7 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
         let span = tables.and_then(|tables| tables.get(table)).map(|t| t.span);
         scene.sources.primitives.push(ObjectSource {
             label: format!("objects[{table}]"),
-            location: span.map(|span| r.location(span)),
+            location: span.map(|span| lines.location(span.start)),
         });
     }
     Ok(scene)
