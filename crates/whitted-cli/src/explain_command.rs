@@ -85,7 +85,7 @@ pub fn run(args: &ExplainArgs) -> Result<(), String> {
     let explanation = explain_pixel(&scene, args.pixel, args.sample).map_err(|e| e.to_string())?;
     let file = args.scene.scene.as_deref();
     let text = if args.json {
-        let mut json = serde_json::to_string_pretty(&explanation_json(&scene, file, &explanation))
+        let mut json = serde_json::to_string(&explanation_json(&scene, file, &explanation))
             .map_err(|e| e.to_string())?;
         json.push('\n');
         json
