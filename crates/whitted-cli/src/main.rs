@@ -5,11 +5,16 @@
 
 mod arguments;
 mod bench_command;
+mod explain_command;
+mod explain_json;
+mod explain_svg;
+mod explain_text;
 mod merge_command;
 mod outputs;
 mod progress;
 mod render_command;
 mod report;
+mod scene_arguments;
 #[cfg(unix)]
 mod signals;
 mod split;
@@ -38,6 +43,7 @@ enum Command {
     Render(render_command::RenderArgs),
     Bench(bench_command::BenchArgs),
     Merge(merge_command::MergeArgs),
+    Explain(explain_command::ExplainArgs),
 }
 
 fn main() -> ExitCode {
@@ -50,6 +56,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render_command::run(&args),
         Command::Bench(args) => bench_command::run(&args),
         Command::Merge(args) => merge_command::run(&args),
+        Command::Explain(args) => explain_command::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

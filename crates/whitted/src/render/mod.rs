@@ -3,16 +3,20 @@
 //! picture is identical bit for bit whatever the number of threads.
 
 mod camera;
+mod explain;
 mod gradient_note;
 mod merge;
 mod part;
 mod photon_pass;
 mod resources;
+mod sample_ray;
 mod scene;
 mod selection;
 mod settings;
+mod sources;
 
 pub use camera::{Camera, CameraError};
+pub use explain::{ExplainError, PixelExplanation, explain_pixel};
 pub use gradient_note::GradientExceeded;
 pub use merge::{MergeError, Merged, merge_parts};
 pub use part::{
@@ -25,6 +29,7 @@ pub use selection::{PixelSelection, SelectionError, Share, Window};
 pub use settings::{
     Aov, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, RenderSettings, check_image_size,
 };
+pub use sources::{LineIndex, ObjectSource, ObjectSources, PrimitiveDescription, SourceLocation};
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -37,13 +42,23 @@ use crate::integrator::{
     Integrator, RayCounts, RayKind, RecursionLimits, SECONDARY_RAY_BUDGET, Shading,
 };
 use crate::limits::{MemoryBudget, MemoryError};
-use crate::math::random::hash64;
-use crate::math::sampling::pixel_sample;
 use crate::shading::Color;
 use crate::world::{MAX_PRIMITIVES, MaterialId, World};
+use sample_ray::{pixel_pattern, sample_ray};
 
 /// Side of the square tiles the image is cut into, in pixels.
 const TILE_SIZE: u32 = 16;
+
+/// The world of `scene`, its structures of the kinds its settings ask for
+/// (shared by [`render`] and [`explain_pixel`], which must trace the same).
+fn build_world(scene: &Scene) -> World<'_> {
+    let settings = &scene.settings;
+    World::build_levels(
+        &scene.objects,
+        settings.accel_top.unwrap_or(settings.accel),
+        settings.accel_bottom.unwrap_or(settings.accel),
+    )
+}
 
 /// Worker stack: a base for everything but the recursion, plus room for
 /// each level (one level measured at about 1.5 KiB in a release build; the
@@ -261,11 +276,7 @@ pub fn render_selected(
 
     gradient_note::forget(&scene.objects);
     let build_start = std::time::Instant::now();
-    let world = World::build_levels(
-        &scene.objects,
-        settings.accel_top.unwrap_or(settings.accel),
-        settings.accel_bottom.unwrap_or(settings.accel),
-    );
+    let world = build_world(scene);
     let build_seconds = build_start.elapsed().as_secs_f64();
     let shading = Shading {
         materials: &scene.materials,
@@ -415,17 +426,11 @@ fn render_tile(
                 continue;
             }
             tile.selected += 1;
-            let pattern = hash64(u64::from(y) << 32 | u64::from(x)) as u32;
+            let pattern = pixel_pattern(x, y);
             let mut sum = Color::ZERO;
             let mut centre = None;
             for s in 0..spp {
-                let offset = pixel_sample(s, spp, pattern);
-                let ray = camera.ray(
-                    settings.width,
-                    settings.height,
-                    f64::from(x) + offset.x,
-                    f64::from(y) + offset.y,
-                );
+                let ray = sample_ray(camera, settings, (x, y), pattern, s);
                 let sample = integrator.trace_primary(&ray, &mut tile.rays);
                 if let Some(material) = sample.cut_at {
                     *tile.cuts.entry(material).or_default() += 1;

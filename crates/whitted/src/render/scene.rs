@@ -5,7 +5,7 @@
 use crate::image::ColorSpace;
 use crate::math::Transform;
 use crate::mesh::TriangleMesh;
-use crate::render::{Camera, RenderSettings};
+use crate::render::{Camera, ObjectSources, RenderSettings};
 use crate::shading::{Color, Light, Material};
 use crate::shape::Shape;
 use crate::world::{MaterialId, MeshId, Objects};
@@ -33,6 +33,8 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// The shapes and meshes placed in the world.
     pub objects: Objects,
+    /// Where the scene file defines each of them (for `whitted explain`).
+    pub sources: ObjectSources,
 }
 
 impl Scene {
@@ -49,6 +51,7 @@ impl Scene {
             material_names: Vec::new(),
             lights: Vec::new(),
             objects: Objects::default(),
+            sources: ObjectSources::default(),
         }
     }
 

@@ -121,9 +121,8 @@ pub(super) fn read_definitions(
         let f = r.table(value, &name, "definition")?;
         let keys = r.check_keys(&f, DEFINITION_KEYS);
         let content = match (f.get("objects"), f.get("mesh")) {
-            (Some(objects), None) => {
-                read_objects(r, Some(objects), materials).map(Content::Objects)
-            }
+            (Some(objects), None) => read_objects(r, Some(objects), materials)
+                .map(|items| Content::Objects(items.into_iter().map(|(_, item)| item).collect())),
             (None, Some(mesh)) => read_mesh(r, mesh).map(Content::Mesh),
             (Some(_), Some(mesh)) => Err(r.error(
                 r.span_of(mesh),

@@ -50,12 +50,13 @@ use std::path::Path;
 use toml_span::Span;
 use toml_span::value::Value;
 
+use self::definition::Item;
 use self::reader::{Parsed, Reader};
 use crate::image::ColorSpace;
 use crate::math::Vec3;
 use crate::render::{Camera, CameraError};
 use crate::render::{MAX_DEPTH, MAX_SAMPLES, MAX_SIDE, check_image_size};
-use crate::render::{RenderSettings, Scene};
+use crate::render::{ObjectSource, RenderSettings, Scene};
 use crate::scene::{Diagnostic, SceneError, without_bom};
 use crate::shading::Color;
 use crate::shading::Material;
@@ -144,8 +145,24 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
     }
     let (objects, definitions) = (objects?, definitions?);
     let default_material = MaterialId(scene.materials.len() as u32);
+    let (tables, objects): (Vec<usize>, Vec<Item>) = objects.into_iter().unzip();
     if definition::needs_default_material(&objects, &definitions) {
         scene.add_material(Material::default());
+    }
+    // Where each shape the scene places itself is defined, in the order
+    // they are added (instances are not shapes of the top level).
+    let arrays = top.get("objects").and_then(|value| value.as_array());
+    let lines = r.line_index();
+    for (table, _) in tables
+        .iter()
+        .zip(&objects)
+        .filter(|(_, item)| matches!(item, Item::Object(_)))
+    {
+        let span = arrays.and_then(|arrays| arrays.get(*table)).map(|t| t.span);
+        scene.sources.primitives.push(ObjectSource {
+            label: format!("objects[{table}]"),
+            location: span.map(|span| lines.location(span.start)),
+        });
     }
     definition::place_all(r, &mut scene, objects, definitions, default_material)?;
     Ok(scene)

@@ -41,11 +41,12 @@ pub(super) struct Object {
 const COMMON_KEYS: &[&str] = &["shape", "material", "transform"];
 
 /// Reads the `[[objects]]` array, if any; `materials` are the names defined.
+/// Each object comes with the index of the table that defined it.
 pub(super) fn read_objects(
     r: &mut Reader<'_>,
     value: Option<&Value<'_>>,
     materials: &[String],
-) -> Parsed<Vec<Item>> {
+) -> Parsed<Vec<(usize, Item)>> {
     let Some(value) = value else {
         return Ok(Vec::new());
     };
@@ -53,7 +54,10 @@ pub(super) fn read_objects(
     let objects = all(objects
         .iter()
         .map(|object| read_object(r, object, materials)))?;
-    Ok(objects.into_iter().flatten().collect())
+    let by_table = objects.into_iter().enumerate();
+    Ok(by_table
+        .flat_map(|(table, objects)| objects.into_iter().map(move |object| (table, object)))
+        .collect())
 }
 
 /// One object, or one per patch of a `shape = "patches"` file, or an
