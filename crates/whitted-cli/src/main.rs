@@ -13,6 +13,7 @@ mod merge_command;
 mod outputs;
 mod progress;
 mod render_command;
+mod render_stats;
 mod report;
 mod scene_arguments;
 #[cfg(unix)]

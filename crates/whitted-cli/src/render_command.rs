@@ -9,6 +9,7 @@ use whitted::render::{Aov, Share, Window, render, render_selected};
 
 use crate::arguments;
 use crate::progress::ProgressReport;
+use crate::render_stats::{self, StageSeconds};
 use crate::report::note;
 use crate::scene_arguments::SceneArgs;
 use crate::split::{self, PartRender};
@@ -57,6 +58,12 @@ pub struct RenderArgs {
     /// part for `whitted merge`.
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = split::crop, allow_hyphen_values = true)]
     crop: Option<Window>,
+
+    /// After the summary, print where the time went (reading, building,
+    /// photons, tracing with the threads' use, writing) and the rays by
+    /// kind with their rates (printed even with --quiet).
+    #[arg(long)]
+    stats: bool,
 
     /// Print nothing but errors.
     #[arg(short, long)]
@@ -132,7 +139,9 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             .collect::<Result<Vec<_>, _>>()?,
     };
     check_destinations(&args.output, &aov_outputs, args.quiet)?;
+    let load_start = Instant::now();
     let mut scene = args.scene.load(args.quiet)?;
+    let load_seconds = load_start.elapsed().as_secs_f64();
 
     scene.settings.threads = args.threads;
     scene.settings.aovs = match &part {
@@ -177,6 +186,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         note!("{photons}");
     }
 
+    let write_start = Instant::now();
     match selection {
         Some(selection) => PartRender::write(
             &args.output,
@@ -196,6 +206,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         }
     }
 
+    let write_seconds = write_start.elapsed().as_secs_f64();
     if !args.quiet {
         let rays = output.rays;
         let by_kind = output
@@ -215,6 +226,16 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             output.build_seconds,
             rays.total() as f64 / elapsed / 1e6,
         );
+    }
+    if args.stats {
+        let stages = StageSeconds {
+            load: load_seconds,
+            render: elapsed,
+            write: write_seconds,
+        };
+        for line in render_stats::lines(&output, stages) {
+            note!("{line}");
+        }
     }
     Ok(())
 }

@@ -14,6 +14,7 @@ mod scene;
 mod selection;
 mod settings;
 mod sources;
+mod trace_timing;
 
 pub use camera::{Camera, CameraError};
 pub use explain::{ExplainError, PixelExplanation, explain_pixel};
@@ -30,6 +31,7 @@ pub use settings::{
     Aov, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, RenderSettings, check_image_size,
 };
 pub use sources::{LineIndex, ObjectSource, ObjectSources, PrimitiveDescription, SourceLocation};
+pub use trace_timing::TraceTiming;
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -89,6 +91,8 @@ pub struct RenderOutput {
     pub ray_kinds: &'static [RayKind],
     /// Seconds spent building the world (its acceleration structures).
     pub build_seconds: f64,
+    /// How long the tiles took, and how busy the threads were.
+    pub trace: TraceTiming,
     /// The thread count asked for, when it was lowered to what helps.
     pub thread_clamp: Option<ThreadClamp>,
     /// The camera samples the budget of secondary rays cut short, if any.
@@ -304,16 +308,19 @@ pub fn render_selected(
         rays: RayCounts::default(),
         cuts: HashMap::new(),
     });
+    let clock = trace_timing::TraceClock::start();
     pool.install(|| {
         tiles.into_par_iter().for_each(|index| {
-            let tile = render_tile(
-                &integrator,
-                &scene.camera,
-                settings,
-                selection,
-                index % tiles_x,
-                index / tiles_x,
-            );
+            let tile = clock.tile(|| {
+                render_tile(
+                    &integrator,
+                    &scene.camera,
+                    settings,
+                    selection,
+                    index % tiles_x,
+                    index / tiles_x,
+                )
+            });
             let pixels = tile.selected;
             films
                 .lock()
@@ -323,6 +330,7 @@ pub fn render_selected(
             progress(Progress { done: now, total });
         });
     });
+    let trace = clock.finish(pool.current_num_threads());
     let films = films.into_inner().unwrap_or_else(PoisonError::into_inner);
     check_finite(&films.image)?;
     let ray_budget_cut = budget_cut(scene, &films.cuts);
@@ -332,6 +340,7 @@ pub fn render_selected(
         rays: films.rays,
         ray_kinds: integrator.ray_kinds(),
         build_seconds,
+        trace,
         thread_clamp,
         ray_budget_cut,
         gradient_exceeded: gradient_note::report(&scene.objects),
