@@ -20,11 +20,13 @@
 //! falloff = 4                     # Warn exponent, default 0
 //! ```
 //!
-//! Directions are normalised; a zero direction is an error.
+//! Directions are normalised; a zero direction is an error. Area lights
+//! (`rect`, `disk`, `sphere`) are read in `area_light.rs`.
 
 use toml_span::Span;
 use toml_span::value::Value;
 
+use super::area_light::{AREA_KINDS, read_area_light};
 use super::reader::{Parsed, Reader, all, list};
 use crate::shading::Color;
 use crate::shading::{Attenuation, Light};
@@ -45,6 +47,9 @@ const KINDS: &[(&str, &[&str])] = &[
             "falloff",
         ],
     ),
+    AREA_KINDS[0],
+    AREA_KINDS[1],
+    AREA_KINDS[2],
 ];
 
 /// Reads the `[[lights]]` array, if any.
@@ -81,6 +86,11 @@ fn read_light(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Light> {
                 intensity: intensity?,
                 attenuation: attenuation?,
             }
+        }
+        "rect" | "disk" | "sphere" => {
+            let light = read_area_light(r, &f, kind);
+            keys?;
+            return light;
         }
         "directional" => {
             let direction = r.require(&f, "direction", Reader::direction);

@@ -34,6 +34,7 @@
 //! out of range, unknown names, and shapes, transforms or cameras their
 //! constructors refuse.
 
+mod area_light;
 mod csg;
 mod light;
 mod material;
@@ -129,7 +130,7 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
     scene.background = render.background;
     scene.ambient = render.ambient;
     scene.color_space = render.color_space;
-    scene.lights = lights?;
+    let lights = lights?;
     for (material, name) in materials.list?.into_iter().zip(&materials.names) {
         scene.add_named_material(name, material);
     }
@@ -143,6 +144,12 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
             .material
             .map_or(default_material, |index| MaterialId(index as u32));
         scene.add_primitive(object.shape, material, object.transform);
+    }
+    for light in lights {
+        // Area lights' shapes were checked where they were read.
+        scene
+            .add_light(light)
+            .map_err(|e| r.error(Span::new(0, 0), e.to_string()))?;
     }
     Ok(scene)
 }
