@@ -246,3 +246,212 @@ impl AreaLight {
 fn shadow_distance(distance: f64, p: Vec3) -> f64 {
     distance - SHADOW_GAP * (distance + p.abs().max_element())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Aabb;
+    use crate::math::random::Rng;
+    use crate::shading::{Light, direct_samples};
+
+    /// The irradiance at `p` facing `n` that [`direct_samples`] estimates
+    /// from `light` with `samples` shadow rays, unoccluded.
+    fn irradiance(light: &AreaLight, samples: u32, p: Vec3, n: Vec3) -> f64 {
+        let light = Light::Area(AreaLight {
+            samples,
+            ..light.clone()
+        });
+        direct_samples(std::slice::from_ref(&light), p)
+            .map(|(_, s)| s.intensity.r * n.dot(s.to_light).max(0.0))
+            .sum()
+    }
+
+    fn disk(radius: f64, height: f64) -> AreaLight {
+        AreaLight {
+            emitter: Emitter::Disk {
+                center: Vec3::new(0.0, height, 0.0),
+                normal: -Vec3::Y,
+                radius,
+            },
+            radiance: Color::splat(2.0),
+            samples: 1,
+        }
+    }
+
+    fn close(estimate: f64, exact: f64, tolerance: f64) -> bool {
+        ((estimate - exact) / exact).abs() < tolerance
+    }
+
+    #[test]
+    fn a_disk_light_gives_pi_l_sin_squared_of_its_angular_radius() {
+        for (radius, height) in [(1.0, 2.0), (0.3, 5.0), (3.0, 1.0)] {
+            let light = disk(radius, height);
+            let sin2 = radius * radius / (radius * radius + height * height);
+            let exact = PI * 2.0 * sin2;
+            let coarse = irradiance(&light, 16, Vec3::ZERO, Vec3::Y);
+            let fine = irradiance(&light, 4096, Vec3::ZERO, Vec3::Y);
+            assert!(close(fine, exact, 0.005), "{fine} vs {exact}");
+            assert!((fine - exact).abs() <= (coarse - exact).abs() + 1e-3 * exact);
+        }
+    }
+
+    #[test]
+    fn a_sphere_light_gives_pi_l_sin_squared_of_its_angular_radius() {
+        let light = AreaLight {
+            emitter: Emitter::Sphere {
+                center: Vec3::new(0.5, 3.0, -0.2),
+                radius: 0.8,
+            },
+            radiance: Color::splat(1.5),
+            samples: 1,
+        };
+        let p = Vec3::new(0.5, 0.0, -0.2);
+        let exact = PI * 1.5 * 0.8f64.powi(2) / 9.0;
+        let fine = irradiance(&light, 4096, p, Vec3::Y);
+        assert!(close(fine, exact, 0.005), "{fine} vs {exact}");
+        // Inside the sphere it lights nothing.
+        assert_eq!(irradiance(&light, 16, Vec3::new(0.5, 3.0, 0.0), Vec3::Y), 0.0);
+    }
+
+    /// The form factor from a point to a parallel `a × b` rectangle at
+    /// distance `c` with one corner straight above the point.
+    fn corner_form_factor(a: f64, b: f64, c: f64) -> f64 {
+        let (x, y) = (a / c, b / c);
+        let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+        (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * PI)
+    }
+
+    #[test]
+    fn a_square_light_over_a_plane_gives_the_analytic_form_factor() {
+        let light = AreaLight {
+            emitter: Emitter::Rect {
+                corner: Vec3::new(0.0, 1.5, 0.0),
+                edge_u: Vec3::new(0.0, 0.0, 2.0),
+                edge_v: Vec3::new(2.0, 0.0, 0.0),
+            },
+            radiance: Color::splat(3.0),
+            samples: 1,
+        };
+        // Wrong way round: the front faces up, away from the floor.
+        assert_eq!(irradiance(&light, 64, Vec3::ZERO, Vec3::Y), 0.0);
+        let light = AreaLight {
+            emitter: Emitter::Rect {
+                corner: Vec3::new(0.0, 1.5, 0.0),
+                edge_u: Vec3::new(2.0, 0.0, 0.0),
+                edge_v: Vec3::new(0.0, 0.0, 2.0),
+            },
+            ..light
+        };
+        // Under a corner, and under a point that splits it into four.
+        let under_corner = PI * 3.0 * corner_form_factor(2.0, 2.0, 1.5);
+        let inside = PI
+            * 3.0
+            * (corner_form_factor(0.5, 0.7, 1.5)
+                + corner_form_factor(1.5, 0.7, 1.5)
+                + corner_form_factor(0.5, 1.3, 1.5)
+                + corner_form_factor(1.5, 1.3, 1.5));
+        for (p, exact) in [
+            (Vec3::ZERO, under_corner),
+            (Vec3::new(0.5, 0.0, 0.7), inside),
+        ] {
+            let fine = irradiance(&light, 4096, p, Vec3::Y);
+            assert!(close(fine, exact, 0.005), "{fine} vs {exact} at {p}");
+        }
+    }
+
+    #[test]
+    fn power_is_pi_radiance_area_and_a_given_power_is_kept() {
+        let emitter = Emitter::Disk {
+            center: Vec3::ZERO,
+            normal: Vec3::Z,
+            radius: 0.5,
+        };
+        let radiance = AreaLight::radiance_for_power(&emitter, Color::new(1.0, 2.0, 3.0));
+        let light = AreaLight {
+            emitter,
+            radiance,
+            samples: 4,
+        };
+        let power = Light::Area(light).power(&Aabb::EMPTY);
+        assert!((power - Color::new(1.0, 2.0, 3.0)).abs().max_element() < 1e-12);
+    }
+
+    #[test]
+    fn photons_from_a_disk_light_reach_a_facing_disk_by_their_form_factor() {
+        // Coaxial parallel disks of radii r1 (the light) and r2 at h.
+        let (r1, r2, h) = (0.5, 1.0, 1.2);
+        let light = Light::Area(AreaLight {
+            emitter: Emitter::Disk {
+                center: Vec3::ZERO,
+                normal: Vec3::Z,
+                radius: r1,
+            },
+            radiance: Color::splat(0.7),
+            samples: 1,
+        });
+        let power = light.power(&Aabb::EMPTY).r;
+        assert!((power - 0.7 * PI * PI * r1 * r1).abs() < 1e-12);
+        let (a, b) = (r1 / h, r2 / h);
+        let x = 1.0 + (1.0 + b * b) / (a * a);
+        let form_factor = 0.5 * (x - (x * x - 4.0 * (b / a).powi(2)).sqrt());
+        let mut rng = Rng::new(7);
+        let n = 200_000;
+        let mut arrived = 0.0;
+        for _ in 0..n {
+            let u = [rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()];
+            let ray = light.emit(u, &Aabb::EMPTY).unwrap();
+            assert_eq!(ray.power.r, power);
+            assert!(ray.direction.z > 0.0 && ray.origin.z > 0.0);
+            let t = (h - ray.origin.z) / ray.direction.z;
+            let hit = ray.origin + t * ray.direction;
+            if hit.x * hit.x + hit.y * hit.y < r2 * r2 {
+                arrived += ray.power.r / f64::from(n);
+            }
+        }
+        let exact = power * form_factor;
+        assert!(close(arrived, exact, 0.01), "{arrived} vs {exact}");
+    }
+
+    #[test]
+    fn photons_leave_a_sphere_light_outwards_from_just_outside_it() {
+        let light = Light::Area(AreaLight {
+            emitter: Emitter::Sphere {
+                center: Vec3::new(1.0, 2.0, 3.0),
+                radius: 0.5,
+            },
+            radiance: Color::ONE,
+            samples: 1,
+        });
+        let mut rng = Rng::new(3);
+        for _ in 0..1000 {
+            let u = [rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()];
+            let ray = light.emit(u, &Aabb::EMPTY).unwrap();
+            let out = ray.origin - Vec3::new(1.0, 2.0, 3.0);
+            assert!(out.length() > 0.5 && out.length() < 0.5 + 1e-6);
+            assert!(out.dot(ray.direction) > 0.0);
+            assert_eq!(ray.power.r, 4.0 * PI * PI * 0.25);
+        }
+    }
+
+    #[test]
+    fn shadow_rays_end_just_short_of_the_sampled_point() {
+        let light = disk(1.0, 2.0);
+        let s = light.sample(Vec3::ZERO, [0.0, 0.0], 1).unwrap();
+        assert!(s.distance < 2.0 && s.distance > 2.0 - 1e-6);
+    }
+
+    #[test]
+    fn the_sample_pattern_depends_on_the_point_alone() {
+        let light = [Light::Area(AreaLight {
+            samples: 9,
+            ..disk(1.0, 2.0)
+        })];
+        let p = Vec3::new(0.1, 0.0, 0.2);
+        let once: Vec<_> = direct_samples(&light, p).collect();
+        let again: Vec<_> = direct_samples(&light, p).collect();
+        assert_eq!(once, again);
+        assert_eq!(once.len(), 9);
+        let elsewhere: Vec<_> = direct_samples(&light, p + Vec3::X * 1e-9).collect();
+        assert_ne!(once[0].1.to_light, elsewhere[0].1.to_light);
+    }
+}

@@ -244,7 +244,7 @@ mod tests {
             assert!(close(total, light.power(&bounds), 1e-9));
             let position = match light {
                 Light::Point { position, .. } | Light::Spot { position, .. } => position,
-                Light::Directional { .. } => unreachable!(),
+                Light::Directional { .. } | Light::Area(_) => unreachable!(),
             };
             let intensity = light.sample(position + towards).unwrap().intensity;
             let expected = intensity * solid_angle;
