@@ -122,3 +122,73 @@ pub(super) fn read_area_light(r: &mut Reader<'_>, f: &Fields<'_, '_>, kind: &str
 fn finite(c: Color) -> bool {
     Vec3::new(c.r, c.g, c.b).is_finite()
 }
+
+#[cfg(test)]
+mod tests {
+    use std::f64::consts::PI;
+
+    use super::super::tests::{CAMERA, errors, scene};
+    use super::*;
+
+    #[test]
+    fn each_kind_is_read_with_its_glowing_shape() {
+        let s = scene(&format!(
+            "{CAMERA}[[lights]]\ntype = 'rect'\norigin = [0, 2, 0]\nedge_u = [1, 0, 0]\n\
+             edge_v = [0, 0, 1]\nradiance = [1, 2, 3]\nsamples = 4\n\
+             [[lights]]\ntype = 'disk'\ncenter = [0, 3, 0]\nnormal = [0, -2, 0]\nradius = 0.5\n\
+             power = 2\n\
+             [[lights]]\ntype = 'sphere'\ncenter = [1, 1, 1]\nradius = 0.25\nradiance = 1\n"
+        ));
+        assert_eq!(s.lights.len(), 3);
+        assert_eq!(s.objects.primitives.len(), 3);
+        let Light::Area(rect) = &s.lights[0] else {
+            panic!("{:?}", s.lights[0]);
+        };
+        assert_eq!(rect.radiance, Color::new(1.0, 2.0, 3.0));
+        assert_eq!(rect.samples, 4);
+        let Light::Area(disk) = &s.lights[1] else {
+            panic!("{:?}", s.lights[1]);
+        };
+        assert_eq!(disk.samples, DEFAULT_SAMPLES);
+        assert!((disk.power().r - 2.0).abs() < 1e-12);
+        assert_eq!(
+            disk.emitter,
+            Emitter::Disk {
+                center: Vec3::new(0.0, 3.0, 0.0),
+                normal: -Vec3::Y,
+                radius: 0.5
+            }
+        );
+        // The glowing shapes emit π L and nothing else.
+        let glow = &s.materials[s.objects.primitives[2].material.0 as usize];
+        assert_eq!(glow.emission, Color::splat(PI).into());
+        assert!(glow.diffuse.is_black() && glow.ambient.is_black());
+    }
+
+    #[test]
+    fn brightness_is_radiance_or_power_and_shapes_must_have_an_area() {
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[[lights]]\ntype = 'sphere'\ncenter = [0, 0, 0]\nradius = 1\n\
+                 radiance = 1\npower = 2\n\
+                 [[lights]]\ntype = 'disk'\ncenter = [0, 0, 0]\nnormal = [0, 1, 0]\nradius = 1\n\
+                 [[lights]]\ntype = 'rect'\norigin = [0, 0, 0]\nedge_u = [1, 0, 0]\n\
+                 edge_v = [2, 0, 0]\nradiance = 1\nsamples = 0\nintensity = 1\n"
+            )),
+            vec![
+                "sphere light: give `radiance` or `power`, not both",
+                "disk light: missing `radiance` or `power` (how bright it is)",
+                "`samples` must be at least 1, got 0",
+                "unknown key `intensity` in rect light; expected one of: \
+                 type, origin, edge_u, edge_v, radiance, power, samples",
+            ]
+        );
+        assert_eq!(
+            errors(&format!(
+                "{CAMERA}[[lights]]\ntype = 'rect'\norigin = [0, 0, 0]\nedge_u = [1, 0, 0]\n\
+                 edge_v = [2, 0, 0]\nradiance = 1\n"
+            )),
+            vec!["rect light: degenerate parallelogram: its edges are parallel or of zero length"]
+        );
+    }
+}

@@ -254,7 +254,7 @@ mod tests {
         assert_eq!(
             errors(&format!(
                 "{CAMERA}[[lights]]\nposition = [0, 0, 0]\ncolour = 3\nfoo = 1\n\
-                 [[lights]]\ntype = 'sun'\nangle = 10\nintensity = -1\nradius = 2\n\
+                 [[lights]]\ntype = 'sun'\nangle = 10\nintensity = -1\nsize = 2\n\
                  [[lights]]\ntype = 'point'\npositon = [0, 0, 0]\nattenuation = [0, 0, 0]\n\
                  [[lights]]\ntype = 'directional'\ndirection = [0, 0, 0]\nangle = 3\n\
                  [[lights]]\ntype = 'spot'\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n\
@@ -263,13 +263,17 @@ mod tests {
             [
                 "missing required key `type` in light",
                 "unknown key `colour` in light; none of the light types has it; expected one \
-                 of: type, position, intensity, attenuation, direction, angle, falloff",
+                 of: type, position, intensity, attenuation, direction, angle, falloff, origin, \
+                 edge_u, edge_v, radiance, power, samples, center, normal, radius",
                 "unknown key `foo` in light; none of the light types has it; expected one \
-                 of: type, position, intensity, attenuation, direction, angle, falloff",
-                "unknown light type `sun`; expected one of: point, directional, spot",
+                 of: type, position, intensity, attenuation, direction, angle, falloff, origin, \
+                 edge_u, edge_v, radiance, power, samples, center, normal, radius",
+                "unknown light type `sun`; expected one of: point, directional, spot, rect, disk, \
+                 sphere",
                 "`intensity` must not be negative, got -1",
-                "unknown key `radius` in light; none of the light types has it; expected one \
-                 of: type, position, intensity, attenuation, direction, angle, falloff",
+                "unknown key `size` in light; none of the light types has it; expected one \
+                 of: type, position, intensity, attenuation, direction, angle, falloff, origin, \
+                 edge_u, edge_v, radiance, power, samples, center, normal, radius",
                 "missing required key `position` in point light",
                 "unknown key `positon` in point light; expected one of: type, position, \
                  intensity, attenuation",
