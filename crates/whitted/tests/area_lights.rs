@@ -159,7 +159,8 @@ fn the_penumbra_of_a_sphere_lies_where_similar_triangles_put_it() {
                     "{accel:?}: inner edge {inner} vs {inner_predicted}"
                 );
                 // Half the light is hidden about half-way across.
-                let middle = shaded.floor(0.5 * (inner + outer)) / open.floor(0.5 * (inner + outer));
+                let middle =
+                    shaded.floor(0.5 * (inner + outer)) / open.floor(0.5 * (inner + outer));
                 assert!((0.3..0.7).contains(&middle), "{middle}");
             })
         });
@@ -180,6 +181,9 @@ fn the_light_is_seen_glowing_and_does_not_shadow_itself() {
         let sin2 = LIGHT_RADIUS.powi(2) / (LIGHT_RADIUS.powi(2) + LIGHT_HEIGHT.powi(2));
         let exact = std::f64::consts::PI * sin2;
         let floor = probe.floor(0.0);
-        assert!(((floor - exact) / exact).abs() < 0.005, "{floor} vs {exact}");
+        assert!(
+            ((floor - exact) / exact).abs() < 0.005,
+            "{floor} vs {exact}"
+        );
     });
 }

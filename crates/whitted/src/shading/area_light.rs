@@ -310,7 +310,10 @@ mod tests {
         let fine = irradiance(&light, 4096, p, Vec3::Y);
         assert!(close(fine, exact, 0.005), "{fine} vs {exact}");
         // Inside the sphere it lights nothing.
-        assert_eq!(irradiance(&light, 16, Vec3::new(0.5, 3.0, 0.0), Vec3::Y), 0.0);
+        assert_eq!(
+            irradiance(&light, 16, Vec3::new(0.5, 3.0, 0.0), Vec3::Y),
+            0.0
+        );
     }
 
     /// The form factor from a point to a parallel `a × b` rectangle at

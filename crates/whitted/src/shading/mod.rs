@@ -18,10 +18,10 @@ pub mod scatter;
 pub mod tangent_frame;
 pub mod texture;
 
+pub use area_light::{AreaLight, Emitter};
 pub use bump::{Bump, shading_normal};
 pub use color::Color;
 pub use emission::EmittedRay;
-pub use area_light::{AreaLight, Emitter};
 pub use light::{Attenuation, Light, LightSample, direct_samples};
 pub use material::Material;
 pub use medium::{Crossing, MediumStack};
