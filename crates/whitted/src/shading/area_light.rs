@@ -147,7 +147,7 @@ impl AreaLight {
                 let axis = *center - p;
                 let d2 = axis.length_squared();
                 let sin2_max = radius * radius / d2;
-                if !(sin2_max < 1.0) {
+                if sin2_max.is_nan() || sin2_max >= 1.0 {
                     return None;
                 }
                 let d_c = d2.sqrt();
