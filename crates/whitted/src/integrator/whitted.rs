@@ -31,7 +31,8 @@ use crate::integrator::{PrimarySample, RayCounts, RayKind, RecursionLimits, Shad
 use crate::math::{Ray, Vec3, offset_ray_origin};
 use crate::shading::optics::reflect;
 use crate::shading::{
-    Color, Crossing, Light, Lobes, Material, MediumStack, Weights, phong, shading_normal,
+    Color, Crossing, Light, Lobes, Material, MediumStack, Weights, direct_samples, phong,
+    shading_normal,
 };
 use crate::world::{MaterialId, Surface, World};
 
@@ -201,11 +202,7 @@ impl<'a> Whitted<'a> {
         let diffuse = m.diffuse.at(s.uv);
         let specular = m.specular.at(s.uv);
         if alpha != Color::ZERO && (diffuse != Color::ZERO || specular != Color::ZERO) {
-            for (index, light) in self.shading.lights.iter().enumerate() {
-                let Some(sample) = light.sample(s.point) else {
-                    tally.observer.light(index, None, None);
-                    continue;
-                };
+            for (index, light, sample) in direct_samples(self.shading.lights, s.point) {
                 let n_dot_l = n.dot(sample.to_light);
                 if n_dot_l <= 0.0 || (bumped && facing.dot(sample.to_light) <= 0.0) {
                     tally.observer.light(index, Some(&sample), None);
@@ -330,6 +327,7 @@ impl<'a> Whitted<'a> {
         let target = match light {
             Light::Directional { .. } => None,
             Light::Point { position, .. } | Light::Spot { position, .. } => Some(*position),
+            Light::Area(_) => Some(s.point + distance * to_light),
         };
         let segment = |origin: Vec3| {
             let t_max = target.map_or(distance, |p| (p - origin).dot(to_light));

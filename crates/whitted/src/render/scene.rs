@@ -6,8 +6,8 @@ use crate::image::ColorSpace;
 use crate::math::Transform;
 use crate::mesh::TriangleMesh;
 use crate::render::{Camera, ObjectSources, RenderSettings};
-use crate::shading::{Color, Light, Material};
-use crate::shape::Shape;
+use crate::shading::{Color, Light, Material, Texture};
+use crate::shape::{Shape, ShapeError};
 use crate::world::{MaterialId, MeshId, Objects};
 
 /// Everything needed to render one picture.
@@ -53,6 +53,27 @@ impl Scene {
             objects: Objects::default(),
             sources: ObjectSources::default(),
         }
+    }
+
+    /// Adds a light; an area light also places its glowing shape, with a
+    /// material that only emits ([`crate::shading::AreaLight::glow`]), so the camera and
+    /// mirrors see it (and it stops other lights' shadow rays, as the lamp
+    /// it stands for would). Refused when the light's shape is degenerate.
+    pub fn add_light(&mut self, light: Light) -> Result<(), ShapeError> {
+        if let Light::Area(area) = &light {
+            let (shape, transform) = area.glowing_shape()?;
+            let glow = Material {
+                ambient: Texture::default(),
+                diffuse: Texture::default(),
+                emission: area.glow().into(),
+                ..Material::default()
+            };
+            let name = format!("area light {}", self.lights.len() + 1);
+            let material = self.add_named_material(&name, glow);
+            self.add_primitive(shape, material, transform);
+        }
+        self.lights.push(light);
+        Ok(())
     }
 
     /// Adds a material and returns its id.

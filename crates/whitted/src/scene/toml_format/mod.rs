@@ -34,6 +34,7 @@
 //! out of range, unknown names, and shapes, transforms or cameras their
 //! constructors refuse.
 
+mod area_light;
 mod csg;
 mod definition;
 mod light;
@@ -139,7 +140,7 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
     scene.background = render.background;
     scene.ambient = render.ambient;
     scene.color_space = render.color_space;
-    scene.lights = lights?;
+    let lights = lights?;
     for (material, name) in materials.list?.into_iter().zip(&materials.names) {
         scene.add_named_material(name, material);
     }
@@ -165,6 +166,24 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
         });
     }
     definition::place_all(r, &mut scene, objects, definitions, default_material)?;
+    let light_tables = top.get("lights").and_then(|value| value.as_array());
+    for (index, light) in lights.into_iter().enumerate() {
+        let shapes = scene.objects.primitives.len();
+        // Area lights' shapes were checked where they were read.
+        scene
+            .add_light(light)
+            .map_err(|e| r.error(Span::new(0, 0), e.to_string()))?;
+        if scene.objects.primitives.len() > shapes {
+            // The glowing shape of an area light, named as the light.
+            let span = light_tables
+                .and_then(|tables| tables.get(index))
+                .map(|t| t.span);
+            scene.sources.primitives.push(ObjectSource {
+                label: format!("lights[{index}]"),
+                location: span.map(|span| lines.location(span.start)),
+            });
+        }
+    }
     Ok(scene)
 }
 
