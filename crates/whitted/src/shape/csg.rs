@@ -29,6 +29,15 @@
 //! medium stack see a CSG object as any other closed solid. A leaf's
 //! material is its own, else that of the nearest CSG child above it that
 //! has one, else the CSG object's ([`Csg::material`] answers `None`).
+//!
+//! **One medium.** The medium stack of refraction is keyed by the solid's
+//! medium, not by the material of the surface crossed, so a ray entering
+//! through one child's surface and leaving through another's (of another
+//! material) leaves the solid. The medium is the CSG object's own
+//! material; the scene reader fills an object that has none with its
+//! first solid's ([`Csg::filled_with`]). The children's materials give
+//! their surfaces' colour, mirror and transparency; their indices of
+//! refraction are not used.
 
 use super::solid::{Crossing, Solidity};
 use super::{LocalSurface, Shape, ShapeHit};
@@ -148,6 +157,8 @@ struct Data {
     bounds: Aabb,
     /// The diagonal of `bounds`.
     size: f64,
+    /// The material filling the solid, when not the object's own.
+    medium: Option<u32>,
 }
 
 /// A CSG object.
@@ -193,6 +204,7 @@ impl Csg {
             }],
             bounds: Aabb::EMPTY,
             size: 0.0,
+            medium: None,
         };
         let mut parts = Vec::with_capacity(children.len());
         let mut child_bounds = Vec::with_capacity(children.len());
@@ -245,6 +257,27 @@ impl Csg {
     /// above it) has one of its own.
     pub fn material(&self, hit: &ShapeHit) -> Option<u32> {
         self.data.leaves[(hit.part >> 16) as usize].material
+    }
+
+    /// The material whose index of refraction fills the solid, when it is
+    /// not the object's own (set by [`Csg::filled_with`]). A CSG object is
+    /// one medium: a ray that enters through one child's surface and
+    /// leaves through another's is inside the same medium between them.
+    pub fn medium(&self) -> Option<u32> {
+        self.data.medium
+    }
+
+    /// The object filled with `material` (`None`: with the object's own).
+    #[must_use]
+    pub fn filled_with(mut self, material: Option<u32>) -> Self {
+        self.data.medium = material;
+        self
+    }
+
+    /// The first solid's own material (depth-first, inherited from a CSG
+    /// child above it), if it has one.
+    pub fn first_material(&self) -> Option<u32> {
+        self.data.leaves[0].material
     }
 
     /// True when `p` lies inside the solid.

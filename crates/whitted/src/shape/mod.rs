@@ -334,6 +334,15 @@ impl Shape {
             _ => None,
         }
     }
+
+    /// The material that fills the solid, where it is not the shape's
+    /// material (a CSG object's, [`Csg::medium`]).
+    pub fn medium(&self) -> Option<u32> {
+        match self {
+            Shape::Csg(c) => c.medium(),
+            _ => None,
+        }
+    }
 }
 
 #[cfg(test)]

@@ -42,10 +42,20 @@ pub struct Surface {
     pub dpdv: Vec3,
     /// The surface's material.
     pub material: MaterialId,
+    /// The material whose index of refraction fills the solid behind the
+    /// surface, the key of the medium stack: the surface's own material,
+    /// except on a CSG object, which is one medium whatever its children's
+    /// materials ([`crate::shape::Csg::medium`]).
+    pub medium: MaterialId,
 }
 
 impl Surface {
-    pub(crate) fn from_local(s: LocalSurface, shading_normal: Vec3, material: MaterialId) -> Self {
+    pub(crate) fn from_local(
+        s: LocalSurface,
+        shading_normal: Vec3,
+        material: MaterialId,
+        medium: MaterialId,
+    ) -> Self {
         Self {
             point: s.point,
             point_error: s.point_error,
@@ -55,6 +65,7 @@ impl Surface {
             dpdu: s.dpdu,
             dpdv: s.dpdv,
             material,
+            medium,
         }
     }
 }

@@ -508,30 +508,31 @@ impl<'a> World<'a> {
 
     /// The world-space surface at a hit returned for `ray`.
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> Surface {
-        let (local, shading_normal, material, transform) = match self.primitive_ref(hit.primitive.0)
-        {
-            PrimitiveRef::Shape(i) => {
-                let p = &self.objects.primitives[i as usize];
-                let transform = self.transform(p.transform);
-                let object_ray = transform.map_or(*ray, |t| t.ray_to_object(ray));
-                let s = p.shape.surface(&object_ray, &hit.shape_hit);
-                let material = p
-                    .shape
-                    .material(&hit.shape_hit)
-                    .map_or(p.material, MaterialId);
-                (s, s.normal, material, transform)
-            }
-            PrimitiveRef::Triangle { instance, triangle } => {
-                let m = &self.objects.mesh_instances[instance as usize];
-                let transform = self.transform(m.transform);
-                let object_ray = transform.map_or(*ray, |t| t.ray_to_object(ray));
-                let mesh = &self.objects.meshes[m.mesh.0 as usize];
-                let s = mesh.surface(triangle, &object_ray, &hit.shape_hit);
-                (s.local, s.shading_normal, m.material, transform)
-            }
-        };
+        let (local, shading_normal, material, medium, transform) =
+            match self.primitive_ref(hit.primitive.0) {
+                PrimitiveRef::Shape(i) => {
+                    let p = &self.objects.primitives[i as usize];
+                    let transform = self.transform(p.transform);
+                    let object_ray = transform.map_or(*ray, |t| t.ray_to_object(ray));
+                    let s = p.shape.surface(&object_ray, &hit.shape_hit);
+                    let material = p
+                        .shape
+                        .material(&hit.shape_hit)
+                        .map_or(p.material, MaterialId);
+                    let medium = p.shape.medium().map_or(p.material, MaterialId);
+                    (s, s.normal, material, medium, transform)
+                }
+                PrimitiveRef::Triangle { instance, triangle } => {
+                    let m = &self.objects.mesh_instances[instance as usize];
+                    let transform = self.transform(m.transform);
+                    let object_ray = transform.map_or(*ray, |t| t.ray_to_object(ray));
+                    let mesh = &self.objects.meshes[m.mesh.0 as usize];
+                    let s = mesh.surface(triangle, &object_ray, &hit.shape_hit);
+                    (s.local, s.shading_normal, m.material, m.material, transform)
+                }
+            };
         match transform {
-            None => Surface::from_local(local, shading_normal, material),
+            None => Surface::from_local(local, shading_normal, material, medium),
             Some(t) => {
                 let (point, point_error) =
                     t.point_with_error_to_world(local.point, local.point_error);
@@ -544,6 +545,7 @@ impl<'a> World<'a> {
                     dpdu: t.vector_to_world(local.dpdu),
                     dpdv: t.vector_to_world(local.dpdv),
                     material,
+                    medium,
                 }
             }
         }

@@ -91,7 +91,14 @@ pub(super) fn read(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) 
         };
         r.error(children_span, message)
     })?;
-    let shape = Shape::Csg(shape);
+    // A CSG object is one medium: its own material's, else its first
+    // solid's.
+    let medium = if material.is_none() {
+        shape.first_material()
+    } else {
+        None
+    };
+    let shape = Shape::Csg(shape.filled_with(medium));
     let world = transform.bounds_to_world(&shape.bounds());
     if world.is_finite() {
         let reach = world.min.abs().max(world.max.abs()).max_element();
@@ -179,6 +186,8 @@ mod tests {
         assert!((surface.point.y - 1.5).abs() < 1e-12, "{}", surface.point);
         assert!(surface.normal.y > 0.99);
         assert_eq!(surface.material, MaterialId(1));
+        // One medium, the CSG object's material, whatever the child's.
+        assert_eq!(surface.medium, MaterialId(0));
         let hit = world.intersect(&down(0.9)).unwrap();
         assert!((hit.t() - 3.0).abs() < 1e-12);
         assert_eq!(world.surface(&down(0.9), &hit).material, MaterialId(0));

@@ -422,6 +422,15 @@ fn lens(r: f64, d: f64) -> Shape {
     )
 }
 
+/// A leaf as a child again, with its transform and material.
+fn leaf_child(leaf: &Leaf) -> CsgChild {
+    CsgChild {
+        shape: leaf.shape.clone(),
+        transform: leaf.transform,
+        material: leaf.material,
+    }
+}
+
 /// A hollow shell: a sphere minus a smaller one inside it.
 fn shell() -> Shape {
     let sphere = |r: f64| Shape::Sphere(Sphere::new(Vec3::ZERO, r).unwrap());
@@ -454,27 +463,55 @@ fn a_lens_of_two_spheres_focuses_where_the_thick_lens_equation_says() {
     // vertex: 1/f = (n-1) (1/R1 - 1/R2 + (n-1) d / (n R1 R2)) with
     // R1 = R, R2 = -R, and BFD = f (1 - (n-1) d / (n R1)).
     use crate::shading::optics::refract;
+    //
+    // The two spheres have materials of their own (1 and 2, both of index
+    // `n`) and the lens is filled with material 3 (index `n`): a ray walks
+    // through it with the medium stack, keyed by the lens's medium.
+    use crate::shading::MediumStack;
     let (r, d, n) = (2.0, 0.6, 1.5);
+    let ior = [1.0, n, n, n];
+    let Shape::Csg(two_materials) = lens(r, d) else {
+        unreachable!()
+    };
+    let mut children: Vec<CsgChild> = two_materials
+        .data
+        .leaves
+        .iter()
+        .map(|leaf| leaf_child(leaf))
+        .collect();
+    children[0].material = Some(1);
+    children[1].material = Some(2);
+    let lens = Csg::new(CsgOperation::Intersection, children)
+        .unwrap()
+        .filled_with(Some(3));
     let mut objects = Objects::default();
-    objects.add_primitive(lens(r, d), MaterialId(0), Transform::IDENTITY);
+    objects.add_primitive(Shape::Csg(lens), MaterialId(0), Transform::IDENTITY);
     let world = World::new(&objects);
     let f = 1.0 / ((n - 1.0) * (2.0 / r - (n - 1.0) * d / (n * r * r)));
     let bfd = f * (1.0 - (n - 1.0) * d / (n * r));
     for h in [0.005, 0.01, 0.02] {
         let mut ray = Ray::new(Vec3::new(h, 0.0, -5.0), Vec3::Z);
         let mut inside = false;
-        for _ in 0..2 {
+        let mut media = MediumStack::default();
+        for material in [1, 2] {
             let hit = world.intersect(&ray).expect("the lens is crossed twice");
             let s = world.surface(&ray, &hit);
+            assert_eq!(s.material, MaterialId(material));
+            assert_eq!(s.medium, MaterialId(3));
             let entering = ray.dir.dot(s.normal) < 0.0;
             assert_ne!(entering, inside);
+            let crossing = media.cross(s.medium, ior[s.medium.0 as usize], entering);
             let facing = if entering { s.normal } else { -s.normal };
-            let eta = if entering { 1.0 / n } else { n };
+            let eta = crossing.n_from / crossing.n_to;
             let dir = refract(ray.dir.normalize(), facing, eta).unwrap();
             let origin = offset_ray_origin(s.point, s.point_error, s.normal, dir);
             ray = Ray::new(origin, dir);
             inside = entering;
+            media = crossing.after;
         }
+        // Out in the air again, the stack empty.
+        assert_eq!(media.ior(), 1.0);
+        assert!(!media.contains(MaterialId(3)));
         assert!(world.intersect(&ray).is_none());
         let t = -ray.origin.x / ray.dir.x;
         let crossing = ray.at(t).z - d / 2.0;
@@ -536,4 +573,48 @@ fn every_structure_agrees_with_brute_force_on_csg_objects() {
         }
         assert!(csg_hits > 200, "{kind:?}: {csg_hits}");
     }
+}
+
+#[test]
+fn a_ray_through_children_of_different_materials_leaves_in_the_outside_medium() {
+    // Two overlapping spheres of glasses 1 and 2 (indices 1.5 and 1.7),
+    // their union filled with glass 1: in through sphere 1, out through
+    // sphere 2, the ray is back in the air (keyed by the surface's
+    // material, the stack would still hold glass 1).
+    use crate::shading::MediumStack;
+    let ior = [1.0, 1.5, 1.7];
+    let sphere = |x: f64, material| CsgChild {
+        material: Some(material),
+        ..child(
+            Shape::Sphere(Sphere::new(Vec3::new(x, 0.0, 0.0), 1.0).unwrap()),
+            None,
+        )
+    };
+    let union = Csg::new(CsgOperation::Union, vec![sphere(-0.5, 1), sphere(0.5, 2)]).unwrap();
+    let mut objects = Objects::default();
+    let glass = union.first_material();
+    objects.add_primitive(
+        Shape::Csg(union.filled_with(glass)),
+        MaterialId(0),
+        Transform::IDENTITY,
+    );
+    let world = World::new(&objects);
+    let mut ray = Ray::new(Vec3::new(-5.0, 0.01, 0.02), Vec3::X);
+    let mut media = MediumStack::default();
+    for (material, entering) in [(1, true), (2, false)] {
+        let hit = world.intersect(&ray).unwrap();
+        let s = world.surface(&ray, &hit);
+        assert_eq!(s.material, MaterialId(material));
+        assert_eq!(ray.dir.dot(s.normal) < 0.0, entering);
+        let crossing = media.cross(s.medium, ior[s.medium.0 as usize], entering);
+        assert_eq!(crossing.n_from, if entering { 1.0 } else { 1.5 });
+        assert_eq!(crossing.n_to, if entering { 1.5 } else { 1.0 });
+        media = crossing.after;
+        ray = Ray::new(
+            offset_ray_origin(s.point, s.point_error, s.normal, ray.dir),
+            ray.dir,
+        );
+    }
+    assert_eq!(media.ior(), 1.0);
+    assert!(world.intersect(&ray).is_none());
 }
