@@ -115,6 +115,14 @@ pub enum CsgError {
         /// Why it is open.
         why: &'static str,
     },
+    /// A mesh child with more triangles than a hit can name.
+    #[error("child {index} is a mesh of {count} triangles; a CSG child has at most {MAX_LEAVES}")]
+    TooManyTriangles {
+        /// Which child, from 0.
+        index: usize,
+        /// How many triangles it has.
+        count: usize,
+    },
     /// More leaves than [`MAX_LEAVES`].
     #[error("a CSG object holds at most {MAX_LEAVES} solids, this one has {count}")]
     TooManyLeaves {
@@ -188,6 +196,14 @@ impl Csg {
             });
         }
         for (index, child) in children.iter().enumerate() {
+            if let Shape::Mesh(mesh) = &child.shape
+                && mesh.len() > MAX_LEAVES
+            {
+                return Err(CsgError::TooManyTriangles {
+                    index,
+                    count: mesh.len(),
+                });
+            }
             if let Solidity::Open(why) = child.shape.solidity() {
                 return Err(CsgError::Open {
                     index,

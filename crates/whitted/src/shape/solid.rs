@@ -79,6 +79,11 @@ impl Shape {
                 Solidity::Open("a flat shape has no inside")
             }
             Shape::BezierPatch(_) => Solidity::Open("a patch is a surface with no inside"),
+            Shape::Mesh(m) if m.open_edge().is_none() => Solidity::Closed,
+            Shape::Mesh(_) => Solidity::Open(
+                "a mesh is closed only when every edge is shared by exactly two \
+                 triangles, consistently oriented",
+            ),
         }
     }
 
@@ -114,6 +119,7 @@ impl Shape {
                 p.cmpge(b.min).all() && p.cmple(b.max).all() && i.function().eval(p) <= 0.0
             }
             Shape::Csg(c) => c.contains(p),
+            Shape::Mesh(m) => m.open_edge().is_none() && m.contains(p),
             _ => false,
         }
     }
@@ -124,6 +130,7 @@ impl Shape {
     pub fn crossings(&self, ray: &Ray, out: &mut Vec<Crossing>) {
         let how = match self {
             Shape::Csg(c) => return c.crossings(ray, out),
+            Shape::Mesh(m) => return m.crossings(ray, out),
             Shape::Sphere(_) | Shape::AxisBox(_) | Shape::Cylinder(_) | Shape::Cone(_) => CONVEX,
             Shape::Quadric(_) => CONVEX,
             _ => BY_NORMAL,

@@ -130,6 +130,20 @@ fn read_child(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> Pa
             ),
         )
     })?;
+    if let Shape::Mesh(mesh) = &object.shape
+        && let Some(edge) = mesh.open_edge()
+    {
+        let at = value
+            .as_table()
+            .and_then(|t| t.iter().find(|(k, _)| k.name == "triangles"))
+            .and_then(|(_, list)| list.as_array())
+            .and_then(|list| list.get(edge.triangle))
+            .map_or(value.span, |triangle| triangle.span);
+        return Err(r.error(
+            at,
+            format!("a mesh cannot be a CSG child unless it is closed: {edge}"),
+        ));
+    }
     if let Solidity::Open(why) = object.shape.solidity() {
         let kind = object.shape.kind();
         return Err(r.error(
@@ -138,7 +152,7 @@ fn read_child(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> Pa
                 "a {kind} cannot be a CSG child, which must be a closed solid: {why}; \
                  closed solids are spheres, boxes, cylinders and cones with caps, tori, \
                  quadrics without bounds that are ellipsoids, superellipsoids, implicit \
-                 surfaces and CSG objects"
+                 surfaces, closed meshes and CSG objects"
             ),
         ));
     }
@@ -209,7 +223,7 @@ mod tests {
                 "a disk cannot be a CSG child, which must be a closed solid: a flat shape has \
                  no inside; closed solids are spheres, boxes, cylinders and cones with caps, \
                  tori, quadrics without bounds that are ellipsoids, superellipsoids, implicit \
-                 surfaces and CSG objects",
+                 surfaces, closed meshes and CSG objects",
                 "a CSG union needs at least two children, this one has 1; write the child as \
                  an object of its own",
                 "unknown CSG operation `merge`; expected one of: union, intersection, difference",

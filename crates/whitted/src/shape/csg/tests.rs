@@ -8,8 +8,9 @@ use super::*;
 use crate::accel::AccelKind;
 use crate::math::random::Rng;
 use crate::math::{Transform, offset_ray_origin};
+use crate::shape::small_mesh::tests::{cube_mesh, torus_mesh};
 use crate::shape::testing::{assert_crossings_alternate, assert_no_self_intersection};
-use crate::shape::{AxisBox, Cone, Cylinder, Plane, Sphere, Torus};
+use crate::shape::{AxisBox, Cone, Cylinder, Plane, SmallMesh, Sphere, Torus};
 use crate::world::{MaterialId, Objects, World};
 
 /// A CSG tree as written, for the reference: evaluated as given, not as
@@ -62,7 +63,8 @@ impl Spec {
 }
 
 fn random_leaf(rng: &mut Rng) -> Spec {
-    let shape = match rng.below(5) {
+    let shape = match rng.below(6) {
+        5 => Shape::Mesh(torus_mesh(rng.range(0.4, 0.8), rng.range(0.1, 0.35), 10, 6)),
         0 => Shape::Sphere(
             Sphere::new(
                 rng.point_in(Vec3::splat(-0.5), Vec3::splat(0.5)),
@@ -477,7 +479,7 @@ fn a_lens_of_two_spheres_focuses_where_the_thick_lens_equation_says() {
         .data
         .leaves
         .iter()
-        .map(|leaf| leaf_child(leaf))
+        .map(leaf_child)
         .collect();
     children[0].material = Some(1);
     children[1].material = Some(2);
@@ -571,7 +573,7 @@ fn every_structure_agrees_with_brute_force_on_csg_objects() {
                 csg_hits += usize::from(hit.primitive.0 % 2 == 0);
             }
         }
-        assert!(csg_hits > 200, "{kind:?}: {csg_hits}");
+        assert!(csg_hits > 120, "{kind:?}: {csg_hits}");
     }
 }
 
@@ -617,4 +619,73 @@ fn a_ray_through_children_of_different_materials_leaves_in_the_outside_medium() 
     }
     assert_eq!(media.ior(), 1.0);
     assert!(world.intersect(&ray).is_none());
+}
+
+#[test]
+fn a_closed_mesh_child_cuts_like_the_solid_it_meshes() {
+    // The cube [-1, 1]³ as a mesh of 12 triangles (given inside out, so
+    // turned round) and as a box, each minus a sphere on a corner and
+    // intersected with a torus: the same first hits and normals.
+    let sphere = || {
+        child(
+            Shape::Sphere(Sphere::new(Vec3::splat(1.0), 0.8).unwrap()),
+            None,
+        )
+    };
+    let torus = || {
+        let t = Transform::rotate(Vec3::X, 30.0).unwrap();
+        child(Shape::Torus(Torus::new(0.9, 0.5).unwrap()), Some(t))
+    };
+    let cube_box = Shape::AxisBox(AxisBox::new(Vec3::splat(-1.0), Vec3::ONE).unwrap());
+    let build = |cube: Shape| {
+        let cut = Csg::new(CsgOperation::Difference, vec![child(cube, None), sphere()]).unwrap();
+        let cut = child(Shape::Csg(cut), None);
+        Shape::Csg(Csg::new(CsgOperation::Union, vec![cut, torus()]).unwrap())
+    };
+    let (mesh, reference) = (build(Shape::Mesh(cube_mesh(true))), build(cube_box));
+    let mut rng = Rng::new(4);
+    let mut on_mesh = 0;
+    for _ in 0..2000 {
+        let origin = 4.0 * rng.unit_vector();
+        let ray = Ray::new(
+            origin,
+            rng.point_in(Vec3::splat(-1.2), Vec3::splat(1.2)) - origin,
+        );
+        let (a, b) = (mesh.intersect(&ray), reference.intersect(&ray));
+        assert_eq!(a.is_some(), b.is_some(), "{ray:?}");
+        let (Some(a), Some(b)) = (a, b) else { continue };
+        assert!((a.t - b.t).abs() < 1e-9, "{ray:?}: {} vs {}", a.t, b.t);
+        let (sa, sb) = (mesh.surface(&ray, &a), reference.surface(&ray, &b));
+        assert!((sa.normal - sb.normal).length() < 1e-9, "{ray:?}");
+        on_mesh += usize::from(a.part >> 16 == 0);
+    }
+    assert!(on_mesh > 300, "{on_mesh}");
+}
+
+#[test]
+fn an_open_mesh_child_is_refused() {
+    let cube = cube_mesh(false);
+    let mut triangles = cube.triangles().to_vec();
+    triangles.pop();
+    let open = SmallMesh::new(cube.positions().to_vec(), triangles).unwrap();
+    let error = Csg::new(
+        CsgOperation::Union,
+        vec![child(Shape::Mesh(open), None), unit_box_child()],
+    )
+    .unwrap_err();
+    assert!(
+        matches!(
+            error,
+            CsgError::Open {
+                index: 0,
+                kind: "mesh",
+                ..
+            }
+        ),
+        "{error}"
+    );
+}
+
+fn unit_box_child() -> CsgChild {
+    child(unit_box(), None)
 }
