@@ -55,7 +55,7 @@ pub use plane::Plane;
 pub use polygon::Polygon;
 pub use quadric::Quadric;
 pub use small_mesh::{OpenEdge, SmallMesh};
-pub use solid::{Crossing, Solidity};
+pub use solid::{Crossing, Crossings, Solidity};
 pub use sphere::Sphere;
 pub use superellipsoid::{MAX_EXPONENT, MIN_EXPONENT, Superellipsoid, exponent};
 pub use torus::Torus;

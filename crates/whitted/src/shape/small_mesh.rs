@@ -14,7 +14,7 @@
 
 use std::collections::HashMap;
 
-use super::solid::Crossing;
+use super::solid::{Crossing, Crossings};
 use super::triangle::{RayShear, watertight};
 use super::{LocalSurface, ShapeError, ShapeHit};
 use crate::math::{Aabb, DVec2, Ray, Vec3, gamma};
@@ -191,7 +191,7 @@ impl SmallMesh {
         }
         // Off every axis and diagonal, so that it seldom meets an edge.
         let line = Ray::new(p, Vec3::new(0.5773, 0.5851, 0.5697));
-        let mut crossings = Vec::new();
+        let mut crossings = Crossings::new();
         self.crossings(&line, &mut crossings);
         crossings
             .iter()
@@ -204,7 +204,7 @@ impl SmallMesh {
     /// line, in order: every triangle the line meets, going in where the
     /// triangle faces the line. Two crossings in the same direction in a
     /// row (the line through an edge meets both its triangles) are one.
-    pub fn crossings(&self, ray: &Ray, out: &mut Vec<Crossing>) {
+    pub fn crossings(&self, ray: &Ray, out: &mut Crossings) {
         let mut line = *ray;
         line.t_min = f64::NEG_INFINITY;
         line.t_max = f64::INFINITY;

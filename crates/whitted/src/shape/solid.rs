@@ -15,8 +15,14 @@
 //! that is never followed by a way out is dropped, so a graze never leaves
 //! the solid open to infinity.
 
+use smallvec::SmallVec;
+
 use super::{Shape, ShapeHit};
 use crate::math::{Ray, Vec3};
+
+/// A list of crossings, kept on the stack while short (no heap allocation
+/// per ray for the usual few).
+pub type Crossings = SmallVec<[Crossing; 8]>;
 
 /// One place a line crosses a solid's surface.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -127,7 +133,7 @@ impl Shape {
     /// Appends to `out` every crossing of the shape's surface along the
     /// ray's whole line (its interval is ignored), in order. For closed
     /// shapes only.
-    pub fn crossings(&self, ray: &Ray, out: &mut Vec<Crossing>) {
+    pub fn crossings(&self, ray: &Ray, out: &mut Crossings) {
         let how = match self {
             Shape::Csg(c) => return c.crossings(ray, out),
             Shape::Mesh(m) => return m.crossings(ray, out),
@@ -288,9 +294,9 @@ mod tests {
                 // The line's parameter is its own: start it anywhere.
                 let start = rng.range(-1.0, 1.0);
                 let ray = Ray::new(origin - start * dir, dir);
-                let mut crossings = Vec::new();
+                let mut crossings = Crossings::new();
                 shape.crossings(&ray, &mut crossings);
-                assert!(crossings.len() % 2 == 0, "{}: {crossings:?}", shape.kind());
+                assert!(crossings.len().is_multiple_of(2), "{}: {crossings:?}", shape.kind());
                 crossed += usize::from(!crossings.is_empty());
                 let step = 4.0 / 400.0;
                 let near = 1e-7 * size / dir.length();

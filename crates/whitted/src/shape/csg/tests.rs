@@ -222,7 +222,7 @@ fn crossings_of_a_csg_object_agree_with_its_inside_test() {
         for _ in 0..40 {
             let origin = bounds.centroid() + 2.0 * size * rng.unit_vector();
             let ray = Ray::new(origin, rng.point_in(bounds.min, bounds.max) - origin);
-            let mut crossings = Vec::new();
+            let mut crossings = Crossings::new();
             shape.crossings(&ray, &mut crossings);
             assert!(crossings.windows(2).all(|w| w[0].entering != w[1].entering));
             for c in &crossings {
@@ -317,7 +317,7 @@ fn coincident_faces_join_or_cancel_and_the_first_child_wins_ties() {
     for _ in 0..500 {
         let origin = Vec3::new(-1.0, rng.range(0.01, 0.99), rng.range(0.01, 0.99));
         let ray = Ray::new(origin, Vec3::new(1.0, rng.range(-1e-3, 1e-3), 0.0));
-        let mut crossings = Vec::new();
+        let mut crossings = Crossings::new();
         stacked.crossings(&ray, &mut crossings);
         assert_eq!(crossings.len(), 2, "{crossings:?}");
         assert!((ray.at(crossings[1].hit.t).x - 2.0).abs() < 1e-9);
@@ -475,12 +475,7 @@ fn a_lens_of_two_spheres_focuses_where_the_thick_lens_equation_says() {
     let Shape::Csg(two_materials) = lens(r, d) else {
         unreachable!()
     };
-    let mut children: Vec<CsgChild> = two_materials
-        .data
-        .leaves
-        .iter()
-        .map(leaf_child)
-        .collect();
+    let mut children: Vec<CsgChild> = two_materials.data.leaves.iter().map(leaf_child).collect();
     children[0].material = Some(1);
     children[1].material = Some(2);
     let lens = Csg::new(CsgOperation::Intersection, children)

@@ -140,9 +140,9 @@ fn crossings_and_inside_test_agree_with_the_winding_number_on_random_lines() {
             let dir = (target - origin) * rng.range(0.2, 3.0);
             let start = rng.range(-1.0, 1.0);
             let ray = Ray::new(origin - start * dir, dir);
-            let mut crossings = Vec::new();
+            let mut crossings = Crossings::new();
             mesh.crossings(&ray, &mut crossings);
-            assert!(crossings.len() % 2 == 0, "{crossings:?}");
+            assert!(crossings.len().is_multiple_of(2), "{crossings:?}");
             assert!(crossings.windows(2).all(|w| w[0].hit.t <= w[1].hit.t));
             crossed += usize::from(!crossings.is_empty());
             for k in 0..200 {
@@ -172,7 +172,7 @@ fn the_closest_hit_is_the_first_crossing_in_the_interval() {
     for _ in 0..300 {
         let origin = rng.point_in(Vec3::splat(-2.0), Vec3::splat(2.0));
         let ray = Ray::new(origin, rng.unit_vector());
-        let mut crossings = Vec::new();
+        let mut crossings = Crossings::new();
         mesh.crossings(&ray, &mut crossings);
         let first = crossings.iter().find(|c| c.hit.t > 1e-9).map(|c| c.hit.t);
         let hit = mesh.intersect(&ray).map(|h| h.t);
