@@ -296,7 +296,11 @@ mod tests {
                 let ray = Ray::new(origin - start * dir, dir);
                 let mut crossings = Crossings::new();
                 shape.crossings(&ray, &mut crossings);
-                assert!(crossings.len().is_multiple_of(2), "{}: {crossings:?}", shape.kind());
+                assert!(
+                    crossings.len().is_multiple_of(2),
+                    "{}: {crossings:?}",
+                    shape.kind()
+                );
                 crossed += usize::from(!crossings.is_empty());
                 let step = 4.0 / 400.0;
                 let near = 1e-7 * size / dir.length();
