@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Renders the pictures of docs/shapes.md into docs/images/: each new shape's
-# example scene and the mixed scene classic-shapes.toml (and the caustic of
-# docs/scene-format.md, scenes/caustics.toml), at the scene's own
-# aspect ratio, 480 pixels wide, 4 samples per pixel.
+# example scene, the CSG scene csg.toml and the mixed scene
+# classic-shapes.toml (and the caustic of docs/scene-format.md,
+# scenes/caustics.toml), at the scene's own aspect ratio, 480 pixels wide,
+# 4 samples per pixel.
 #
 #   scripts/render-gallery.sh [WHITTED]
 #
@@ -24,4 +25,5 @@ render tori 360
 render superellipsoids 300
 render implicit 360
 render patches 360
+render csg 360
 render caustics 300

@@ -239,7 +239,11 @@ impl<'a> Whitted<'a> {
             n_from,
             n_to,
             after: inside_after,
-        } = media.cross(s.material, m.ior, entering);
+        } = media.cross(
+            s.medium,
+            self.shading.materials[s.medium.0 as usize].ior,
+            entering,
+        );
         let lobes = Lobes::new(
             Weights {
                 opacity: alpha,

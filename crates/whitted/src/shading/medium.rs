@@ -7,9 +7,10 @@
 use crate::world::MaterialId;
 
 /// The media a ray is inside, innermost last: the materials of the objects
-/// it has entered, with their indices of refraction. Keyed by material, so a
-/// closed mesh of many triangles is one medium, and two overlapping objects
-/// of the same material are one medium too. The innermost entry is the
+/// it has entered, with their indices of refraction. Keyed by the material
+/// filling the solid (`Surface::medium`: a CSG object's is one for all its
+/// children), so a closed mesh of many triangles is one medium, and two
+/// overlapping objects of the same material are one medium too. The innermost entry is the
 /// medium the ray travels in. Fixed capacity (eight nested media; deeper
 /// nesting is not recorded): no allocation per ray.
 #[derive(Clone, Copy, Debug, Default)]

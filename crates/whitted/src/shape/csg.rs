@@ -29,8 +29,19 @@
 //! medium stack see a CSG object as any other closed solid. A leaf's
 //! material is its own, else that of the nearest CSG child above it that
 //! has one, else the CSG object's ([`Csg::material`] answers `None`).
+//!
+//! **One medium.** The medium stack of refraction is keyed by the solid's
+//! medium, not by the material of the surface crossed, so a ray entering
+//! through one child's surface and leaving through another's (of another
+//! material) leaves the solid. The medium is the CSG object's own
+//! material; the scene reader fills an object that has none with its
+//! first solid's ([`Csg::filled_with`]). The children's materials give
+//! their surfaces' colour, mirror and transparency; their indices of
+//! refraction are not used.
 
-use super::solid::{Crossing, Solidity};
+use smallvec::SmallVec;
+
+use super::solid::{Crossing, Crossings, Solidity};
 use super::{LocalSurface, Shape, ShapeHit};
 use crate::math::{Aabb, Ray, Transform, Vec3};
 
@@ -106,6 +117,14 @@ pub enum CsgError {
         /// Why it is open.
         why: &'static str,
     },
+    /// A mesh child with more triangles than a hit can name.
+    #[error("child {index} is a mesh of {count} triangles; a CSG child has at most {MAX_LEAVES}")]
+    TooManyTriangles {
+        /// Which child, from 0.
+        index: usize,
+        /// How many triangles it has.
+        count: usize,
+    },
     /// More leaves than [`MAX_LEAVES`].
     #[error("a CSG object holds at most {MAX_LEAVES} solids, this one has {count}")]
     TooManyLeaves {
@@ -124,6 +143,9 @@ struct Leaf {
     /// True when the leaf is subtracted an odd number of times: its
     /// normals are turned round.
     complemented: bool,
+    /// Its bounds in the CSG's space, a little widened: a line that
+    /// misses them does not cross the leaf.
+    bounds: Aabb,
 }
 
 /// A node's child: a leaf or another node, by index.
@@ -148,6 +170,8 @@ struct Data {
     bounds: Aabb,
     /// The diagonal of `bounds`.
     size: f64,
+    /// The material filling the solid, when not the object's own.
+    medium: Option<u32>,
 }
 
 /// A CSG object.
@@ -177,6 +201,14 @@ impl Csg {
             });
         }
         for (index, child) in children.iter().enumerate() {
+            if let Shape::Mesh(mesh) = &child.shape
+                && mesh.len() > MAX_LEAVES
+            {
+                return Err(CsgError::TooManyTriangles {
+                    index,
+                    count: mesh.len(),
+                });
+            }
             if let Solidity::Open(why) = child.shape.solidity() {
                 return Err(CsgError::Open {
                     index,
@@ -193,6 +225,7 @@ impl Csg {
             }],
             bounds: Aabb::EMPTY,
             size: 0.0,
+            medium: None,
         };
         let mut parts = Vec::with_capacity(children.len());
         let mut child_bounds = Vec::with_capacity(children.len());
@@ -203,6 +236,11 @@ impl Csg {
             parts.push(data.adopt(child, subtracted));
         }
         data.nodes[0].children = parts;
+        for leaf in &mut data.leaves {
+            let local = leaf.shape.bounds();
+            let b = leaf.transform.map_or(local, |t| t.bounds_to_world(&local));
+            leaf.bounds = b.expanded(1e-9 * b.extent().length());
+        }
         if data.leaves.len() > MAX_LEAVES {
             return Err(CsgError::TooManyLeaves {
                 count: data.leaves.len(),
@@ -247,6 +285,27 @@ impl Csg {
         self.data.leaves[(hit.part >> 16) as usize].material
     }
 
+    /// The material whose index of refraction fills the solid, when it is
+    /// not the object's own (set by [`Csg::filled_with`]). A CSG object is
+    /// one medium: a ray that enters through one child's surface and
+    /// leaves through another's is inside the same medium between them.
+    pub fn medium(&self) -> Option<u32> {
+        self.data.medium
+    }
+
+    /// The object filled with `material` (`None`: with the object's own).
+    #[must_use]
+    pub fn filled_with(mut self, material: Option<u32>) -> Self {
+        self.data.medium = material;
+        self
+    }
+
+    /// The first solid's own material (depth-first, inherited from a CSG
+    /// child above it), if it has one.
+    pub fn first_material(&self) -> Option<u32> {
+        self.data.leaves[0].material
+    }
+
     /// True when `p` lies inside the solid.
     pub fn contains(&self, p: Vec3) -> bool {
         self.data.contains(Part::Node(0), p)
@@ -255,14 +314,15 @@ impl Csg {
     /// The closest place in the ray's interval where it enters or leaves
     /// the solid.
     pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        let boundaries = self.data.classify(ray);
-        boundaries
-            .iter()
-            .find(|b| ray.contains(b.hit.t))
-            .map(|b| ShapeHit {
-                part: b.leaf << 16 | b.hit.part,
-                ..b.hit
-            })
+        self.data.classify(ray, |boundaries| {
+            boundaries
+                .iter()
+                .find(|b| ray.contains(b.hit.t))
+                .map(|b| ShapeHit {
+                    part: b.leaf << 16 | b.hit.part,
+                    ..b.hit
+                })
+        })
     }
 
     /// True when the ray enters or leaves the solid in its interval.
@@ -271,14 +331,16 @@ impl Csg {
     }
 
     /// Every crossing of the solid's surface along the ray's whole line.
-    pub fn crossings(&self, ray: &Ray, out: &mut Vec<Crossing>) {
-        out.extend(self.data.classify(ray).into_iter().map(|b| Crossing {
-            hit: ShapeHit {
-                part: b.leaf << 16 | b.hit.part,
-                ..b.hit
-            },
-            entering: b.entering,
-        }));
+    pub fn crossings(&self, ray: &Ray, out: &mut Crossings) {
+        self.data.classify(ray, |boundaries| {
+            out.extend(boundaries.iter().map(|b| Crossing {
+                hit: ShapeHit {
+                    part: b.leaf << 16 | b.hit.part,
+                    ..b.hit
+                },
+                entering: b.entering,
+            }));
+        });
     }
 
     /// The surface at a hit: the leaf's, in the CSG's space, its normal
@@ -321,6 +383,7 @@ impl Data {
                 transform: child.transform,
                 material: child.material,
                 complemented: subtracted,
+                bounds: Aabb::EMPTY,
             });
             return Part::Leaf(self.leaves.len() as u32 - 1);
         };
@@ -367,93 +430,136 @@ impl Data {
         }
     }
 
-    /// Where the whole tree's answer changes along the ray's line, in
-    /// order, alternately in and out.
-    fn classify(&self, ray: &Ray) -> Vec<Boundary> {
+    /// Calls `f` with where the whole tree's answer changes along the
+    /// ray's line, in order, alternately in and out. The lists are built
+    /// in a buffer of the thread's, reused from ray to ray.
+    fn classify<R>(&self, ray: &Ray, f: impl FnOnce(&[Boundary]) -> R) -> R {
         let speed = ray.dir.length();
         let tolerance = if speed > 0.0 {
             COINCIDENT * self.size / speed
         } else {
             0.0
         };
-        self.boundaries(Part::Node(0), ray, tolerance)
+        let mut line = *ray;
+        line.t_min = f64::NEG_INFINITY;
+        line.t_max = f64::INFINITY;
+        let run = |arena: &mut Vec<Boundary>| {
+            arena.clear();
+            let start = self.boundaries(Part::Node(0), &line, tolerance, arena);
+            f(&arena[start..])
+        };
+        ARENA.with(|arena| match arena.try_borrow_mut() {
+            Ok(mut arena) => run(&mut arena),
+            // Only if `f` classified again: a buffer of its own.
+            Err(_) => run(&mut Vec::new()),
+        })
     }
 
-    fn boundaries(&self, part: Part, ray: &Ray, tolerance: f64) -> Vec<Boundary> {
+    /// Appends the boundaries of `part` along `line` (the ray with an
+    /// unbounded interval) to `arena` and returns where they start.
+    fn boundaries(
+        &self,
+        part: Part,
+        line: &Ray,
+        tolerance: f64,
+        arena: &mut Vec<Boundary>,
+    ) -> usize {
+        let start = arena.len();
         let node = match part {
-            Part::Leaf(i) => return self.leaf_boundaries(i, ray),
+            Part::Leaf(i) => {
+                self.leaf_boundaries(i, line, arena);
+                return start;
+            }
             Part::Node(i) => &self.nodes[i as usize],
         };
-        let mut lists = Vec::with_capacity(node.children.len());
+        let mut lists: SmallVec<[(usize, usize); 8]> = SmallVec::new();
         for (k, &child) in node.children.iter().enumerate() {
-            let list = self.boundaries(child, ray, tolerance);
+            let first = self.boundaries(child, line, tolerance, arena);
             let needed = match node.operation {
                 CsgOperation::Union => false,
                 CsgOperation::Intersection => true,
                 CsgOperation::Difference => k == 0,
             };
-            if needed && list.is_empty() {
-                return Vec::new();
+            if needed && first == arena.len() {
+                arena.truncate(start);
+                return start;
             }
-            lists.push(list);
+            lists.push((first, arena.len()));
         }
-        if node.operation == CsgOperation::Union
-            && lists.iter().filter(|l| !l.is_empty()).count() < 2
-        {
-            return lists
-                .into_iter()
-                .find(|l| !l.is_empty())
-                .unwrap_or_default();
+        let mut crossed = lists.iter().filter(|(a, b)| a < b);
+        let (one, two) = (crossed.next().copied(), crossed.next());
+        if node.operation == CsgOperation::Union && two.is_none() {
+            let (a, b) = one.unwrap_or((start, start));
+            arena.copy_within(a..b, start);
+            arena.truncate(start + b - a);
+            return start;
         }
-        tidy(sweep(node.operation, &lists, tolerance), tolerance)
+        let out = arena.len();
+        sweep(node.operation, arena, &lists, tolerance);
+        let end = out + tidy(&mut arena[out..], tolerance);
+        arena.copy_within(out..end, start);
+        arena.truncate(start + end - out);
+        start
     }
 
-    fn leaf_boundaries(&self, i: u32, ray: &Ray) -> Vec<Boundary> {
+    /// Appends the crossings of leaf `i` along `line` to `arena`.
+    fn leaf_boundaries(&self, i: u32, line: &Ray, arena: &mut Vec<Boundary>) {
         let leaf = &self.leaves[i as usize];
-        let mut crossings = Vec::new();
-        match &leaf.transform {
-            None => leaf.shape.crossings(ray, &mut crossings),
-            Some(t) => leaf.shape.crossings(&t.ray_to_object(ray), &mut crossings),
+        if leaf.bounds.intersect_ray(line).is_none() {
+            return;
         }
-        crossings
-            .into_iter()
-            .map(|c| Boundary {
-                leaf: i,
-                hit: c.hit,
-                entering: c.entering,
-            })
-            .collect()
+        let mut crossings = Crossings::new();
+        match &leaf.transform {
+            None => leaf.shape.crossings(line, &mut crossings),
+            Some(t) => leaf.shape.crossings(&t.ray_to_object(line), &mut crossings),
+        }
+        arena.extend(crossings.into_iter().map(|c| Boundary {
+            leaf: i,
+            hit: c.hit,
+            entering: c.entering,
+        }));
     }
 }
 
-/// Where `operation`'s answer over the children's boundary `lists`
-/// changes. The lists are walked together in order of `t`; crossings of
-/// different children closer than `tolerance` to the first of them are
-/// taken at once, as one place, and where the answer changes there the
-/// earliest child whose crossing goes the same way gives the surface.
-fn sweep(operation: CsgOperation, lists: &[Vec<Boundary>], tolerance: f64) -> Vec<Boundary> {
-    let mut next = vec![0usize; lists.len()];
-    let mut inside = vec![false; lists.len()];
+thread_local! {
+    /// The boundary lists of the ray being classified on this thread.
+    static ARENA: std::cell::RefCell<Vec<Boundary>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Appends to `arena` where `operation`'s answer over the children's
+/// boundary lists (`arena[a..b]` for each `(a, b)` of `lists`) changes.
+/// The lists are walked together in order of `t`; crossings of different
+/// children closer than `tolerance` to the first of them are taken at
+/// once, as one place, and where the answer changes there the earliest
+/// child whose crossing goes the same way gives the surface.
+fn sweep(
+    operation: CsgOperation,
+    arena: &mut Vec<Boundary>,
+    lists: &[(usize, usize)],
+    tolerance: f64,
+) {
+    let mut next: SmallVec<[usize; 8]> = lists.iter().map(|&(a, _)| a).collect();
+    let mut inside: SmallVec<[bool; 8]> = SmallVec::from_elem(false, lists.len());
     let mut answer = false;
-    let mut out = Vec::new();
     // The crossings taken at one place: (child, boundary).
-    let mut group: Vec<(usize, Boundary)> = Vec::new();
+    let mut group: SmallVec<[(usize, Boundary); 4]> = SmallVec::new();
     loop {
         let earliest = lists
             .iter()
             .enumerate()
-            .filter_map(|(k, list)| list.get(next[k]))
-            .map(|b| b.hit.t)
+            .filter(|&(k, &(_, end))| next[k] < end)
+            .map(|(k, _)| arena[next[k]].hit.t)
             .fold(f64::INFINITY, f64::min);
         if earliest == f64::INFINITY {
-            return out;
+            return;
         }
         group.clear();
-        for (k, list) in lists.iter().enumerate() {
-            while let Some(b) = list.get(next[k])
-                && b.hit.t - earliest < tolerance.max(0.0) + f64::MIN_POSITIVE
+        for (k, &(_, end)) in lists.iter().enumerate() {
+            while next[k] < end
+                && arena[next[k]].hit.t - earliest < tolerance.max(0.0) + f64::MIN_POSITIVE
             {
-                group.push((k, *b));
+                let b = arena[next[k]];
+                group.push((k, b));
                 inside[k] = b.entering;
                 next[k] += 1;
             }
@@ -468,28 +574,32 @@ fn sweep(operation: CsgOperation, lists: &[Vec<Boundary>], tolerance: f64) -> Ve
             .iter()
             .find(|&&(k, b)| (b.entering != subtracted(k)) == now)
             .unwrap_or(&group[0]);
-        out.push(Boundary {
+        arena.push(Boundary {
             entering: now,
             ..*b
         });
     }
 }
 
-/// `boundaries` (alternately in and out, starting in) without the
-/// stretches of solid or of space shorter than `tolerance`.
-fn tidy(boundaries: Vec<Boundary>, tolerance: f64) -> Vec<Boundary> {
-    let mut out: Vec<Boundary> = Vec::with_capacity(boundaries.len());
-    for pair in boundaries.chunks_exact(2) {
-        let (enter, leave) = (pair[0], pair[1]);
+/// Drops from `boundaries` (alternately in and out, starting in) the
+/// stretches of solid or of space shorter than `tolerance`, in place;
+/// returns how many are left.
+fn tidy(boundaries: &mut [Boundary], tolerance: f64) -> usize {
+    let mut kept = 0;
+    for k in (0..boundaries.len() / 2).map(|k| 2 * k) {
+        let (enter, leave) = (boundaries[k], boundaries[k + 1]);
         if leave.hit.t - enter.hit.t < tolerance {
             continue;
         }
-        match out.last_mut() {
-            Some(last) if enter.hit.t - last.hit.t < tolerance => *last = leave,
-            _ => out.extend([enter, leave]),
+        if kept > 0 && enter.hit.t - boundaries[kept - 1].hit.t < tolerance {
+            boundaries[kept - 1] = leave;
+        } else {
+            boundaries[kept] = enter;
+            boundaries[kept + 1] = leave;
+            kept += 2;
         }
     }
-    out
+    kept
 }
 
 #[cfg(test)]

@@ -33,6 +33,7 @@ mod plane;
 mod polygon;
 mod quadratic;
 mod quadric;
+mod small_mesh;
 mod solid;
 mod sphere;
 mod superellipsoid;
@@ -53,7 +54,8 @@ pub use parallelogram::Parallelogram;
 pub use plane::Plane;
 pub use polygon::Polygon;
 pub use quadric::Quadric;
-pub use solid::{Crossing, Solidity};
+pub use small_mesh::{OpenEdge, SmallMesh};
+pub use solid::{Crossing, Crossings, Solidity};
 pub use sphere::Sphere;
 pub use superellipsoid::{MAX_EXPONENT, MIN_EXPONENT, Superellipsoid, exponent};
 pub use torus::Torus;
@@ -256,6 +258,9 @@ pub enum Shape {
     Superellipsoid(Superellipsoid),
     /// A union, intersection or difference of closed solids.
     Csg(Csg),
+    /// A small triangle mesh written out in the scene, tested by brute
+    /// force.
+    Mesh(SmallMesh),
 }
 
 const _: () = assert!(std::mem::size_of::<Shape>() <= 80);
@@ -278,6 +283,7 @@ macro_rules! dispatch {
             Shape::BezierPatch($s) => $body,
             Shape::Superellipsoid($s) => $body,
             Shape::Csg($s) => $body,
+            Shape::Mesh($s) => $body,
         }
     };
 }
@@ -323,6 +329,7 @@ impl Shape {
             Shape::BezierPatch(_) => "bezier_patch",
             Shape::Superellipsoid(_) => "superellipsoid",
             Shape::Csg(_) => "csg",
+            Shape::Mesh(_) => "mesh",
         }
     }
 
@@ -331,6 +338,15 @@ impl Shape {
     pub fn material(&self, hit: &ShapeHit) -> Option<u32> {
         match self {
             Shape::Csg(c) => c.material(hit),
+            _ => None,
+        }
+    }
+
+    /// The material that fills the solid, where it is not the shape's
+    /// material (a CSG object's, [`Csg::medium`]).
+    pub fn medium(&self) -> Option<u32> {
+        match self {
+            Shape::Csg(c) => c.medium(),
             _ => None,
         }
     }

@@ -15,8 +15,14 @@
 //! that is never followed by a way out is dropped, so a graze never leaves
 //! the solid open to infinity.
 
+use smallvec::SmallVec;
+
 use super::{Shape, ShapeHit};
 use crate::math::{Ray, Vec3};
+
+/// A list of crossings, kept on the stack while short (no heap allocation
+/// per ray for the usual few).
+pub type Crossings = SmallVec<[Crossing; 8]>;
 
 /// One place a line crosses a solid's surface.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -79,6 +85,11 @@ impl Shape {
                 Solidity::Open("a flat shape has no inside")
             }
             Shape::BezierPatch(_) => Solidity::Open("a patch is a surface with no inside"),
+            Shape::Mesh(m) if m.open_edge().is_none() => Solidity::Closed,
+            Shape::Mesh(_) => Solidity::Open(
+                "a mesh is closed only when every edge is shared by exactly two \
+                 triangles, consistently oriented",
+            ),
         }
     }
 
@@ -114,6 +125,7 @@ impl Shape {
                 p.cmpge(b.min).all() && p.cmple(b.max).all() && i.function().eval(p) <= 0.0
             }
             Shape::Csg(c) => c.contains(p),
+            Shape::Mesh(m) => m.open_edge().is_none() && m.contains(p),
             _ => false,
         }
     }
@@ -121,9 +133,10 @@ impl Shape {
     /// Appends to `out` every crossing of the shape's surface along the
     /// ray's whole line (its interval is ignored), in order. For closed
     /// shapes only.
-    pub fn crossings(&self, ray: &Ray, out: &mut Vec<Crossing>) {
+    pub fn crossings(&self, ray: &Ray, out: &mut Crossings) {
         let how = match self {
             Shape::Csg(c) => return c.crossings(ray, out),
+            Shape::Mesh(m) => return m.crossings(ray, out),
             Shape::Sphere(_) | Shape::AxisBox(_) | Shape::Cylinder(_) | Shape::Cone(_) => CONVEX,
             Shape::Quadric(_) => CONVEX,
             _ => BY_NORMAL,
@@ -281,9 +294,13 @@ mod tests {
                 // The line's parameter is its own: start it anywhere.
                 let start = rng.range(-1.0, 1.0);
                 let ray = Ray::new(origin - start * dir, dir);
-                let mut crossings = Vec::new();
+                let mut crossings = Crossings::new();
                 shape.crossings(&ray, &mut crossings);
-                assert!(crossings.len() % 2 == 0, "{}: {crossings:?}", shape.kind());
+                assert!(
+                    crossings.len().is_multiple_of(2),
+                    "{}: {crossings:?}",
+                    shape.kind()
+                );
                 crossed += usize::from(!crossings.is_empty());
                 let step = 4.0 / 400.0;
                 let near = 1e-7 * size / dir.length();

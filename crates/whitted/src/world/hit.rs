@@ -42,10 +42,20 @@ pub struct Surface {
     pub dpdv: Vec3,
     /// The surface's material.
     pub material: MaterialId,
+    /// The material whose index of refraction fills the solid behind the
+    /// surface, the key of the medium stack: the surface's own material,
+    /// except on a CSG object, which is one medium whatever its children's
+    /// materials ([`crate::shape::Csg::medium`]).
+    pub medium: MaterialId,
 }
 
 impl Surface {
-    pub(crate) fn from_local(s: LocalSurface, shading_normal: Vec3, material: MaterialId) -> Self {
+    pub(crate) fn from_local(
+        s: LocalSurface,
+        shading_normal: Vec3,
+        material: MaterialId,
+        medium: MaterialId,
+    ) -> Self {
         Self {
             point: s.point,
             point_error: s.point_error,
@@ -55,12 +65,13 @@ impl Surface {
             dpdu: s.dpdu,
             dpdv: s.dpdv,
             material,
+            medium,
         }
     }
 
     /// The surface seen from the space `t` carries this one's into: the
     /// point with its error bound, the normals (renormalised) and the
-    /// tangents carried by `t`; uv and material unchanged.
+    /// tangents carried by `t`; uv, material and medium unchanged.
     pub(crate) fn to_outer(self, t: &Transform) -> Self {
         let (point, point_error) = t.point_with_error_to_world(self.point, self.point_error);
         Self {
@@ -72,6 +83,7 @@ impl Surface {
             dpdu: t.vector_to_world(self.dpdu),
             dpdv: t.vector_to_world(self.dpdv),
             material: self.material,
+            medium: self.medium,
         }
     }
 }

@@ -723,14 +723,15 @@ impl<'a> World<'a> {
         shape_hit: &ShapeHit,
         material: Option<MaterialId>,
     ) -> Surface {
-        let (local, shading_normal, own, transform) = match self.primitive_ref(number) {
+        let (local, shading_normal, own, own_medium, transform) = match self.primitive_ref(number) {
             PrimitiveRef::Shape(i) => {
                 let p = &self.objects.primitives[i as usize];
                 let transform = self.transform(p.transform);
                 let object_ray = transform.map_or(*ray, |t| t.ray_to_object(ray));
                 let s = p.shape.surface(&object_ray, shape_hit);
                 let material = p.shape.material(shape_hit).map_or(p.material, MaterialId);
-                (s, s.normal, material, transform)
+                let medium = p.shape.medium().map_or(p.material, MaterialId);
+                (s, s.normal, material, medium, transform)
             }
             PrimitiveRef::Triangle { instance, triangle } => {
                 let m = &self.objects.mesh_instances[instance as usize];
@@ -738,7 +739,7 @@ impl<'a> World<'a> {
                 let object_ray = transform.map_or(*ray, |t| t.ray_to_object(ray));
                 let mesh = &self.objects.meshes[m.mesh.0 as usize];
                 let s = mesh.surface(triangle, &object_ray, shape_hit);
-                (s.local, s.shading_normal, m.material, transform)
+                (s.local, s.shading_normal, m.material, m.material, transform)
             }
             PrimitiveRef::Placed {
                 instance,
@@ -752,7 +753,12 @@ impl<'a> World<'a> {
                 return self.transform(i.transform).map_or(s, |t| s.to_outer(t));
             }
         };
-        let s = Surface::from_local(local, shading_normal, material.unwrap_or(own));
+        let s = Surface::from_local(
+            local,
+            shading_normal,
+            material.unwrap_or(own),
+            material.unwrap_or(own_medium),
+        );
         transform.map_or(s, |t| s.to_outer(t))
     }
 }

@@ -141,7 +141,11 @@ fn follow(
         let entering = incident.dot(s.normal) < 0.0;
         let facing = if entering { s.normal } else { -s.normal };
         let n = shading_normal(m.bump.as_ref(), &s, facing, -incident);
-        let crossing = media.cross(s.material, m.ior, entering);
+        let crossing = media.cross(
+            s.medium,
+            shading.materials[s.medium.0 as usize].ior,
+            entering,
+        );
         let lobes = m.lobes(s.uv, incident, n, crossing.n_from, crossing.n_to);
         if specular && lobes.diffuse != Color::ZERO {
             out.push(Photon::new(s.point, incident, power));

@@ -92,7 +92,14 @@ pub(super) fn read(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) 
         };
         r.error(children_span, message)
     })?;
-    let shape = Shape::Csg(shape);
+    // A CSG object is one medium: its own material's, else its first
+    // solid's.
+    let medium = if material.is_none() {
+        shape.first_material()
+    } else {
+        None
+    };
+    let shape = Shape::Csg(shape.filled_with(medium));
     let world = transform.bounds_to_world(&shape.bounds());
     if world.is_finite() {
         let reach = world.min.abs().max(world.max.abs()).max_element();
@@ -135,6 +142,20 @@ fn read_child(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> Pa
             ),
         )
     })?;
+    if let Shape::Mesh(mesh) = &object.shape
+        && let Some(edge) = mesh.open_edge()
+    {
+        let at = value
+            .as_table()
+            .and_then(|t| t.iter().find(|(k, _)| k.name == "triangles"))
+            .and_then(|(_, list)| list.as_array())
+            .and_then(|list| list.get(edge.triangle))
+            .map_or(value.span, |triangle| triangle.span);
+        return Err(r.error(
+            at,
+            format!("a mesh cannot be a CSG child unless it is closed: {edge}"),
+        ));
+    }
     if let Solidity::Open(why) = object.shape.solidity() {
         let kind = object.shape.kind();
         return Err(r.error(
@@ -143,7 +164,7 @@ fn read_child(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> Pa
                 "a {kind} cannot be a CSG child, which must be a closed solid: {why}; \
                  closed solids are spheres, boxes, cylinders and cones with caps, tori, \
                  quadrics without bounds that are ellipsoids, superellipsoids, implicit \
-                 surfaces and CSG objects"
+                 surfaces, closed meshes and CSG objects"
             ),
         ));
     }
@@ -191,6 +212,8 @@ mod tests {
         assert!((surface.point.y - 1.5).abs() < 1e-12, "{}", surface.point);
         assert!(surface.normal.y > 0.99);
         assert_eq!(surface.material, MaterialId(1));
+        // One medium, the CSG object's material, whatever the child's.
+        assert_eq!(surface.medium, MaterialId(0));
         let hit = world.intersect(&down(0.9)).unwrap();
         assert!((hit.t() - 3.0).abs() < 1e-12);
         assert_eq!(world.surface(&down(0.9), &hit).material, MaterialId(0));
@@ -212,7 +235,7 @@ mod tests {
                 "a disk cannot be a CSG child, which must be a closed solid: a flat shape has \
                  no inside; closed solids are spheres, boxes, cylinders and cones with caps, \
                  tori, quadrics without bounds that are ellipsoids, superellipsoids, implicit \
-                 surfaces and CSG objects",
+                 surfaces, closed meshes and CSG objects",
                 "a CSG union needs at least two children, this one has 1; write the child as \
                  an object of its own",
                 "unknown CSG operation `merge`; expected one of: union, intersection, difference",

@@ -334,7 +334,7 @@ mod tests {
                                  vertices, origin, edge_u, edge_v, inner_radius, base, top, \
                                  caps, base_radius, top_radius, min, max, major, minor, \
                                  a, b, c, d, e, f, g, h, i, j, bounds, function, max_gradient, \
-                                 points, n, file";
+                                 points, n, triangles, file";
         assert_eq!(
             errors(&format!(
                 "{CAMERA}[materials.glass]\n\

@@ -17,6 +17,7 @@
 //! shape = "implicit"       # function, bounds = [[..], [..]], max_gradient
 //! shape = "bezier_patch"   # points = 4 rows of 4 [x, y, z], row i along u
 //! shape = "superellipsoid" # e, n, center = [0, 0, 0], radius = 1
+//! shape = "mesh"           # vertices, triangles = [[0, 1, 2], ...] (from 0)
 //! ```
 //!
 //! Disks, cylinders and cones are built in canonical position (standing on
@@ -40,11 +41,12 @@ mod implicit;
 use toml_span::Span;
 use toml_span::value::Value;
 
-use super::reader::{Fields, Parsed, Reader, Reported, both, list};
+use super::reader::{Fields, Parsed, Reader, Reported, all, both, list};
 use crate::math::{Aabb, Transform, Vec3, magnitude};
 use crate::shape::{
     AxisBox, BezierPatch, Cone, Cylinder, Disk, Parallelogram, Plane, Polygon, Quadric, Shape,
-    ShapeError, Sphere, Superellipsoid, Torus, Triangle, exponent, non_negative, positive,
+    ShapeError, SmallMesh, Sphere, Superellipsoid, Torus, Triangle, exponent, non_negative,
+    positive,
 };
 
 /// A shape in its object space and where that space sits before the
@@ -148,6 +150,11 @@ pub(super) const SHAPE_KINDS: &[ShapeKind] = &[
         name: "superellipsoid",
         keys: &["e", "n", "center", "radius"],
         build: superellipsoid,
+    },
+    ShapeKind {
+        name: "mesh",
+        keys: &["vertices", "triangles"],
+        build: mesh,
     },
 ];
 
@@ -255,6 +262,56 @@ fn polygon(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Placed> {
         refused(r, f, at, e)
     })?;
     Ok(Placed::in_place(Shape::Polygon(polygon)))
+}
+
+/// The most triangles a `mesh` object has: it is tested by brute force.
+const MAX_MESH_TRIANGLES: u32 = 65_536;
+
+fn mesh(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Placed> {
+    let vertices = r.require(f, "vertices", Reader::points);
+    let count = vertices.as_ref().map_or(u32::MAX, |v| v.len() as u32);
+    let triangles = r.require(f, "triangles", |r, value, key| {
+        let items = r.array(value, key, "a list of triangles [[i, j, k], ...]")?;
+        if items.len() > MAX_MESH_TRIANGLES as usize {
+            return Err(r.error(
+                value.span,
+                format!(
+                    "a mesh object has at most {MAX_MESH_TRIANGLES} triangles, this one has {} \
+                     (put big meshes in an OBJ file)",
+                    items.len()
+                ),
+            ));
+        }
+        all(items.iter().map(|item| {
+            let corners = r.array(item, key, "a triangle [i, j, k] of vertex numbers")?;
+            if corners.len() != 3 {
+                return Err(r.error(
+                    item.span,
+                    format!("expected 3 vertex numbers, found {}", corners.len()),
+                ));
+            }
+            let last = count.saturating_sub(1);
+            let message = |r: &mut Reader<'_>, v: &Value<'_>| {
+                let n = v.as_integer().unwrap_or(-1);
+                r.error(
+                    v.span,
+                    format!("no vertex {n}: vertices are numbered from 0 to {last}"),
+                )
+            };
+            let mut t = [0; 3];
+            for (slot, v) in t.iter_mut().zip(corners) {
+                match v.as_integer() {
+                    Some(n) if (0..i64::from(count)).contains(&n) => *slot = n as u32,
+                    Some(_) => return Err(message(r, v)),
+                    None => return Err(r.wrong_type(v, key, "an integer")),
+                }
+            }
+            Ok(t)
+        }))
+    });
+    let at = r.value_span(f, "triangles");
+    let mesh = SmallMesh::new(vertices?, triangles?).map_err(|e| refused(r, f, at, e))?;
+    Ok(Placed::in_place(Shape::Mesh(mesh)))
 }
 
 fn parallelogram(r: &mut Reader<'_>, f: &Fields<'_, '_>, _: Span) -> Parsed<Placed> {
