@@ -62,6 +62,9 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N", value_parser = arguments::photons, allow_negative_numbers = true)]
     photons: Option<u64>,
 
+    #[command(flatten)]
+    aa: crate::anti_aliasing::AaArgs,
+
     /// Acceleration structure over the objects (overrides the scene's
     /// `accel`); every structure gives the same picture.
     #[arg(long, value_name = "NAME", value_parser = parse_accel)]
@@ -258,6 +261,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
     settings.accel = args.accel.unwrap_or(settings.accel);
     settings.photons.count = args.photons.unwrap_or(settings.photons.count);
+    settings.aa = args.aa.apply(settings.aa)?;
 
     scene.settings.threads = args.threads;
     scene.settings.aovs = match &part {
@@ -330,11 +334,11 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             .collect::<Vec<_>>()
             .join(", ");
         note!(
-            "{}: {}x{}, {} spp in {:.3} s; rays: {by_kind}; {:.2} Mrays/s",
+            "{}: {}x{}, {} in {:.3} s; rays: {by_kind}; {:.2} Mrays/s",
             args.output.display(),
             scene.settings.width,
             scene.settings.height,
-            scene.settings.samples_per_pixel,
+            crate::anti_aliasing::sampling(&scene.settings),
             elapsed,
             rays.total() as f64 / elapsed / 1e6,
         );

@@ -34,6 +34,7 @@
 //! out of range, unknown names, and shapes, transforms or cameras their
 //! constructors refuse.
 
+mod anti_aliasing;
 mod csg;
 mod light;
 mod material;
@@ -170,6 +171,9 @@ const RENDER_KEYS: &[&str] = &[
     photons::PHOTON_KEYS[0],
     photons::PHOTON_KEYS[1],
     photons::PHOTON_KEYS[2],
+    anti_aliasing::AA_KEYS[0],
+    anti_aliasing::AA_KEYS[1],
+    anti_aliasing::AA_KEYS[2],
 ];
 
 fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
@@ -201,6 +205,7 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
     let accel = r.or_default(&f, "accel", d.accel, read_accel);
     let color_space = r.or_default(&f, "colours", ColorSpace::Linear, read_color_space);
     let photons = photons::read_photons(r, &f);
+    let aa = anti_aliasing::read_anti_aliasing(r, &f);
     keys?;
     let (width, height) = size?;
     Ok(Render {
@@ -212,6 +217,7 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
             min_weight: min_weight?,
             accel: accel?,
             photons: photons?,
+            aa: aa?,
             ..d
         },
         background: background?,
@@ -362,7 +368,7 @@ pub(super) mod tests {
                 "expected 3 numbers for `background`, found 2",
                 "`ambient` must not be negative, got -1",
                 "unknown key `size` in [render]; expected one of: width, height, samples, \
-                 max_depth, min_weight, background, ambient, accel, colours, photons, gather, radius",
+                 max_depth, min_weight, background, ambient, accel, colours, photons, gather, radius, aa, aa_threshold, aa_depth",
                 "unknown acceleration structure `octree`; expected one of: bvh, kdtree, grid, linear",
                 "unknown colour convention `srgb` for `colours`; expected one of: linear, display",
             ]
