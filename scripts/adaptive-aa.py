@@ -4,10 +4,11 @@ three SPD scenes, the adaptive picture against a 64-spp stratified
 reference, with the camera rays and times of both.
 
     scripts/adaptive-aa.py BINARY [--size N] [--threshold T] [--depth D]
-                           [--threads T] [--scenes DIR]
+                           [--min-depth M] [--threads T] [--scenes DIR]
 
 For each scene it renders the reference (`--spp 64`) and the adaptive
-picture (`--aa adaptive --aa-threshold T --aa-depth D`) as PFM, encodes both
+picture (`--aa adaptive --aa-threshold T --aa-depth D --aa-min-depth M`)
+as PFM, encodes both
 as the PNG writer would (8-bit codes through the sRGB curve for linear
 scenes, scaled for NFF's display values) and reports the mean absolute
 error per channel (in 1/255), the share of pixels whose channels are all
@@ -69,6 +70,7 @@ def main():
     parser.add_argument("--size", type=int, default=256)
     parser.add_argument("--threshold", type=float, default=0.1)
     parser.add_argument("--depth", type=int, default=3)
+    parser.add_argument("--min-depth", type=int, default=0)
     parser.add_argument("--threads", type=int, default=0)
     parser.add_argument("--scenes", default="/work/shared/scenes/spd")
     parser.add_argument("--only", nargs="*", help="scene names to run")
@@ -77,7 +79,8 @@ def main():
         os.path.join(a.scenes, n) for n in ("balls.nff", "gears.nff", "teapot.nff")]
     if a.only:
         scenes = [s for s in scenes if os.path.basename(s).split(".")[0] in a.only]
-    print(f"{a.size}x{a.size}; adaptive threshold {a.threshold}, depth {a.depth}; "
+    print(f"{a.size}x{a.size}; adaptive threshold {a.threshold}, depth {a.depth}, "
+          f"min depth {a.min_depth}; "
           "reference 64 spp stratified")
     print(f"{'scene':<14} {'ref rays':>10} {'ref s':>7} {'aa rays':>10} {'aa s':>7} "
           f"{'cam %':>6} {'MAE/255':>8} {'<=8/255':>8} {'max':>4}  bar")
@@ -92,7 +95,8 @@ def main():
             aa_s, aa_primary, aa_total = render(
                 a.binary, scene, aa_out,
                 ["--aa", "adaptive", "--aa-threshold", str(a.threshold),
-                 "--aa-depth", str(a.depth)], a.size, a.threads)
+                 "--aa-depth", str(a.depth), "--aa-min-depth", str(a.min_depth)],
+                a.size, a.threads)
             _, _, ref = read_pfm(ref_out)
             _, _, aa = read_pfm(aa_out)
             codes_ref = [encode(v) for v in ref]

@@ -24,6 +24,12 @@ pub struct AaArgs {
     /// side, down to squares 1/2^D of a pixel wide (default 3; at most 6).
     #[arg(long, value_name = "D", value_parser = depth, allow_negative_numbers = true)]
     aa_depth: Option<u32>,
+
+    /// Adaptive anti-aliasing: halve every pixel D times whatever its
+    /// corners (default 0, POV-Ray's way; 1 finds features smaller than a
+    /// pixel that no corner sees; at most --aa-depth).
+    #[arg(long, value_name = "D", value_parser = depth, allow_negative_numbers = true)]
+    aa_min_depth: Option<u32>,
 }
 
 impl AaArgs {
@@ -39,19 +45,27 @@ impl AaArgs {
         };
         match method {
             AntiAliasing::Stratified => {
-                if self.aa_threshold.is_some() || self.aa_depth.is_some() {
+                if self.aa_threshold.is_some()
+                    || self.aa_depth.is_some()
+                    || self.aa_min_depth.is_some()
+                {
                     return Err(
-                        "--aa-threshold and --aa-depth apply only to adaptive anti-aliasing; \
-                         add --aa adaptive"
+                        "--aa-threshold, --aa-depth and --aa-min-depth apply only to adaptive \
+                         anti-aliasing; add --aa adaptive"
                             .to_string(),
                     );
                 }
                 Ok(method)
             }
-            AntiAliasing::Adaptive(a) => Ok(AntiAliasing::Adaptive(Adaptive {
-                threshold: self.aa_threshold.unwrap_or(a.threshold),
-                depth: self.aa_depth.unwrap_or(a.depth),
-            })),
+            AntiAliasing::Adaptive(a) => {
+                let adaptive = Adaptive {
+                    threshold: self.aa_threshold.unwrap_or(a.threshold),
+                    depth: self.aa_depth.unwrap_or(a.depth),
+                    min_depth: self.aa_min_depth.unwrap_or(a.min_depth),
+                };
+                adaptive.check().map_err(|e| e.to_string())?;
+                Ok(AntiAliasing::Adaptive(adaptive))
+            }
         }
     }
 }
@@ -101,6 +115,7 @@ mod tests {
         let scene = AntiAliasing::Adaptive(Adaptive {
             threshold: 0.1,
             depth: 2,
+            min_depth: 1,
         });
         let none = AaArgs::default();
         assert_eq!(none.apply(scene), Ok(scene));
@@ -112,32 +127,38 @@ mod tests {
             aa: method("adaptive").ok(),
             aa_threshold: None,
             aa_depth: Some(4),
+            aa_min_depth: None,
         };
         assert_eq!(
             adaptive.apply(AntiAliasing::Stratified),
             Ok(AntiAliasing::Adaptive(Adaptive {
                 threshold: 0.3,
-                depth: 4
+                depth: 4,
+                min_depth: 0,
             }))
         );
         assert_eq!(
             adaptive.apply(scene),
             Ok(AntiAliasing::Adaptive(Adaptive {
                 threshold: 0.1,
-                depth: 4
+                depth: 4,
+                min_depth: 1,
             }))
         );
         let stratified = AaArgs {
             aa: Some(AntiAliasing::Stratified),
             aa_threshold: Some(0.1),
             aa_depth: None,
+            aa_min_depth: None,
         };
-        assert!(
-            stratified
-                .apply(scene)
-                .unwrap_err()
-                .contains("--aa adaptive")
-        );
+        let message = stratified.apply(scene).unwrap_err();
+        assert!(message.contains("--aa adaptive"), "{message}");
+        let too_deep = AaArgs {
+            aa_min_depth: Some(3),
+            ..AaArgs::default()
+        };
+        let message = too_deep.apply(scene).unwrap_err();
+        assert!(message.contains("minimum depth 3"), "{message}");
     }
 
     #[test]

@@ -4,7 +4,8 @@
 //! A camera ray is traced through each corner of the pixel. Where the four
 //! corners of a square differ by more than the threshold, the square is cut
 //! into four and the new corners traced, down to squares
-//! `1 / 2^depth` of a pixel wide. The pixel's colour is the area average of
+//! `1 / 2^depth` of a pixel wide (and, beyond POV-Ray, down to
+//! `1 / 2^min_depth` whatever the corners). The pixel's colour is the area average of
 //! its squares, each the mean of its four corners.
 //!
 //! Corners lie on a fine grid (`2^depth` steps per pixel) and are cached by
@@ -59,6 +60,10 @@ pub struct Adaptive {
     pub threshold: f64,
     /// The most times a pixel is halved along each side.
     pub depth: u32,
+    /// The times a pixel is halved whatever its corners (0, POV-Ray's
+    /// way, looks at the pixel corners first): a feature smaller than the
+    /// pixel that no corner sees is found by the finer first grid.
+    pub min_depth: u32,
 }
 
 impl Default for Adaptive {
@@ -66,6 +71,7 @@ impl Default for Adaptive {
         Self {
             threshold: DEFAULT_AA_THRESHOLD,
             depth: DEFAULT_AA_DEPTH,
+            min_depth: 0,
         }
     }
 }
@@ -82,6 +88,14 @@ pub enum AdaptiveError {
          1/64 of a pixel wide)"
     )]
     Depth(u32),
+    /// A minimum depth beyond the depth.
+    #[error("the anti-aliasing minimum depth {min_depth} is more than the depth {depth}")]
+    MinDepth {
+        /// The minimum depth.
+        min_depth: u32,
+        /// The depth.
+        depth: u32,
+    },
 }
 
 impl AntiAliasing {
@@ -115,8 +129,8 @@ impl AntiAliasing {
 }
 
 impl Adaptive {
-    /// Refuses a threshold that is not a number of at least 0, or a depth
-    /// beyond [`MAX_AA_DEPTH`].
+    /// Refuses a threshold that is not a number of at least 0, a depth
+    /// beyond [`MAX_AA_DEPTH`] or a minimum depth beyond the depth.
     pub fn check(&self) -> Result<(), AdaptiveError> {
         if !(self.threshold.is_finite() && self.threshold >= 0.0) {
             return Err(AdaptiveError::Threshold(self.threshold));
@@ -124,17 +138,23 @@ impl Adaptive {
         if self.depth > MAX_AA_DEPTH {
             return Err(AdaptiveError::Depth(self.depth));
         }
+        if self.min_depth > self.depth {
+            return Err(AdaptiveError::MinDepth {
+                min_depth: self.min_depth,
+                depth: self.depth,
+            });
+        }
         Ok(())
     }
 }
 
 impl fmt::Display for Adaptive {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "adaptive anti-aliasing (threshold {}, depth {})",
-            self.threshold, self.depth
-        )
+        write!(f, "adaptive anti-aliasing (threshold {}, ", self.threshold)?;
+        match self.min_depth {
+            0 => write!(f, "depth {})", self.depth),
+            min => write!(f, "depth {min} to {})", self.depth),
+        }
     }
 }
 
@@ -203,7 +223,8 @@ impl<'a> AdaptivePixels<'a> {
             self.corner(fx, fy + side, cost),
             self.corner(fx + side, fy + side, cost),
         ];
-        if side == 1 || !self.differ(&c) {
+        let forced = side > 1 << (self.adaptive.depth - self.adaptive.min_depth);
+        if side == 1 || !(forced || self.differ(&c)) {
             return (c[0].color + c[1].color + c[2].color + c[3].color) * 0.25;
         }
         let half = side / 2;

@@ -24,7 +24,11 @@ fn scene(text: &str, aa: AntiAliasing) -> Scene {
 }
 
 fn adaptive(threshold: f64, depth: u32) -> AntiAliasing {
-    AntiAliasing::Adaptive(Adaptive { threshold, depth })
+    AntiAliasing::Adaptive(Adaptive {
+        threshold,
+        depth,
+        min_depth: 0,
+    })
 }
 
 fn camera_rays(output: &RenderOutput) -> u64 {
@@ -53,6 +57,23 @@ fn names_defaults_and_limits() {
     assert_eq!(
         adaptive(0.1, MAX_AA_DEPTH + 1).check(),
         Err(AdaptiveError::Depth(MAX_AA_DEPTH + 1))
+    );
+    let min = |min_depth, depth| Adaptive {
+        threshold: 0.1,
+        depth,
+        min_depth,
+    };
+    assert!(min(2, 2).check().is_ok());
+    assert_eq!(
+        min(3, 2).check(),
+        Err(AdaptiveError::MinDepth {
+            min_depth: 3,
+            depth: 2
+        })
+    );
+    assert_eq!(
+        min(1, 4).to_string(),
+        "adaptive anti-aliasing (threshold 0.1, depth 1 to 4)"
     );
     for bad in [-0.1, f64::NAN, f64::INFINITY] {
         assert!(matches!(
@@ -174,4 +195,40 @@ fn aovs_keep_the_pixel_centre_and_stratified_stays_as_it_was() {
     let centre = render(&s, &|_| {}).unwrap();
     assert_eq!(with.aovs, centre.aovs);
     assert_eq!(camera_rays(&centre), 24 * 20);
+}
+
+#[test]
+fn a_minimum_depth_subdivides_flat_pixels_and_finds_what_corners_miss() {
+    let mut flat = scene(FLAT, adaptive(0.0, 3));
+    flat.settings.aa = AntiAliasing::Adaptive(Adaptive {
+        threshold: 0.0,
+        depth: 3,
+        min_depth: 2,
+    });
+    let output = render(&flat, &|_| {}).unwrap();
+    // Each tile traces its corners on a grid 4 times finer.
+    let corners: u64 = [16, 16, 8]
+        .iter()
+        .flat_map(|w| [16, 4].map(|h| (4 * w + 1) * (4 * h + 1)))
+        .sum();
+    assert_eq!(camera_rays(&output), corners);
+    // A ball inside one pixel, between its corners: only the finer grid
+    // sees it.
+    let speck = "[render]\nwidth = 3\nheight = 3\nbackground = [1, 1, 1]\n\
+        [camera]\neye = [0, 0, -5]\nlook_at = [0, 0, 0]\nfov = 30\n\
+        [[objects]]\nshape = \"sphere\"\ncenter = [0, 0, 0]\nradius = 0.3\n";
+    let corners_only = render(&scene(speck, adaptive(0.3, 3)), &|_| {}).unwrap();
+    assert_eq!(corners_only.image.pixel(1, 1), [1.0; 3]);
+    let mut finer = scene(speck, adaptive(0.3, 3));
+    finer.settings.aa = AntiAliasing::Adaptive(Adaptive {
+        threshold: 0.3,
+        depth: 3,
+        min_depth: 1,
+    });
+    let found = render(&finer, &|_| {}).unwrap();
+    assert!(
+        found.image.pixel(1, 1)[0] < 0.9,
+        "{:?}",
+        found.image.pixel(1, 1)
+    );
 }

@@ -1,18 +1,19 @@
-//! The anti-aliasing keys of `[render]`: `aa`, `aa_threshold` and
-//! `aa_depth` (see [`crate::render::AntiAliasing`]).
+//! The anti-aliasing keys of `[render]`: `aa`, `aa_threshold`,
+//! `aa_depth` and `aa_min_depth` (see [`crate::render::AntiAliasing`]).
 //!
 //! ```toml
 //! [render]
 //! aa = "adaptive"      # or "stratified" (the default: `samples` per pixel)
 //! aa_threshold = 0.1   # subdivide where corners differ by more (default 0.3)
 //! aa_depth = 3         # halve a pixel at most this often (default 3, at most 6)
+//! aa_min_depth = 1     # halve it this often whatever the corners (default 0)
 //! ```
 
 use super::reader::{Fields, Parsed, Reader, list};
 use crate::render::{Adaptive, AntiAliasing, MAX_AA_DEPTH};
 
 /// The keys read here.
-pub(super) const AA_KEYS: [&str; 3] = ["aa", "aa_threshold", "aa_depth"];
+pub(super) const AA_KEYS: [&str; 4] = ["aa", "aa_threshold", "aa_depth", "aa_min_depth"];
 
 /// The anti-aliasing of a `[render]` table: stratified unless `aa` says
 /// otherwise; the threshold and depth only with `aa = "adaptive"`.
@@ -32,8 +33,11 @@ pub(super) fn read_anti_aliasing(r: &mut Reader<'_>, f: &Fields<'_, '_>) -> Pars
     let depth = r.or_default(f, "aa_depth", d.depth, |r, v, k| {
         r.count(v, k, 0, MAX_AA_DEPTH)
     });
+    let min_depth = r.or_default(f, "aa_min_depth", d.min_depth, |r, v, k| {
+        r.count(v, k, 0, MAX_AA_DEPTH)
+    });
     let method = method?;
-    let (threshold, depth) = (threshold?, depth?);
+    let (threshold, depth, min_depth) = (threshold?, depth?, min_depth?);
     if method == AntiAliasing::Stratified {
         for key in &AA_KEYS[1..] {
             if f.get(key).is_some() {
@@ -48,7 +52,18 @@ pub(super) fn read_anti_aliasing(r: &mut Reader<'_>, f: &Fields<'_, '_>) -> Pars
         }
         return Ok(method);
     }
-    Ok(AntiAliasing::Adaptive(Adaptive { threshold, depth }))
+    if min_depth > depth {
+        let span = r.value_span(f, "aa_min_depth");
+        return Err(r.error(
+            span,
+            format!("`aa_min_depth` must be at most `aa_depth` ({depth}), got {min_depth}"),
+        ));
+    }
+    Ok(AntiAliasing::Adaptive(Adaptive {
+        threshold,
+        depth,
+        min_depth,
+    }))
 }
 
 #[cfg(test)]
@@ -66,10 +81,11 @@ mod tests {
             AntiAliasing::Adaptive(Adaptive::default())
         );
         assert_eq!(
-            aa("aa = \"adaptive\"\naa_threshold = 0.05\naa_depth = 4\n"),
+            aa("aa = \"adaptive\"\naa_threshold = 0.05\naa_depth = 4\naa_min_depth = 1\n"),
             AntiAliasing::Adaptive(Adaptive {
                 threshold: 0.05,
-                depth: 4
+                depth: 4,
+                min_depth: 1,
             })
         );
     }
@@ -88,6 +104,10 @@ mod tests {
         assert_eq!(
             bad("aa_depth = 2\n"),
             ["`aa_depth` applies only to adaptive anti-aliasing; add aa = \"adaptive\""]
+        );
+        assert_eq!(
+            bad("aa = \"adaptive\"\naa_depth = 2\naa_min_depth = 3\n"),
+            ["`aa_min_depth` must be at most `aa_depth` (2), got 3"]
         );
     }
 }

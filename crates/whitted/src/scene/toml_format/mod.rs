@@ -174,6 +174,7 @@ const RENDER_KEYS: &[&str] = &[
     anti_aliasing::AA_KEYS[0],
     anti_aliasing::AA_KEYS[1],
     anti_aliasing::AA_KEYS[2],
+    anti_aliasing::AA_KEYS[3],
 ];
 
 fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
@@ -368,7 +369,7 @@ pub(super) mod tests {
                 "expected 3 numbers for `background`, found 2",
                 "`ambient` must not be negative, got -1",
                 "unknown key `size` in [render]; expected one of: width, height, samples, \
-                 max_depth, min_weight, background, ambient, accel, colours, photons, gather, radius, aa, aa_threshold, aa_depth",
+                 max_depth, min_weight, background, ambient, accel, colours, photons, gather, radius, aa, aa_threshold, aa_depth, aa_min_depth",
                 "unknown acceleration structure `octree`; expected one of: bvh, kdtree, grid, linear",
                 "unknown colour convention `srgb` for `colours`; expected one of: linear, display",
             ]
