@@ -63,7 +63,7 @@ pub struct RenderArgs {
     photons: Option<u64>,
 
     #[command(flatten)]
-    aa: crate::anti_aliasing::AaArgs,
+    aa: Box<crate::anti_aliasing::AaArgs>,
 
     /// Acceleration structure over the objects (overrides the scene's
     /// `accel`); every structure gives the same picture.
