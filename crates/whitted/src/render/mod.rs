@@ -45,8 +45,7 @@ use crate::math::Ray;
 use crate::math::random::hash64;
 use crate::math::sampling::pixel_sample;
 use crate::shading::Color;
-use crate::world::{Hit, Surface};
-use crate::world::{MAX_PRIMITIVES, MaterialId, World};
+use crate::world::{Hit, MAX_PRIMITIVES, MaterialId, Surface, World};
 use adaptive::{AdaptivePixels, Cost};
 
 /// Side of the square tiles the image is cut into, in pixels.
