@@ -1,5 +1,6 @@
-//! The anti-aliasing options of `whitted render`: `--aa`, `--aa-threshold`
-//! and `--aa-depth`, which override the scene's `[render]` keys.
+//! The anti-aliasing options of `whitted render` and `whitted explain`:
+//! `--aa`, `--aa-threshold`, `--aa-depth` and `--aa-min-depth`, which
+//! override the scene's `[render]` keys.
 
 use clap::Args;
 use whitted::render::{Adaptive, AntiAliasing, MAX_AA_DEPTH, RenderSettings};

@@ -6,11 +6,17 @@
 mod anti_aliasing;
 mod arguments;
 mod bench_command;
+mod explain_command;
+mod explain_json;
+mod explain_svg;
+mod explain_text;
 mod merge_command;
 mod outputs;
 mod progress;
 mod render_command;
+mod render_stats;
 mod report;
+mod scene_arguments;
 #[cfg(unix)]
 mod signals;
 mod split;
@@ -39,6 +45,7 @@ enum Command {
     Render(render_command::RenderArgs),
     Bench(bench_command::BenchArgs),
     Merge(merge_command::MergeArgs),
+    Explain(explain_command::ExplainArgs),
 }
 
 fn main() -> ExitCode {
@@ -51,6 +58,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render_command::run(&args),
         Command::Bench(args) => bench_command::run(&args),
         Command::Merge(args) => merge_command::run(&args),
+        Command::Explain(args) => explain_command::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -4,16 +4,14 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::Args;
-use whitted::accel::AccelKind;
 use whitted::image::{ImageError, ImageFormat, check_destination};
-use whitted::limits::MemoryBudget;
-use whitted::math::Vec3;
-use whitted::render::{Aov, Share, Window, check_image_size, render, render_selected};
-use whitted::scene::{CameraOverride, LoadOptions, load_any_with};
+use whitted::render::{Aov, Share, Window, render, render_selected};
 
 use crate::arguments;
 use crate::progress::ProgressReport;
+use crate::render_stats::{self, StageSeconds};
 use crate::report::note;
+use crate::scene_arguments::SceneArgs;
 use crate::split::{self, PartRender};
 
 /// Render a scene to an image.
@@ -29,46 +27,13 @@ use crate::split::{self, PartRender};
   whitted render bunny.obj --eye 0,0.1,0.3 --fov 40   a Wavefront OBJ model, seen from elsewhere
   whitted render scenes/whitted.toml -o out.exr --aov depth=depth.pfm --aov normal=normal.exr")]
 pub struct RenderArgs {
-    /// Scene file: .toml (ours), .nff (Neutral File Format), .obj
-    /// (Wavefront, with its .mtl) or .bpt (Bézier patches). Without one,
-    /// the built-in scene is rendered.
-    scene: Option<PathBuf>,
+    #[command(flatten)]
+    scene: SceneArgs,
 
     /// Output image: .png, .exr or .pfm; or .wpart, a part of the image
     /// for `whitted merge` (docs/cluster.md).
     #[arg(short, long, value_name = "OUT", default_value = "whitted.png")]
     output: PathBuf,
-
-    /// Image width in pixels (1 to 65535; at most 268435456 pixels in all).
-    #[arg(long, value_name = "W", value_parser = arguments::image_side, allow_negative_numbers = true)]
-    width: Option<u32>,
-
-    /// Image height in pixels (1 to 65535; at most 268435456 pixels in all).
-    #[arg(long, value_name = "H", value_parser = arguments::image_side, allow_negative_numbers = true)]
-    height: Option<u32>,
-
-    /// Samples per pixel, on a stratified seeded pattern (1 = pixel centre;
-    /// at most 65536).
-    #[arg(long, value_name = "N", value_parser = arguments::samples, allow_negative_numbers = true)]
-    spp: Option<u32>,
-
-    /// Maximum reflection/refraction depth (0 = no secondary rays; default 8;
-    /// at most 1000).
-    #[arg(long, value_name = "D", value_parser = arguments::depth, allow_negative_numbers = true)]
-    max_depth: Option<u32>,
-
-    /// Photons to shoot for caustics (overrides the scene's `photons`; 0 =
-    /// off, the default; at most 100000000).
-    #[arg(long, value_name = "N", value_parser = arguments::photons, allow_negative_numbers = true)]
-    photons: Option<u64>,
-
-    #[command(flatten)]
-    aa: Box<crate::anti_aliasing::AaArgs>,
-
-    /// Acceleration structure over the objects (overrides the scene's
-    /// `accel`); every structure gives the same picture.
-    #[arg(long, value_name = "NAME", value_parser = parse_accel)]
-    accel: Option<AccelKind>,
 
     /// Worker threads (default: all cores). The picture is the same for any
     /// number.
@@ -84,28 +49,6 @@ pub struct RenderArgs {
     #[arg(long, value_name = "NAME=FILE")]
     aov: Vec<String>,
 
-    /// Put the camera's eye here (replaces the scene's).
-    #[arg(long, value_name = "X,Y,Z", value_parser = arguments::vec3, allow_hyphen_values = true)]
-    eye: Option<Vec3>,
-
-    /// Point the camera at this point (replaces the scene's).
-    #[arg(long, value_name = "X,Y,Z", value_parser = arguments::vec3, allow_hyphen_values = true)]
-    look_at: Option<Vec3>,
-
-    /// The direction that is up on the image (replaces the scene's).
-    #[arg(long, value_name = "X,Y,Z", value_parser = arguments::vec3, allow_hyphen_values = true)]
-    up: Option<Vec3>,
-
-    /// Vertical field of view in degrees, top edge to bottom edge
-    /// (replaces the scene's; between 0 and 180, both excluded).
-    #[arg(long, value_name = "DEG", value_parser = arguments::field_of_view, allow_hyphen_values = true)]
-    fov: Option<f64>,
-
-    /// The memory budget: the most an image, a texture or an input file
-    /// may take, like 512M or 8G (default: 3/4 of this machine's memory).
-    #[arg(long, value_name = "SIZE", value_parser = whitted::limits::parse_size)]
-    max_memory: Option<u64>,
-
     /// Render only worker I's share (from 0) of N: every N-th row, into a
     /// .wpart part for `whitted merge`.
     #[arg(long, value_name = "I/N", value_parser = split::tile, allow_hyphen_values = true)]
@@ -116,17 +59,15 @@ pub struct RenderArgs {
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = split::crop, allow_hyphen_values = true)]
     crop: Option<Window>,
 
+    /// After the summary, print where the time went (reading, building,
+    /// photons, tracing with the threads' use, writing) and the rays by
+    /// kind with their rates (printed even with --quiet).
+    #[arg(long)]
+    stats: bool,
+
     /// Print nothing but errors.
     #[arg(short, long)]
     quiet: bool,
-}
-
-/// Parses the name of an acceleration structure.
-fn parse_accel(name: &str) -> Result<AccelKind, String> {
-    AccelKind::from_name(name).ok_or_else(|| {
-        let names: Vec<&str> = AccelKind::ALL.iter().map(AccelKind::name).collect();
-        format!("expected one of: {}", names.join(", "))
-    })
 }
 
 /// Parses `NAME=FILE` into an AOV and its destination.
@@ -185,35 +126,9 @@ pub fn check_destinations(
     Ok(())
 }
 
-/// The parts of the scene's camera the arguments replace.
-fn camera_override(args: &RenderArgs) -> CameraOverride {
-    CameraOverride {
-        eye: args.eye,
-        look_at: args.look_at,
-        up: args.up,
-        fov_degrees: args.fov,
-    }
-}
-
-/// Refuses, before the scene is read, what the arguments alone show cannot
-/// be rendered: an image of too many pixels, a camera no scene could have.
-/// (Each value was checked on its own as it was parsed.)
-fn check_arguments(args: &RenderArgs) -> Result<(), String> {
-    if let (Some(width), Some(height)) = (args.width, args.height) {
-        check_image_size(width, height)
-            .map_err(|e| format!("--width {width} --height {height}: {e}"))?;
-    }
-    camera_override(args)
-        .check()
-        .map_err(|e| format!("the camera asked for is invalid: {e}"))
-}
-
 /// Runs the command.
 pub fn run(args: &RenderArgs) -> Result<(), String> {
-    check_arguments(args)?;
-    if let Some(bytes) = args.max_memory {
-        MemoryBudget::given(bytes).set_current();
-    }
+    args.scene.check()?;
     let part = PartRender::from_args(&args.output, args.tile, args.crop, &args.aov)?;
     let aov_outputs = match part {
         Some(_) => Vec::new(),
@@ -224,44 +139,9 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             .collect::<Result<Vec<_>, _>>()?,
     };
     check_destinations(&args.output, &aov_outputs, args.quiet)?;
-
-    let options = LoadOptions {
-        camera: camera_override(args),
-    };
-    let mut scene = match &args.scene {
-        Some(path) => {
-            let start = Instant::now();
-            let loaded = load_any_with(path, &options).map_err(|e| e.to_string())?;
-            if !args.quiet {
-                for warning in &loaded.warnings {
-                    note!("{warning}\n");
-                }
-                note!(
-                    "{}: read in {:.3} s, {} primitives",
-                    path.display(),
-                    start.elapsed().as_secs_f64(),
-                    loaded.scene.objects.primitive_count()
-                );
-            }
-            loaded.scene
-        }
-        None => {
-            let mut scene = whitted::scene::default_scene();
-            scene.camera = options
-                .camera
-                .apply(&scene.camera)
-                .map_err(|e| format!("the camera asked for is invalid: {e}"))?;
-            scene
-        }
-    };
-    let settings = &mut scene.settings;
-    settings.width = args.width.unwrap_or(settings.width);
-    settings.height = args.height.unwrap_or(settings.height);
-    settings.samples_per_pixel = args.spp.unwrap_or(settings.samples_per_pixel);
-    settings.max_depth = args.max_depth.unwrap_or(settings.max_depth);
-    settings.accel = args.accel.unwrap_or(settings.accel);
-    settings.photons.count = args.photons.unwrap_or(settings.photons.count);
-    settings.aa = args.aa.apply(settings.aa)?;
+    let load_start = Instant::now();
+    let mut scene = args.scene.load(args.quiet)?;
+    let load_seconds = load_start.elapsed().as_secs_f64();
 
     scene.settings.threads = args.threads;
     scene.settings.aovs = match &part {
@@ -306,11 +186,12 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         note!("{photons}");
     }
 
+    let write_start = Instant::now();
     match selection {
         Some(selection) => PartRender::write(
             &args.output,
             &scene,
-            args.scene.as_deref(),
+            args.scene.scene.as_deref(),
             selection,
             &output,
         )?,
@@ -325,6 +206,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         }
     }
 
+    let write_seconds = write_start.elapsed().as_secs_f64();
     if !args.quiet {
         let rays = output.rays;
         let by_kind = output
@@ -334,14 +216,26 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             .collect::<Vec<_>>()
             .join(", ");
         note!(
-            "{}: {}x{}, {} in {:.3} s; rays: {by_kind}; {:.2} Mrays/s",
+            "{}: {}x{}, {} in {:.3} s (world built in {:.3} s); rays: {by_kind}; \
+             {:.2} Mrays/s",
             args.output.display(),
             scene.settings.width,
             scene.settings.height,
             crate::anti_aliasing::sampling(&scene.settings),
             elapsed,
+            output.build_seconds,
             rays.total() as f64 / elapsed / 1e6,
         );
+    }
+    if args.stats {
+        let stages = StageSeconds {
+            load: load_seconds,
+            render: elapsed,
+            write: write_seconds,
+        };
+        for line in render_stats::lines(&output, stages) {
+            note!("{line}");
+        }
     }
     Ok(())
 }

@@ -487,3 +487,51 @@ fn an_obj_model_renders_with_its_warnings_printed() {
     );
     assert!(dir.path().join("whitted.png").exists());
 }
+
+#[test]
+fn stats_break_the_time_down_by_stage_and_the_rays_by_kind() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scenes_folder().join("caustics.toml");
+    let out = whitted(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-q",
+            "--stats",
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "--photons",
+            "2000",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stderr(&out);
+    let stages: Vec<&str> = text
+        .lines()
+        .filter_map(|line| line.strip_prefix("  ")?.split_whitespace().next())
+        .collect();
+    assert_eq!(
+        stages,
+        [
+            "load",
+            "build",
+            "photons",
+            "trace",
+            "other",
+            "write",
+            "total",
+            "primary",
+            "shadow",
+            "reflected",
+            "refracted",
+            "all"
+        ],
+        "{text}"
+    );
+    // Only the stats: --quiet keeps the summary line away.
+    assert!(text.starts_with("stats:\n"), "{text}");
+    assert!(dir.path().join("whitted.png").exists());
+}

@@ -37,13 +37,14 @@ fn scene_file() -> PathBuf {
 const PICTURE: [&str; 6] = ["--width", "61", "--height", "37", "--spp", "3"];
 
 /// Every output of the single render and of the merge, by file name.
-const OUTPUTS: [(&str, &str); 9] = [
+const OUTPUTS: [(&str, &str); 10] = [
     ("-o", "image.png"),
     ("-o", "image.exr"),
     ("-o", "image.pfm"),
     ("--aov", "depth=depth.pfm"),
     ("--aov", "normal=normal.exr"),
     ("--aov", "id=id.pfm"),
+    ("--aov", "instance=instance.exr"),
     ("--aov", "cost=cost.exr"),
     ("--aov", "cost=cost.png"),
     ("--aov", "depth=depth.exr"),
@@ -59,7 +60,7 @@ fn render_tiles(scene: &str, count: u32, dir: &Path) -> Vec<String> {
             let mut args = vec!["render", scene, "--tile", &tile, "-o", &part, "-q"];
             args.extend(PICTURE);
             args.extend(["--aov", "depth", "--aov", "normal", "--aov", "id"]);
-            args.extend(["--aov", "cost"]);
+            args.extend(["--aov", "cost", "--aov", "instance"]);
             succeeds(&args, dir);
             part
         })
@@ -76,9 +77,9 @@ fn merged_tiles_are_the_single_render_bit_for_bit_in_every_format_and_aov() {
     std::fs::create_dir_all(dir.path().join("merged")).unwrap();
     // One command per image format, each with the AOVs that fit it.
     for (image, aovs) in [
-        (0, &OUTPUTS[3..7]),
-        (1, &OUTPUTS[7..8]),
-        (2, &OUTPUTS[8..9]),
+        (0, &OUTPUTS[3..8]),
+        (1, &OUTPUTS[8..9]),
+        (2, &OUTPUTS[9..10]),
     ] {
         let (_, name) = OUTPUTS[image];
         let outputs = |folder: &str| -> Vec<String> {

@@ -4,9 +4,11 @@
 //! pixel of a silhouette or a depth edge, and the depths agree within the
 //! tessellation error.
 //!
-//! The grid is 32×32 quads per patch (65,536 triangles), not the 256×256
-//! of the issue: the test stays well under a second in a debug build, and
-//! the tolerance is the bound of that grid's error.
+//! The grid is 256×256 quads per patch, as the issue asks (4.2 million
+//! triangles in all), and the tolerance is the bound of that grid's error.
+//! Each patch's tessellation is traced as a mesh of its own, one after the
+//! other, and the nearest hit kept: the whole teapot as one mesh would take
+//! some 900 MB while the test runs, one patch at a time takes 30 times less.
 
 use std::path::Path;
 
@@ -19,7 +21,7 @@ use whitted::shape::Shape;
 use whitted::world::World;
 
 const TEAPOT: &str = include_str!("../../../scenes/teapot.bpt");
-const GRID: usize = 32;
+const GRID: usize = 256;
 const WIDTH: u32 = 64;
 const HEIGHT: u32 = 48;
 
@@ -78,6 +80,37 @@ fn depths(scene: &Scene) -> Vec<Option<f64>> {
         .collect()
 }
 
+/// The scene of `patches`' camera holding the patch `net` tessellated to
+/// [`GRID`]×[`GRID`] quads, as a triangle mesh.
+fn tessellated(net: &[[Vec3; 4]; 4], patches: &Scene) -> Scene {
+    let mut positions = Vec::with_capacity((GRID + 1) * (GRID + 1));
+    let mut triangles = Vec::with_capacity(2 * GRID * GRID);
+    for i in 0..=GRID {
+        for j in 0..=GRID {
+            positions.push(point(net, i as f64 / GRID as f64, j as f64 / GRID as f64));
+        }
+    }
+    let at = |i: usize, j: usize| (i * (GRID + 1) + j) as u32;
+    for i in 0..GRID {
+        for j in 0..GRID {
+            for tri in [
+                [at(i, j), at(i + 1, j), at(i + 1, j + 1)],
+                [at(i, j), at(i + 1, j + 1), at(i, j + 1)],
+            ] {
+                let [a, b, c] = tri.map(|k| positions[k as usize]);
+                if (b - a).cross(c - a) != Vec3::ZERO {
+                    triangles.push(tri);
+                }
+            }
+        }
+    }
+    let mut scene = Scene::new(patches.camera.clone());
+    let material = scene.add_material(Material::default());
+    let mesh = scene.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
+    scene.add_mesh_instance(mesh, material, Transform::IDENTITY);
+    scene
+}
+
 #[test]
 fn the_patch_teapot_has_the_depths_of_its_fine_tessellation() {
     let patches = parse_bpt(TEAPOT, Path::new("teapot.bpt")).unwrap().scene;
@@ -91,36 +124,17 @@ fn the_patch_teapot_has_the_depths_of_its_fine_tessellation() {
         })
         .collect();
     let error = nets.iter().map(tessellation_error).fold(0.0, f64::max);
-    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
+    let exact = depths(&patches);
+    let mut reference = vec![None; exact.len()];
     for net in &nets {
-        let base = positions.len() as u32;
-        for i in 0..=GRID {
-            for j in 0..=GRID {
-                positions.push(point(net, i as f64 / GRID as f64, j as f64 / GRID as f64));
-            }
-        }
-        let at = |i: usize, j: usize| base + (i * (GRID + 1) + j) as u32;
-        for i in 0..GRID {
-            for j in 0..GRID {
-                for tri in [
-                    [at(i, j), at(i + 1, j), at(i + 1, j + 1)],
-                    [at(i, j), at(i + 1, j + 1), at(i, j + 1)],
-                ] {
-                    let [a, b, c] = tri.map(|k| positions[k as usize]);
-                    if (b - a).cross(c - a) != Vec3::ZERO {
-                        triangles.push(tri);
-                    }
-                }
-            }
+        let patch_depths = depths(&tessellated(net, &patches));
+        for (nearest, t) in reference.iter_mut().zip(patch_depths) {
+            *nearest = match (*nearest, t) {
+                (Some(a), Some(b)) => Some(f64::min(a, b)),
+                (a, b) => a.or(b),
+            };
         }
     }
-    let mut tessellated = Scene::new(patches.camera.clone());
-    let material = tessellated.add_material(Material::default());
-    let mesh = tessellated.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
-    tessellated.add_mesh_instance(mesh, material, Transform::IDENTITY);
-
-    let exact = depths(&patches);
-    let reference = depths(&tessellated);
     let index = |x: i64, y: i64| (y * i64::from(WIDTH) + x) as usize;
     let mut hits = 0;
     for y in 0..i64::from(HEIGHT) {

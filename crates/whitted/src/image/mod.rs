@@ -204,7 +204,7 @@ impl Film {
     pub fn encode(&self, path: &Path) -> Result<PendingImage, ImageError> {
         let format = ImageFormat::from_path(path)?;
         let encoder: Encoder = match format {
-            ImageFormat::Png => Self::encode_png,
+            ImageFormat::Png => |film, out| film.encode_png(out),
             ImageFormat::Pfm => Self::encode_pfm,
             ImageFormat::Exr => Self::encode_exr,
             ImageFormat::Part => {
@@ -223,7 +223,18 @@ impl Film {
         encode_to_partial(path, |out| encoder(self, out))
     }
 
-    fn encode_png(&self, out: &mut std::fs::File) -> std::io::Result<()> {
+    /// The film encoded as PNG, in memory (to embed in another file).
+    pub fn png_bytes(&self) -> Result<Vec<u8>, ImageError> {
+        let mut bytes = Vec::new();
+        self.encode_png(&mut bytes)
+            .map_err(|source| ImageError::Io {
+                path: PathBuf::from("(memory)"),
+                source,
+            })?;
+        Ok(bytes)
+    }
+
+    fn encode_png(&self, out: impl std::io::Write) -> std::io::Result<()> {
         let mut encoder = png::Encoder::new(BufWriter::new(out), self.width, self.height);
         encoder.set_color(if self.channels == 1 {
             png::ColorType::Grayscale
@@ -326,6 +337,13 @@ impl PendingImage {
         }
         partial.persist(&target).map_err(io)
     }
+}
+
+/// Writes `text` into a partial file beside `path`, to be renamed into
+/// place by [`PendingImage::commit`] like an image (for drawings and
+/// reports written beside the pictures).
+pub fn encode_text(path: &Path, text: &str) -> Result<PendingImage, ImageError> {
+    encode_to_partial(path, |out| std::io::Write::write_all(out, text.as_bytes()))
 }
 
 /// Encodes into a new partial file in the folder of `path`'s target, to

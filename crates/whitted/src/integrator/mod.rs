@@ -8,12 +8,18 @@
 //! traces by kind ([`RayCounts`]); [`Integrator::ray_kinds`] says which
 //! kinds it can trace.
 
+mod observer;
 pub mod photon_map;
 mod ray_counts;
+mod ray_tree;
 mod whitted;
 
+pub use observer::{RayObserver, ShadowStep, Unobserved};
 pub use photon_map::{CausticMap, PhotonSettings};
 pub use ray_counts::{RayCounts, RayKind};
+pub use ray_tree::{
+    HitNode, LightTerm, LightVerdict, RayNode, RayTreeRecorder, ShadingTerms, ShadowSegment, Stop,
+};
 pub use whitted::Whitted;
 
 use crate::accel::{QueryContext, TraversalCounters};
@@ -127,6 +133,19 @@ impl<'a> Integrator<'a> {
     pub fn trace_primary(&self, ray: &Ray, counts: &mut RayCounts) -> PrimarySample {
         match self {
             Integrator::Whitted(w) => w.trace_primary(ray, counts),
+        }
+    }
+
+    /// [`Integrator::trace_primary`], telling `observer` every step (see
+    /// [`RayObserver`]).
+    pub fn trace_primary_observed<O: RayObserver>(
+        &self,
+        ray: &Ray,
+        counts: &mut RayCounts,
+        observer: &mut O,
+    ) -> PrimarySample {
+        match self {
+            Integrator::Whitted(w) => w.trace_primary_observed(ray, counts, observer),
         }
     }
 

@@ -25,12 +25,14 @@
 //!   ([`super::SECONDARY_RAY_BUDGET`]); the sample then says at which
 //!   material it was cut.
 
+use crate::integrator::observer::{RayObserver, ShadowStep, Unobserved};
 use crate::integrator::photon_map::{self, CausticMap};
 use crate::integrator::{PrimarySample, RayCounts, RayKind, RecursionLimits, Shading};
 use crate::math::{Ray, Vec3, offset_ray_origin};
 use crate::shading::optics::reflect;
 use crate::shading::{
-    Color, Crossing, Light, Lobes, Material, MediumStack, Weights, phong, shading_normal,
+    Color, Crossing, Light, Lobes, Material, MediumStack, Weights, direct_samples, phong,
+    shading_normal,
 };
 use crate::world::{MaterialId, Surface, World};
 
@@ -38,9 +40,11 @@ use crate::world::{MaterialId, Surface, World};
 const MAX_SHADOW_CROSSINGS: usize = 64;
 
 /// What one camera sample has traced so far: its rays by kind, the
-/// secondary rays it may still trace, and where it was cut.
-struct SampleTally<'c> {
+/// secondary rays it may still trace, and where it was cut; and who
+/// watches it.
+struct SampleTally<'c, O> {
     counts: &'c mut RayCounts,
+    observer: &'c mut O,
     rays_left: u32,
     /// The material at which a secondary ray was first refused, and
     /// whether that material branches (reflects and refracts); a branching
@@ -48,7 +52,7 @@ struct SampleTally<'c> {
     cut_at: Option<(MaterialId, bool)>,
 }
 
-impl SampleTally<'_> {
+impl<O> SampleTally<'_, O> {
     /// Takes one secondary ray from the budget, for a surface of
     /// `material` (which `branches` or not); false when none is left.
     fn take(&mut self, material: MaterialId, branches: bool) -> bool {
@@ -103,21 +107,39 @@ impl<'a> Whitted<'a> {
 
     /// The colour seen along a camera ray (unit direction), and its first hit.
     pub fn trace_primary(&self, ray: &Ray, counts: &mut RayCounts) -> PrimarySample {
+        self.trace_primary_observed(ray, counts, &mut Unobserved)
+    }
+
+    /// [`Whitted::trace_primary`], telling `observer` every step.
+    pub fn trace_primary_observed<O: RayObserver>(
+        &self,
+        ray: &Ray,
+        counts: &mut RayCounts,
+        observer: &mut O,
+    ) -> PrimarySample {
         counts[RayKind::Primary] += 1;
+        observer.ray_start(RayKind::Primary, ray, Color::ONE, 1.0);
         match self.world.intersect(ray) {
-            None => PrimarySample {
-                color: self.shading.background,
-                first_hit: None,
-                cut_at: None,
-            },
+            None => {
+                observer.ray_hit(ray, None);
+                observer.ray_end(self.shading.background);
+                PrimarySample {
+                    color: self.shading.background,
+                    first_hit: None,
+                    cut_at: None,
+                }
+            }
             Some(hit) => {
                 let surface = self.world.surface(ray, &hit);
+                observer.ray_hit(ray, Some((&hit, &surface)));
                 let mut tally = SampleTally {
                     counts,
+                    observer,
                     rays_left: self.limits.ray_budget,
                     cut_at: None,
                 };
                 let color = self.shade(ray, &surface, 0, 1.0, MediumStack::default(), &mut tally);
+                tally.observer.ray_end(color);
                 PrimarySample {
                     color,
                     first_hit: Some((hit, surface)),
@@ -128,18 +150,22 @@ impl<'a> Whitted<'a> {
     }
 
     /// The colour seen along a secondary ray (unit direction).
-    fn trace(
+    fn trace<O: RayObserver>(
         &self,
         ray: &Ray,
         depth: u32,
         weight: f64,
         media: MediumStack,
-        tally: &mut SampleTally<'_>,
+        tally: &mut SampleTally<'_, O>,
     ) -> Color {
         match self.world.intersect(ray) {
-            None => self.shading.background,
+            None => {
+                tally.observer.ray_hit(ray, None);
+                self.shading.background
+            }
             Some(hit) => {
                 let surface = self.world.surface(ray, &hit);
+                tally.observer.ray_hit(ray, Some((&hit, &surface)));
                 self.shade(ray, &surface, depth, weight, media, tally)
             }
         }
@@ -147,14 +173,14 @@ impl<'a> Whitted<'a> {
 
     /// The colour leaving `s` back along `ray`. `weight` is the largest
     /// factor by which this colour reaches the pixel.
-    fn shade(
+    fn shade<O: RayObserver>(
         &self,
         ray: &Ray,
         s: &Surface,
         depth: u32,
         weight: f64,
         media: MediumStack,
-        tally: &mut SampleTally<'_>,
+        tally: &mut SampleTally<'_, O>,
     ) -> Color {
         let m = &self.shading.materials[s.material.0 as usize];
         let incident = ray.dir;
@@ -166,6 +192,7 @@ impl<'a> Whitted<'a> {
         let n = shading_normal(m.bump.as_ref(), s, facing, view);
         // A tilted normal may see a light that is behind the surface itself.
         let bumped = m.bump.is_some();
+        tally.observer.shading(n, entering);
 
         // The opacity weighs the surface's own light and mirror; the
         // dissolved rest joins the transmitted ray.
@@ -175,16 +202,14 @@ impl<'a> Whitted<'a> {
         let diffuse = m.diffuse.at(s.uv);
         let specular = m.specular.at(s.uv);
         if alpha != Color::ZERO && (diffuse != Color::ZERO || specular != Color::ZERO) {
-            for light in self.shading.lights {
-                let Some(sample) = light.sample(s.point) else {
-                    continue;
-                };
+            for (index, light, sample) in direct_samples(self.shading.lights, s.point) {
                 let n_dot_l = n.dot(sample.to_light);
                 if n_dot_l <= 0.0 || (bumped && facing.dot(sample.to_light) <= 0.0) {
+                    tally.observer.light(index, Some(&sample), None);
                     continue;
                 }
-                let shadow =
-                    self.transmittance(s, light, sample.to_light, sample.distance, tally.counts);
+                let shadow = self.transmittance(s, light, sample.to_light, sample.distance, tally);
+                tally.observer.light(index, Some(&sample), Some(shadow));
                 if shadow == Color::ZERO {
                     continue;
                 }
@@ -201,6 +226,7 @@ impl<'a> Whitted<'a> {
         let mut color = alpha * local;
 
         if depth >= self.limits.max_depth {
+            tally.observer.depth_limit();
             return color;
         }
         let kr = m.reflection.at(s.uv);
@@ -214,12 +240,7 @@ impl<'a> Whitted<'a> {
             n_to,
             after: inside_after,
         } = media.cross(s.material, m.ior, entering);
-        let Lobes {
-            mirror: reflected_weight,
-            refraction: transmitted_weight,
-            refracted,
-            ..
-        } = Lobes::new(
+        let lobes = Lobes::new(
             Weights {
                 opacity: alpha,
                 diffuse,
@@ -232,6 +253,18 @@ impl<'a> Whitted<'a> {
             n_from,
             n_to,
         );
+        tally.observer.lobes(
+            lobes.mirror,
+            lobes.refraction,
+            lobes.refracted.is_some(),
+            [n_from, n_to],
+        );
+        let Lobes {
+            mirror: reflected_weight,
+            refraction: transmitted_weight,
+            refracted,
+            ..
+        } = lobes;
 
         let branches = reflected_weight != Color::ZERO && refracted.is_some();
         let child = weight * reflected_weight.max_element();
@@ -242,22 +275,36 @@ impl<'a> Whitted<'a> {
             tally.counts[RayKind::Reflected] += 1;
             let dir = reflect(incident, n);
             let origin = offset_ray_origin(s.point, s.point_error, s.normal, dir);
-            let c = self.trace(&Ray::new(origin, dir), depth + 1, child, media, tally);
+            let reflected = Ray::new(origin, dir);
+            let kind = RayKind::Reflected;
+            tally
+                .observer
+                .ray_start(kind, &reflected, reflected_weight, child);
+            let c = self.trace(&reflected, depth + 1, child, media, tally);
+            tally.observer.ray_end(c);
             color += reflected_weight * c;
+        } else if reflected_weight != Color::ZERO {
+            let kind = RayKind::Reflected;
+            tally.observer.branch_skipped(kind, reflected_weight, child);
         }
         if let Some(dir) = refracted {
             let child = weight * transmitted_weight.max_element();
             if child >= self.limits.min_weight && tally.take(s.material, branches) {
                 tally.counts[RayKind::Refracted] += 1;
                 let origin = offset_ray_origin(s.point, s.point_error, s.normal, dir);
-                let c = self.trace(
-                    &Ray::new(origin, dir),
-                    depth + 1,
-                    child,
-                    inside_after,
-                    tally,
-                );
+                let refracted = Ray::new(origin, dir);
+                let kind = RayKind::Refracted;
+                tally
+                    .observer
+                    .ray_start(kind, &refracted, transmitted_weight, child);
+                let c = self.trace(&refracted, depth + 1, child, inside_after, tally);
+                tally.observer.ray_end(c);
                 color += transmitted_weight * c;
+            } else {
+                let kind = RayKind::Refracted;
+                tally
+                    .observer
+                    .branch_skipped(kind, transmitted_weight, child);
             }
         }
         color
@@ -267,19 +314,20 @@ impl<'a> Whitted<'a> {
     /// `distance`: 0 behind an opaque surface, the product of what every
     /// transmissive or dissolved surface crossed lets through otherwise
     /// ([`Material::pass_through`]).
-    fn transmittance(
+    fn transmittance<O: RayObserver>(
         &self,
         s: &Surface,
         light: &Light,
         to_light: Vec3,
         distance: f64,
-        counts: &mut RayCounts,
+        tally: &mut SampleTally<'_, O>,
     ) -> Color {
-        counts[RayKind::Shadow] += 1;
+        tally.counts[RayKind::Shadow] += 1;
         let origin = offset_ray_origin(s.point, s.point_error, s.normal, to_light);
         let target = match light {
             Light::Directional { .. } => None,
             Light::Point { position, .. } | Light::Spot { position, .. } => Some(*position),
+            Light::Area(_) => Some(s.point + distance * to_light),
         };
         let segment = |origin: Vec3| {
             let t_max = target.map_or(distance, |p| (p - origin).dot(to_light));
@@ -287,18 +335,24 @@ impl<'a> Whitted<'a> {
         };
         let mut ray = segment(origin);
         if !self.any_transmissive {
-            return if self.world.occluded(&ray) {
-                Color::ZERO
-            } else {
-                Color::ONE
-            };
+            let blocked = self.world.occluded(&ray);
+            tally
+                .observer
+                .shadow_ray(&ray, ShadowStep::AnyHit { blocked });
+            return if blocked { Color::ZERO } else { Color::ONE };
         }
         let mut through = Color::ONE;
         for _ in 0..MAX_SHADOW_CROSSINGS {
             let Some(hit) = self.world.intersect(&ray) else {
+                let step = ShadowStep::Closest { blocker: None };
+                tally.observer.shadow_ray(&ray, step);
                 return through;
             };
             let blocker = self.world.surface(&ray, &hit);
+            let step = ShadowStep::Closest {
+                blocker: Some((&hit, &blocker)),
+            };
+            tally.observer.shadow_ray(&ray, step);
             let m = &self.shading.materials[blocker.material.0 as usize];
             through *= match self.caustics {
                 Some(_) => photon_map::shadow_pass_through(m, blocker.uv),
@@ -307,7 +361,7 @@ impl<'a> Whitted<'a> {
             if through.max_element() <= 0.0 {
                 return Color::ZERO;
             }
-            counts[RayKind::Shadow] += 1;
+            tally.counts[RayKind::Shadow] += 1;
             let origin =
                 offset_ray_origin(blocker.point, blocker.point_error, blocker.normal, to_light);
             ray = segment(origin);

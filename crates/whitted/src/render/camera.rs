@@ -7,7 +7,7 @@
 //! row + 0.5)` in image coordinates, row 0 at the top.
 
 use crate::math::magnitude::{self, MagnitudeError};
-use crate::math::{Aabb, Ray, Vec3, unit};
+use crate::math::{Aabb, DVec2, Ray, Vec3, unit};
 
 /// Why a camera could not be built.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -156,11 +156,42 @@ impl Camera {
         let dir = (self.forward + sx * self.right + sy * self.true_up).normalize();
         Ray::new(self.eye, dir)
     }
+
+    /// Where `point` appears on a `width` × `height` image (pixel units
+    /// from the top-left corner, the inverse of [`Camera::ray`]), and its
+    /// depth along the view direction; the position means something only
+    /// where the depth is positive (in front of the eye).
+    pub fn project(&self, width: u32, height: u32, point: Vec3) -> (DVec2, f64) {
+        let d = point - self.eye;
+        let depth = d.dot(self.forward);
+        let aspect = f64::from(width) / f64::from(height);
+        let sx = d.dot(self.right) / depth;
+        let sy = d.dot(self.true_up) / depth;
+        let x = (sx / (aspect * self.tan_half_fov) + 1.0) * f64::from(width) / 2.0;
+        let y = (1.0 - sy / self.tan_half_fov) * f64::from(height) / 2.0;
+        (DVec2::new(x, y), depth)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn projecting_a_point_on_a_pixel_s_ray_gives_that_pixel() {
+        let c = camera();
+        for (x, y) in [(0.5, 0.5), (199.25, 13.0), (100.0, 99.5)] {
+            let ray = c.ray(200, 100, x, y);
+            let (at, depth) = c.project(200, 100, ray.at(7.5));
+            assert!(
+                (at.x - x).abs() < 1e-9 && (at.y - y).abs() < 1e-9,
+                "{at} for {x},{y}"
+            );
+            assert!(depth > 0.0);
+        }
+        let behind = c.project(200, 100, c.ray(200, 100, 10.0, 10.0).at(-1.0)).1;
+        assert!(behind < 0.0);
+    }
 
     fn camera() -> Camera {
         Camera::new(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 90.0).unwrap()

@@ -10,7 +10,8 @@ use crate::world::Objects;
 /// The implicit surface whose bound was beaten by the widest margin.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GradientExceeded {
-    /// The shape's number among the scene's shapes (from 0).
+    /// The shape's number among the scene's shapes (from 0), followed by
+    /// each definition's shapes in order.
     pub shape: usize,
     /// Its function, as written.
     pub function: String,
@@ -41,18 +42,23 @@ impl fmt::Display for GradientExceeded {
 /// Clears what the implicit surfaces of `objects` have seen, before a
 /// render.
 pub(super) fn forget(objects: &Objects) {
-    for p in &objects.primitives {
+    for p in shapes(objects) {
         if let Shape::Implicit(shape) = &p.shape {
             shape.forget_gradient();
         }
     }
 }
 
+/// The scene's shapes, then each definition's (whose implicit surfaces
+/// note what every instance's rays saw).
+fn shapes(objects: &Objects) -> impl Iterator<Item = &crate::world::Primitive> {
+    let defined = objects.definitions.iter().flat_map(|d| &d.primitives);
+    objects.primitives.iter().chain(defined)
+}
+
 /// The report after a render, if any surface's bound was beaten.
 pub(super) fn report(objects: &Objects) -> Option<GradientExceeded> {
-    let beaten: Vec<(usize, &crate::shape::Implicit, f64)> = objects
-        .primitives
-        .iter()
+    let beaten: Vec<(usize, &crate::shape::Implicit, f64)> = shapes(objects)
         .enumerate()
         .filter_map(|(i, p)| match &p.shape {
             Shape::Implicit(shape) => shape.largest_gradient_seen().map(|seen| (i, shape, seen)),
@@ -116,5 +122,22 @@ mod tests {
         );
         forget(&objects);
         assert_eq!(report(&objects), None);
+    }
+
+    #[test]
+    fn a_surface_in_a_definition_is_reported_after_the_scenes_own() {
+        let mut world = Objects::default();
+        let sphere = Shape::Sphere(Sphere::new(Vec3::ZERO, 1.0).unwrap());
+        world.add_primitive(sphere, MaterialId(0), Transform::IDENTITY);
+        let mut definition = Objects::default();
+        let steep = implicit("10*(x^2 + y^2 + z^2 - 1)", 1.0);
+        definition.add_primitive(steep, MaterialId(0), Transform::IDENTITY);
+        let defined = world.add_definition(definition);
+        world.add_instance(defined, None, Transform::IDENTITY);
+        let ray = Ray::new(Vec3::new(-5.0, 0.2, 0.1), Vec3::new(1.0, 0.1, 0.0));
+        crate::world::World::new(&world).intersect(&ray);
+        assert_eq!(report(&world).map(|note| note.shape), Some(1));
+        forget(&world);
+        assert_eq!(report(&world), None);
     }
 }

@@ -4,19 +4,24 @@
 
 mod adaptive;
 mod camera;
+mod explain;
 mod gradient_note;
 mod merge;
 mod part;
 mod photon_pass;
 mod resources;
+mod sample_ray;
 mod scene;
 mod selection;
 mod settings;
+mod sources;
+mod trace_timing;
 
 pub use adaptive::{
     Adaptive, AdaptiveError, AntiAliasing, DEFAULT_AA_DEPTH, DEFAULT_AA_THRESHOLD, MAX_AA_DEPTH,
 };
 pub use camera::{Camera, CameraError};
+pub use explain::{ExplainError, PixelExplanation, explain_pixel};
 pub use gradient_note::GradientExceeded;
 pub use merge::{MergeError, Merged, merge_parts};
 pub use part::{
@@ -29,6 +34,8 @@ pub use selection::{PixelSelection, SelectionError, Share, Window};
 pub use settings::{
     Aov, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, MAX_SIDE, RenderSettings, check_image_size,
 };
+pub use sources::{LineIndex, ObjectSource, ObjectSources, PrimitiveDescription, SourceLocation};
+pub use trace_timing::TraceTiming;
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -42,14 +49,24 @@ use crate::integrator::{
 };
 use crate::limits::{MemoryBudget, MemoryError};
 use crate::math::Ray;
-use crate::math::random::hash64;
-use crate::math::sampling::pixel_sample;
 use crate::shading::Color;
 use crate::world::{Hit, MAX_PRIMITIVES, MaterialId, Surface, World};
 use adaptive::{AdaptivePixels, Cost};
+use sample_ray::{pixel_pattern, sample_ray};
 
 /// Side of the square tiles the image is cut into, in pixels.
 const TILE_SIZE: u32 = 16;
+
+/// The world of `scene`, its structures of the kinds its settings ask for
+/// (shared by [`render`] and [`explain_pixel`], which must trace the same).
+fn build_world(scene: &Scene) -> World<'_> {
+    let settings = &scene.settings;
+    World::build_levels(
+        &scene.objects,
+        settings.accel_top.unwrap_or(settings.accel),
+        settings.accel_bottom.unwrap_or(settings.accel),
+    )
+}
 
 /// Worker stack: a base for everything but the recursion, plus room for
 /// each level (one level measured at about 1.5 KiB in a release build; the
@@ -78,6 +95,10 @@ pub struct RenderOutput {
     pub rays: RayCounts,
     /// The kinds of rays the integrator traces, in report order.
     pub ray_kinds: &'static [RayKind],
+    /// Seconds spent building the world (its acceleration structures).
+    pub build_seconds: f64,
+    /// How long the tiles took, and how busy the threads were.
+    pub trace: TraceTiming,
     /// The thread count asked for, when it was lowered to what helps.
     pub thread_clamp: Option<ThreadClamp>,
     /// The camera samples the budget of secondary rays cut short, if any.
@@ -131,6 +152,10 @@ pub enum RenderError {
     /// The photon settings are out of range.
     #[error(transparent)]
     Photons(#[from] crate::integrator::photon_map::PhotonSettingsError),
+    /// Instances a world cannot be built from (a scene built in code; the
+    /// readers refuse them with a located message).
+    #[error("the scene's instances are invalid: {0}")]
+    Instances(#[from] crate::world::InstanceError),
     /// The films would exceed the memory budget.
     #[error(transparent)]
     Memory(#[from] MemoryError),
@@ -240,6 +265,7 @@ pub fn render_selected(
     let (width, height) = (settings.width, settings.height);
     settings.check()?;
     selection.check(width, height)?;
+    scene.objects.check_instances()?;
     let primitives = scene.objects.primitive_count();
     if primitives > MAX_PRIMITIVES {
         return Err(RenderError::TooManyPrimitives(primitives));
@@ -262,7 +288,9 @@ pub fn render_selected(
         })?;
 
     gradient_note::forget(&scene.objects);
-    let world = World::build(&scene.objects, settings.accel);
+    let build_start = std::time::Instant::now();
+    let world = build_world(scene);
+    let build_seconds = build_start.elapsed().as_secs_f64();
     let shading = Shading {
         materials: &scene.materials,
         lights: &scene.lights,
@@ -289,17 +317,20 @@ pub fn render_selected(
         rays: RayCounts::default(),
         cuts: HashMap::new(),
     });
+    let clock = trace_timing::TraceClock::start();
     pool.install(|| {
         tiles.into_par_iter().for_each(|index| {
-            let tile = render_tile(
-                &integrator,
-                &scene.camera,
-                scene.color_space,
-                settings,
-                selection,
-                index % tiles_x,
-                index / tiles_x,
-            );
+            let tile = clock.tile(|| {
+                render_tile(
+                    &integrator,
+                    &scene.camera,
+                    scene.color_space,
+                    settings,
+                    selection,
+                    index % tiles_x,
+                    index / tiles_x,
+                )
+            });
             let pixels = tile.selected;
             films
                 .lock()
@@ -309,6 +340,7 @@ pub fn render_selected(
             progress(Progress { done: now, total });
         });
     });
+    let trace = clock.finish(pool.current_num_threads());
     let films = films.into_inner().unwrap_or_else(PoisonError::into_inner);
     check_finite(&films.image)?;
     let ray_budget_cut = budget_cut(scene, &films.cuts, films.rays[RayKind::Primary]);
@@ -317,6 +349,8 @@ pub fn render_selected(
         aovs: films.aovs,
         rays: films.rays,
         ray_kinds: integrator.ray_kinds(),
+        build_seconds,
+        trace,
         thread_clamp,
         ray_budget_cut,
         gradient_exceeded: gradient_note::report(&scene.objects),
@@ -442,17 +476,11 @@ fn render_tile(
                 push_aovs(integrator, camera, settings, x, y, None, &mut tile.aovs);
                 continue;
             }
-            let pattern = hash64(u64::from(y) << 32 | u64::from(x)) as u32;
+            let pattern = pixel_pattern(x, y);
             let mut sum = Color::ZERO;
             let mut centre = None;
             for s in 0..spp {
-                let offset = pixel_sample(s, spp, pattern);
-                let ray = camera.ray(
-                    settings.width,
-                    settings.height,
-                    f64::from(x) + offset.x,
-                    f64::from(y) + offset.y,
-                );
+                let ray = sample_ray(camera, settings, (x, y), pattern, s);
                 let sample = integrator.trace_primary(&ray, &mut tile.rays);
                 if let Some(material) = sample.cut_at {
                     *tile.cuts.entry(material).or_default() += 1;
@@ -507,7 +535,19 @@ fn push_aovs(
                 data.extend_from_slice(&[n.x as f32, n.y as f32, n.z as f32]);
             }
             (Aov::Normal, None) => data.extend_from_slice(&[0.0; 3]),
-            (Aov::Id, Some((hit, _))) => data.push(hit.primitive.0 as f32),
+            (Aov::Id, Some((hit, _))) => data.push(
+                integrator
+                    .world()
+                    .placement(hit.primitive)
+                    .map_or(hit.primitive.0, |(_, p)| p) as f32,
+            ),
+            (Aov::Instance, Some((hit, _))) => data.push(
+                integrator
+                    .world()
+                    .placement(hit.primitive)
+                    .map_or(-1.0, |(k, _)| k as f32),
+            ),
+            (Aov::Instance, None) => data.push(-1.0),
             (Aov::Id, None) => data.push(-1.0),
             (Aov::Cost, _) => {
                 let counters = integrator.traversal_cost(&ray);

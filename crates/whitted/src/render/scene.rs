@@ -5,9 +5,9 @@
 use crate::image::ColorSpace;
 use crate::math::Transform;
 use crate::mesh::TriangleMesh;
-use crate::render::{Camera, RenderSettings};
-use crate::shading::{Color, Light, Material};
-use crate::shape::Shape;
+use crate::render::{Camera, ObjectSources, RenderSettings};
+use crate::shading::{Color, Light, Material, Texture};
+use crate::shape::{Shape, ShapeError};
 use crate::world::{MaterialId, MeshId, Objects};
 
 /// Everything needed to render one picture.
@@ -33,6 +33,8 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// The shapes and meshes placed in the world.
     pub objects: Objects,
+    /// Where the scene file defines each of them (for `whitted explain`).
+    pub sources: ObjectSources,
 }
 
 impl Scene {
@@ -49,7 +51,29 @@ impl Scene {
             material_names: Vec::new(),
             lights: Vec::new(),
             objects: Objects::default(),
+            sources: ObjectSources::default(),
         }
+    }
+
+    /// Adds a light; an area light also places its glowing shape, with a
+    /// material that only emits ([`crate::shading::AreaLight::glow`]), so the camera and
+    /// mirrors see it (and it stops other lights' shadow rays, as the lamp
+    /// it stands for would). Refused when the light's shape is degenerate.
+    pub fn add_light(&mut self, light: Light) -> Result<(), ShapeError> {
+        if let Light::Area(area) = &light {
+            let (shape, transform) = area.glowing_shape()?;
+            let glow = Material {
+                ambient: Texture::default(),
+                diffuse: Texture::default(),
+                emission: area.glow().into(),
+                ..Material::default()
+            };
+            let name = format!("area light {}", self.lights.len() + 1);
+            let material = self.add_named_material(&name, glow);
+            self.add_primitive(shape, material, transform);
+        }
+        self.lights.push(light);
+        Ok(())
     }
 
     /// Adds a material and returns its id.

@@ -47,16 +47,22 @@ pub enum Aov {
     /// World-space shading normal at that hit (facing the camera); 0 for a
     /// miss.
     Normal,
-    /// Index of the primitive hit, as a float; -1 for a miss.
+    /// Index of the primitive hit, as a float; -1 for a miss. Inside an
+    /// instance of a definition, the primitive's index in the definition
+    /// (see [`crate::world::World::placement`]).
     Id,
     /// Traversal cost of that ray: acceleration-structure nodes visited plus
     /// primitives tested.
     Cost,
+    /// Index of the instance of a definition hit (the world's instances,
+    /// in order), as a float; -1 for a miss or a primitive placed by the
+    /// world itself. With `Id`, it names what was hit.
+    Instance,
 }
 
 impl Aov {
     /// Every AOV.
-    pub const ALL: [Aov; 4] = [Aov::Depth, Aov::Normal, Aov::Id, Aov::Cost];
+    pub const ALL: [Aov; 5] = [Aov::Depth, Aov::Normal, Aov::Id, Aov::Cost, Aov::Instance];
 
     /// The name used on the command line.
     pub fn name(&self) -> &'static str {
@@ -65,6 +71,7 @@ impl Aov {
             Aov::Normal => "normal",
             Aov::Id => "id",
             Aov::Cost => "cost",
+            Aov::Instance => "instance",
         }
     }
 
@@ -77,7 +84,7 @@ impl Aov {
     pub fn channels(&self) -> usize {
         match self {
             Aov::Normal => 3,
-            Aov::Depth | Aov::Id | Aov::Cost => 1,
+            Aov::Depth | Aov::Id | Aov::Cost | Aov::Instance => 1,
         }
     }
 }
@@ -102,6 +109,11 @@ pub struct RenderSettings {
     pub min_weight: f64,
     /// The acceleration structure to build over the primitives.
     pub accel: AccelKind,
+    /// The structure over what the world places itself, if not `accel`.
+    pub accel_top: Option<AccelKind>,
+    /// The structure of each definition and each mesh kept as an
+    /// instance, if not `accel`.
+    pub accel_bottom: Option<AccelKind>,
     /// The algorithm that computes the colour along each camera ray.
     pub integrator: IntegratorKind,
     /// Photon-mapped caustics: off unless photons are asked for.
@@ -143,6 +155,8 @@ impl Default for RenderSettings {
             max_depth: 8,
             min_weight: 1e-3,
             accel: AccelKind::default(),
+            accel_top: None,
+            accel_bottom: None,
             integrator: IntegratorKind::default(),
             photons: PhotonSettings::default(),
             threads: None,

@@ -7,8 +7,9 @@
 //! cosine, clamped to `[0, 1]` because a spot is dark behind itself), and
 //! for a directional light, whose intensity is an irradiance, `I` times the
 //! area of the disk that covers the scene's bounds across the light's
-//! direction. Each emitted ray carries that whole flux: `N` of them, each
-//! divided by `N`, are an unbiased estimate of the light, because their
+//! direction; an area light's is `π L A` (radiance times area, Lambertian).
+//! Each emitted ray carries that whole flux: `N` of them, each divided by
+//! `N`, are an unbiased estimate of the light, because their
 //! directions (and, for a directional light, origins) are drawn in
 //! proportion to how the light spreads its intensity.
 //!
@@ -64,6 +65,7 @@ impl Light {
                 Some((_, radius)) => *intensity * (PI * radius * radius),
                 None => Color::ZERO,
             },
+            Light::Area(area) => area.power(),
         }
     }
 
@@ -79,8 +81,9 @@ impl Light {
     ///   (`u[0]`, `u[1]`) of the disk perpendicular to it that covers
     ///   `scene_bounds`, placed upstream of every corner of the bounds.
     ///
-    /// `u[2]` and `u[3]` are for lights with both a position and a
-    /// direction to choose (area lights).
+    /// - Area: a uniform point of its surface (`u[0]`, `u[1]`) and a
+    ///   cosine-weighted direction about its normal there (`u[2]`, `u[3]`);
+    ///   see [`crate::shading::area_light`].
     pub fn emit(&self, u: [f64; 4], scene_bounds: &Aabb) -> Option<EmittedRay> {
         let power = self.power(scene_bounds);
         if power.max_element().is_nan() || power.max_element() <= 0.0 {
@@ -104,6 +107,7 @@ impl Light {
                 let d = uniform_disk([u[0], u[1]]) * radius;
                 (centre + d.x * x + d.y * y, *direction)
             }
+            Light::Area(area) => return Some(area.emit(u)),
         };
         Some(EmittedRay {
             origin,
@@ -240,7 +244,7 @@ mod tests {
             assert!(close(total, light.power(&bounds), 1e-9));
             let position = match light {
                 Light::Point { position, .. } | Light::Spot { position, .. } => position,
-                Light::Directional { .. } => unreachable!(),
+                Light::Directional { .. } | Light::Area(_) => unreachable!(),
             };
             let intensity = light.sample(position + towards).unwrap().intensity;
             let expected = intensity * solid_angle;

@@ -11,15 +11,16 @@
 //! [`crate::shading::emission`]: its flux and the rays it sends out, for
 //! photon tracing).
 //!
-//! Area lights are not here yet. One will be a new variant (an emitting
-//! shape with a radiance); [`Light::sample_towards`] will pick a point on
-//! it from its two numbers, [`Light::emit`] a point and a cosine-weighted
-//! direction from its four, and shadow rays will aim at the sampled point
-//! rather than at a fixed position.
-
-use crate::shading::Color;
+//! An area light ([`crate::shading::area_light`]) is one more variant:
+//! [`Light::sample_towards`] picks a point on it from its two numbers, and
+//! [`direct_samples`] gives the stratified samples of every light that
+//! shade one point (one for a point, spot or directional light).
 
 use crate::math::Vec3;
+use crate::math::random::hash64;
+use crate::math::sampling::pixel_sample;
+use crate::shading::Color;
+use crate::shading::area_light::AreaLight;
 
 /// Distance fall-off coefficients.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -92,6 +93,8 @@ pub enum Light {
         /// How it falls off with distance.
         attenuation: Attenuation,
     },
+    /// A glowing rectangle, disk or sphere: soft shadows.
+    Area(AreaLight),
 }
 
 /// What a light delivers to one point.
@@ -99,7 +102,9 @@ pub enum Light {
 pub struct LightSample {
     /// Unit vector from the point towards the light.
     pub to_light: Vec3,
-    /// Distance to the light (infinite for directional lights).
+    /// Distance to the light (infinite for directional lights; for an area
+    /// light, just short of the sampled point, see
+    /// [`crate::shading::area_light::SHADOW_GAP`]).
     pub distance: f64,
     /// Arriving intensity, with attenuation and spot fall-off applied.
     pub intensity: Color,
@@ -107,7 +112,8 @@ pub struct LightSample {
 
 impl Light {
     /// The light arriving at `p`, or `None` when none can (outside a spot's
-    /// cone, or at the light's own position).
+    /// cone, or at the light's own position). For an area light, the whole
+    /// estimate from the middle of its sample square.
     #[inline]
     pub fn sample(&self, p: Vec3) -> Option<LightSample> {
         match self {
@@ -155,6 +161,7 @@ impl Light {
                     intensity: *intensity * (cone * attenuation.factor(distance)),
                 })
             }
+            Light::Area(area) => area.sample(p, [0.5, 0.5], 1),
         }
     }
 }
@@ -169,9 +176,59 @@ impl Light {
     /// choice's density) behind the same call.
     #[inline]
     pub fn sample_towards(&self, p: Vec3, u: [f64; 2]) -> Option<LightSample> {
-        let _ = u;
-        self.sample(p)
+        match self {
+            Light::Area(area) => area.sample(p, u, 1),
+            _ => self.sample(p),
+        }
     }
+
+    /// How many samples shade one point: an area light's `samples`, 1
+    /// for the others.
+    pub fn sample_count(&self) -> u32 {
+        match self {
+            Light::Area(area) => area.samples.max(1),
+            _ => 1,
+        }
+    }
+}
+
+/// Every sample of the direct light of `lights` at `p`, with its light
+/// and the light's index:
+/// [`Light::sample`] for a point, spot or directional light, and an area
+/// light's `samples` stratified points (Kensler's pattern over its sample
+/// square), each carrying its share of the estimate. The pattern is chosen
+/// by a hash of `p`'s coordinates, a function of the pixel sample alone,
+/// so the picture is the same for any number of threads.
+pub fn direct_samples(
+    lights: &[Light],
+    p: Vec3,
+) -> impl Iterator<Item = (usize, &Light, LightSample)> {
+    lights
+        .iter()
+        .enumerate()
+        .flat_map(move |(light_index, light)| {
+            let count = light.sample_count();
+            let pattern = match light {
+                Light::Area(_) => point_hash(p),
+                _ => 0,
+            };
+            (0..count).filter_map(move |index| {
+                let sample = match light {
+                    Light::Area(area) => {
+                        let u = pixel_sample(index, count, pattern);
+                        area.sample(p, [u.x, u.y], count)
+                    }
+                    _ => light.sample(p),
+                };
+                sample.map(|sample| (light_index, light, sample))
+            })
+        })
+}
+
+/// A 32-bit hash of a point's coordinates, to pick a sample pattern.
+fn point_hash(p: Vec3) -> u32 {
+    let h = hash64(p.x.to_bits() ^ hash64(p.y.to_bits() ^ hash64(p.z.to_bits())));
+    (h >> 32) as u32
 }
 
 fn direction_to(position: Vec3, p: Vec3) -> Option<(Vec3, f64)> {

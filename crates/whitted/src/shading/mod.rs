@@ -5,6 +5,7 @@
 //! light and sampled for the ray or photon they scatter ([`scatter`]);
 //! lights can be sampled from a point and can emit photons ([`emission`]).
 
+pub mod area_light;
 pub mod bump;
 mod color;
 pub mod emission;
@@ -17,10 +18,11 @@ pub mod scatter;
 pub mod tangent_frame;
 pub mod texture;
 
+pub use area_light::{AreaLight, Emitter};
 pub use bump::{Bump, shading_normal};
 pub use color::Color;
 pub use emission::EmittedRay;
-pub use light::{Attenuation, Light, LightSample};
+pub use light::{Attenuation, Light, LightSample, direct_samples};
 pub use material::Material;
 pub use medium::{Crossing, MediumStack};
 pub use scatter::{Lobes, ScatterKind, ScatterSample, Weights, phong};

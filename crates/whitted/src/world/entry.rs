@@ -24,6 +24,8 @@ pub(super) enum EntryKind {
     Primitive,
     /// A mesh instance, tested through its mesh's own structure.
     Instance,
+    /// An instance of a definition, tested through the definition's world.
+    Placed,
 }
 
 /// One position of a structure's index array: a number (a primitive's, a

@@ -2,7 +2,7 @@
 //! and the full world-space surface computed once for the final hit
 //! ([`Surface`]).
 
-use crate::math::{DVec2, Vec3};
+use crate::math::{DVec2, Transform, Vec3};
 use crate::shape::{LocalSurface, ShapeHit};
 use crate::world::{MaterialId, PrimitiveId};
 
@@ -55,6 +55,23 @@ impl Surface {
             dpdu: s.dpdu,
             dpdv: s.dpdv,
             material,
+        }
+    }
+
+    /// The surface seen from the space `t` carries this one's into: the
+    /// point with its error bound, the normals (renormalised) and the
+    /// tangents carried by `t`; uv and material unchanged.
+    pub(crate) fn to_outer(self, t: &Transform) -> Self {
+        let (point, point_error) = t.point_with_error_to_world(self.point, self.point_error);
+        Self {
+            point,
+            point_error,
+            normal: t.normal_to_world(self.normal).normalize(),
+            shading_normal: t.normal_to_world(self.shading_normal).normalize(),
+            uv: self.uv,
+            dpdu: t.vector_to_world(self.dpdu),
+            dpdv: t.vector_to_world(self.dpdv),
+            material: self.material,
         }
     }
 }

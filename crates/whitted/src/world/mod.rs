@@ -13,10 +13,20 @@
 //! and a ray that reaches it is carried into mesh space once. Both levels
 //! use the structure the scene asks for.
 //!
-//! Primitives are numbered once for the whole world: first the shapes of
-//! [`Objects::primitives`] in order, then the triangles of each mesh
-//! instance of [`Objects::mesh_instances`] in order. That number is what
-//! [`Hit`] reports (and the `id` AOV shows), however the instance is kept.
+//! Definitions ([`Objects::definitions`]) generalise the bottom level: each
+//! one placed somewhere is prepared once as a world of its own (with the
+//! bottom structure kind), and each of its instances is one entry of the
+//! placing level with its box there; a ray that reaches it is carried into
+//! the definition's space, unnormalised, and walks the definition's world,
+//! which may hold instances in turn.
+//!
+//! Primitives are numbered once for the whole world, as if every instance
+//! were flattened: first the shapes of [`Objects::primitives`] in order,
+//! then the triangles of each mesh instance of [`Objects::mesh_instances`]
+//! in order, then, for each instance of [`Objects::instances`] in order,
+//! the primitives of its definition numbered the same way. That number is
+//! what [`Hit`] reports, however the instance is kept, and what
+//! [`World::placement`] splits into an instance and a primitive in it.
 
 mod entry;
 mod hit;
@@ -25,7 +35,10 @@ mod objects;
 mod packet;
 
 pub use hit::{Hit, Surface};
-pub use objects::{MaterialId, MeshId, MeshInstance, Objects, Primitive, PrimitiveId, TransformId};
+pub use objects::{
+    DefinitionId, Instance, InstanceError, MAX_INSTANCE_DEPTH, MaterialId, MeshId, MeshInstance,
+    Objects, Primitive, PrimitiveId, TransformId,
+};
 pub use packet::{PACKET_SIZE, PacketHits, RayPacket};
 
 use crate::accel::{
@@ -70,7 +83,25 @@ enum PrimitiveRef {
         /// The triangle in that instance's mesh.
         triangle: u32,
     },
+    /// Primitive `primitive` of the definition placed by instance
+    /// `instance`, in that definition's numbering.
+    Placed {
+        /// Index into [`Objects::instances`].
+        instance: u32,
+        /// The primitive in the definition.
+        primitive: u32,
+    },
 }
+
+/// No objects: what a definition that nothing places is prepared as.
+static NOTHING: Objects = Objects {
+    transforms: Vec::new(),
+    primitives: Vec::new(),
+    meshes: Vec::new(),
+    mesh_instances: Vec::new(),
+    definitions: Vec::new(),
+    instances: Vec::new(),
+};
 
 /// The objects of a scene, ready for ray queries.
 #[derive(Debug)]
@@ -81,6 +112,11 @@ pub struct World<'a> {
     shapes: &'a [Primitive],
     /// The first primitive number of each mesh instance's triangles.
     instance_first: Vec<u32>,
+    /// The first primitive number of each instance of a definition.
+    placed_first: Vec<u32>,
+    /// The definitions prepared, by [`DefinitionId`] (the top level's
+    /// alone; empty in a definition's own world).
+    definitions: Vec<World<'a>>,
     /// The structure of each mesh placed as an instance (several times,
     /// or moved), by mesh id; `None` for the others.
     mesh_structures: Vec<Option<MeshStructure>>,
@@ -97,9 +133,11 @@ pub struct World<'a> {
     /// Whether the processor has AVX, so shadow rays test runs of a leaf's
     /// triangles four at a time.
     wide_triangles: bool,
-    /// The unbounded shapes (infinite planes), tested beside the structure.
-    unbounded: Vec<u32>,
-    /// How many mesh instances are kept as instances.
+    /// The unbounded shapes (infinite planes) and instances of definitions
+    /// holding one, tested beside the structure.
+    unbounded: Vec<Entry>,
+    /// How many entries walk a structure of their own: mesh instances kept
+    /// as instances and instances of definitions.
     instance_count: usize,
     /// How many primitives there are.
     primitive_count: usize,
@@ -115,15 +153,67 @@ impl<'a> World<'a> {
     ///
     /// # Panics
     ///
-    /// When the objects have more than [`MAX_PRIMITIVES`] primitives
-    /// (placements counted): the renderer refuses such a scene
-    /// with an error before building its world.
+    /// As [`Self::build_levels`].
     pub fn build(objects: &'a Objects, kind: AccelKind) -> Self {
+        Self::build_levels(objects, kind, kind)
+    }
+
+    /// Prepares the objects with the structure `top` over what the world
+    /// places and `bottom` for each definition and each mesh kept as an
+    /// instance. Definitions that nothing places are not prepared.
+    ///
+    /// # Panics
+    ///
+    /// When the objects have more than [`MAX_PRIMITIVES`] primitives
+    /// (placements counted) or instances that
+    /// [`Objects::check_instances`] refuses: the renderer refuses such a
+    /// scene with an error before building its world.
+    pub fn build_levels(objects: &'a Objects, top: AccelKind, bottom: AccelKind) -> Self {
         let n = objects.primitive_count();
         assert!(
             n <= MAX_PRIMITIVES,
             "{n} primitives: a world numbers at most {MAX_PRIMITIVES}"
         );
+        if let Err(error) = objects.check_instances() {
+            panic!("the world's instances are invalid: {error}");
+        }
+        // Which definitions something placed places (a definition places
+        // only earlier ones, so one pass from the last finds them all).
+        let mut placed = vec![false; objects.definitions.len()];
+        for i in &objects.instances {
+            placed[i.definition.0 as usize] = true;
+        }
+        for d in (0..placed.len()).rev() {
+            if placed[d] {
+                for i in &objects.definitions[d].instances {
+                    placed[i.definition.0 as usize] = true;
+                }
+            }
+        }
+        let mut definitions: Vec<World<'a>> = Vec::with_capacity(placed.len());
+        for (d, definition) in objects.definitions.iter().enumerate() {
+            let level = Self::build_level(
+                if placed[d] { definition } else { &NOTHING },
+                bottom,
+                bottom,
+                &definitions,
+            );
+            definitions.push(level);
+        }
+        let mut world = Self::build_level(objects, top, bottom, &definitions);
+        world.definitions = definitions;
+        world
+    }
+
+    /// One level: `objects` under a structure of `kind`, its meshes kept as
+    /// instances under structures of `bottom`, its instances placing
+    /// `definitions` (prepared already).
+    fn build_level(
+        objects: &'a Objects,
+        kind: AccelKind,
+        bottom: AccelKind,
+        definitions: &[World<'a>],
+    ) -> Self {
         let to_world =
             |transform: Option<TransformId>, local: Aabb| match objects.transform(transform) {
                 Some(t) => t.bounds_to_world(&local),
@@ -137,6 +227,13 @@ impl<'a> World<'a> {
             instance_first.push(next);
             next += mesh_len(m);
         }
+        let definition = |i: &Instance| &definitions[i.definition.0 as usize];
+        let mut placed_first = Vec::with_capacity(objects.instances.len());
+        for i in &objects.instances {
+            placed_first.push(next);
+            next += definition(i).primitive_count as u32;
+        }
+        let n = next as usize;
         // A mesh placed more than once, or moved, is kept as an instance.
         let mut placements = vec![0u32; objects.meshes.len()];
         for m in &objects.mesh_instances {
@@ -151,7 +248,7 @@ impl<'a> World<'a> {
             if slot.is_none() {
                 *slot = Some(MeshStructure::build(
                     &objects.meshes[m.mesh.0 as usize],
-                    kind,
+                    bottom,
                 ));
             }
         }
@@ -167,7 +264,10 @@ impl<'a> World<'a> {
             .map(|m| objects.meshes[m.mesh.0 as usize].len())
             .sum();
         let mut boxes = Vec::with_capacity(
-            objects.primitives.len() + placed_directly + objects.mesh_instances.len(),
+            objects.primitives.len()
+                + placed_directly
+                + objects.mesh_instances.len()
+                + objects.instances.len(),
         );
         let mut slot_shapes = Vec::new();
         let mut unbounded = Vec::new();
@@ -177,7 +277,7 @@ impl<'a> World<'a> {
                 boxes.push(to_world(p.transform, local));
                 slot_shapes.push(i as u32);
             } else {
-                unbounded.push(i as u32);
+                unbounded.push(Entry::other(i as u32, EntryKind::Primitive));
             }
         }
         // The first slot of each directly placed mesh's run of triangles,
@@ -210,6 +310,19 @@ impl<'a> World<'a> {
                 slot_instances.push(k as u32);
             }
         }
+        // An instance of a definition with an unbounded shape is tested
+        // beside the structure; one of an empty definition is left out.
+        let first_placed_slot = boxes.len() as u32;
+        let mut slot_placed = Vec::new();
+        for (k, i) in objects.instances.iter().enumerate() {
+            let inner = definition(i);
+            if !inner.unbounded.is_empty() {
+                unbounded.push(Entry::other(k as u32, EntryKind::Placed));
+            } else if !inner.bounds.is_empty() {
+                boxes.push(to_world(i.transform, inner.bounds));
+                slot_placed.push(k as u32);
+            }
+        }
         let bounds = boxes
             .par_chunks(PARALLEL_CHUNK)
             .map(|chunk| chunk.iter().fold(Aabb::EMPTY, |a, b| a.union(b)))
@@ -234,6 +347,10 @@ impl<'a> World<'a> {
                     } => Entry::triangle(i, t.vertices()),
                     _ => Entry::other(i, EntryKind::Primitive),
                 };
+            }
+            if slot >= first_placed_slot {
+                let k = slot_placed[(slot - first_placed_slot) as usize];
+                return Entry::other(k, EntryKind::Placed);
             }
             if slot >= first_instance_slot {
                 let k = slot_instances[(slot - first_instance_slot) as usize];
@@ -266,6 +383,10 @@ impl<'a> World<'a> {
             .map(|entry| slot_entry(order.map_or(entry as u32, |o| o[entry])))
             .collect();
         let has_triangles = entries.par_iter().any(|e| e.kind == EntryKind::Triangle);
+        let unbounded_placed = unbounded
+            .iter()
+            .filter(|e| e.kind == EntryKind::Placed)
+            .count();
         #[cfg(target_arch = "x86_64")]
         let wide_triangles = is_x86_feature_detected!("avx");
         #[cfg(not(target_arch = "x86_64"))]
@@ -274,6 +395,8 @@ impl<'a> World<'a> {
             objects,
             shapes: &objects.primitives,
             instance_first,
+            placed_first,
+            definitions: Vec::new(),
             mesh_structures,
             accel,
             bounds,
@@ -281,7 +404,7 @@ impl<'a> World<'a> {
             has_triangles,
             wide_triangles,
             unbounded,
-            instance_count: slot_instances.len(),
+            instance_count: slot_instances.len() + slot_placed.len() + unbounded_placed,
             primitive_count: n,
         }
     }
@@ -290,6 +413,15 @@ impl<'a> World<'a> {
     fn primitive_ref(&self, number: u32) -> PrimitiveRef {
         if (number as usize) < self.objects.primitives.len() {
             return PrimitiveRef::Shape(number);
+        }
+        if let Some(&first) = self.placed_first.first()
+            && number >= first
+        {
+            let instance = self.placed_first.partition_point(|&f| f <= number) - 1;
+            return PrimitiveRef::Placed {
+                instance: instance as u32,
+                primitive: number - self.placed_first[instance],
+            };
         }
         let instance = self
             .instance_first
@@ -347,6 +479,7 @@ impl<'a> World<'a> {
     #[inline]
     fn intersect_other(
         &self,
+        definitions: &[World<'a>],
         e: &Entry,
         query: &Query,
         t_max: f64,
@@ -358,18 +491,53 @@ impl<'a> World<'a> {
                 let (triangle, hit) = structure.intersect(&local, t_max, inner)?;
                 Some((self.instance_first[e.number as usize] + triangle, hit))
             }
+            EntryKind::Placed => {
+                let (definition, mut local) = self.placed_ray(definitions, e.number, query.ray);
+                local.t_max = t_max;
+                let hit = definition.closest(definitions, &local, inner)?;
+                Some((
+                    self.placed_first[e.number as usize] + hit.primitive.0,
+                    hit.shape_hit,
+                ))
+            }
             _ => Some((e.number, self.intersect_shape(e.number, query, t_max)?)),
         }
+    }
+
+    /// Instance `k` of a definition and the definition's world, with the
+    /// ray carried into the definition's space.
+    #[inline]
+    fn placed_ray<'w>(
+        &self,
+        definitions: &'w [World<'a>],
+        k: u32,
+        ray: &Ray,
+    ) -> (&'w World<'a>, Ray) {
+        let i = &self.objects.instances[k as usize];
+        let local = self
+            .transform(i.transform)
+            .map_or(*ray, |t| t.ray_to_object(ray));
+        (&definitions[i.definition.0 as usize], local)
     }
 
     /// True when the entry `e` (a shape or an instance) lies in the query's
     /// ray interval.
     #[inline]
-    fn other_occludes(&self, e: &Entry, query: &Query, inner: &mut QueryContext) -> bool {
+    fn other_occludes(
+        &self,
+        definitions: &[World<'a>],
+        e: &Entry,
+        query: &Query,
+        inner: &mut QueryContext,
+    ) -> bool {
         match e.kind {
             EntryKind::Instance => {
                 let (structure, local) = self.instance_ray(e.number, query.ray);
                 structure.occluded(&local, self.wide_triangles, inner)
+            }
+            EntryKind::Placed => {
+                let (definition, local) = self.placed_ray(definitions, e.number, query.ray);
+                definition.any(definitions, &local, inner)
             }
             _ => self.shape_occludes(e.number, query),
         }
@@ -401,10 +569,24 @@ impl<'a> World<'a> {
         &self.accel
     }
 
-    /// How many mesh instances are kept as instances, each walking its
-    /// mesh's own structure.
+    /// How many entries of the top level walk a structure of their own:
+    /// mesh instances kept as instances and instances of definitions.
     pub fn instance_count(&self) -> usize {
         self.instance_count
+    }
+
+    /// Where primitive `primitive` is placed: `Some((k, p))` when it is
+    /// primitive `p` (in its definition's numbering) of the world's
+    /// instance `k` of a definition ([`Objects::instances`]); `None` when
+    /// the world places it itself.
+    pub fn placement(&self, primitive: PrimitiveId) -> Option<(u32, u32)> {
+        match self.primitive_ref(primitive.0) {
+            PrimitiveRef::Placed {
+                instance,
+                primitive,
+            } => Some((instance, primitive)),
+            _ => None,
+        }
     }
 
     /// The closest hit in the ray's interval.
@@ -415,21 +597,28 @@ impl<'a> World<'a> {
     /// The closest hit, walking as `ctx` says the rays relate and adding
     /// the traversal work (of both levels) to its counters.
     pub fn intersect_with(&self, ray: &Ray, ctx: &mut QueryContext) -> Option<Hit> {
+        self.closest(&self.definitions, ray, ctx)
+    }
+
+    /// The closest hit in this level, its instances placing `definitions`.
+    fn closest(&self, definitions: &[World<'a>], ray: &Ray, ctx: &mut QueryContext) -> Option<Hit> {
         let query = Query::new(ray, self.has_triangles);
         let mut best: Option<Hit> = None;
         let mut t_max = ray.t_max;
-        for &i in &self.unbounded {
-            if let Some(h) = self.intersect_shape(i, &query, t_max) {
+        let mut inner = QueryContext::new(ctx.coherence);
+        for e in &self.unbounded {
+            if let Some((primitive, h)) =
+                self.intersect_other(definitions, e, &query, t_max, &mut inner)
+            {
                 t_max = h.t;
                 best = Some(Hit {
-                    primitive: PrimitiveId(i),
+                    primitive: PrimitiveId(primitive),
                     shape_hit: h,
                 });
             }
         }
         let mut clipped = *ray;
         clipped.t_max = t_max;
-        let mut inner = QueryContext::new(ctx.coherence);
         self.accel
             .intersect_in_leaf_order(&clipped, ctx, |range, t_max| {
                 leaf_hit(
@@ -437,7 +626,7 @@ impl<'a> World<'a> {
                     range,
                     &query,
                     t_max,
-                    |e, t_max| self.intersect_other(e, &query, t_max, &mut inner),
+                    |e, t_max| self.intersect_other(definitions, e, &query, t_max, &mut inner),
                     |primitive, shape_hit| {
                         best = Some(Hit {
                             primitive: PrimitiveId(primitive),
@@ -458,12 +647,19 @@ impl<'a> World<'a> {
     /// Any hit, walking as `ctx` says the rays relate and adding the
     /// traversal work (of both levels) to its counters.
     pub fn occluded_with(&self, ray: &Ray, ctx: &mut QueryContext) -> bool {
+        self.any(&self.definitions, ray, ctx)
+    }
+
+    /// Any hit in this level, its instances placing `definitions`.
+    fn any(&self, definitions: &[World<'a>], ray: &Ray, ctx: &mut QueryContext) -> bool {
         let query = Query::new(ray, self.has_triangles);
+        let mut inner = QueryContext::new(ctx.coherence);
         if self
             .unbounded
             .iter()
-            .any(|&i| self.shape_occludes(i, &query))
+            .any(|e| self.other_occludes(definitions, e, &query, &mut inner))
         {
+            ctx.counters += inner.counters;
             return true;
         }
         if self.instance_count == 0 {
@@ -475,10 +671,9 @@ impl<'a> World<'a> {
                 })
             });
         }
-        let mut inner = QueryContext::new(ctx.coherence);
         let occluded = self.accel.occluded_in_leaf_order(ray, ctx, |range| {
             leaf_occludes(&self.entries, range, &query, self.wide_triangles, |e| {
-                self.other_occludes(e, &query, &mut inner)
+                self.other_occludes(definitions, e, &query, &mut inner)
             })
         });
         ctx.counters += inner.counters;
@@ -508,17 +703,33 @@ impl<'a> World<'a> {
 
     /// The world-space surface at a hit returned for `ray`.
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> Surface {
-        let (local, shading_normal, material, transform) = match self.primitive_ref(hit.primitive.0)
-        {
+        self.surface_in(
+            &self.definitions,
+            ray,
+            hit.primitive.0,
+            &hit.shape_hit,
+            None,
+        )
+    }
+
+    /// The surface of primitive `number` of this level hit by `ray` (in
+    /// this level's space), in this level's space; `material`, if given,
+    /// replaces the primitive's own (an enclosing instance's override).
+    fn surface_in(
+        &self,
+        definitions: &[World<'a>],
+        ray: &Ray,
+        number: u32,
+        shape_hit: &ShapeHit,
+        material: Option<MaterialId>,
+    ) -> Surface {
+        let (local, shading_normal, own, transform) = match self.primitive_ref(number) {
             PrimitiveRef::Shape(i) => {
                 let p = &self.objects.primitives[i as usize];
                 let transform = self.transform(p.transform);
                 let object_ray = transform.map_or(*ray, |t| t.ray_to_object(ray));
-                let s = p.shape.surface(&object_ray, &hit.shape_hit);
-                let material = p
-                    .shape
-                    .material(&hit.shape_hit)
-                    .map_or(p.material, MaterialId);
+                let s = p.shape.surface(&object_ray, shape_hit);
+                let material = p.shape.material(shape_hit).map_or(p.material, MaterialId);
                 (s, s.normal, material, transform)
             }
             PrimitiveRef::Triangle { instance, triangle } => {
@@ -526,27 +737,23 @@ impl<'a> World<'a> {
                 let transform = self.transform(m.transform);
                 let object_ray = transform.map_or(*ray, |t| t.ray_to_object(ray));
                 let mesh = &self.objects.meshes[m.mesh.0 as usize];
-                let s = mesh.surface(triangle, &object_ray, &hit.shape_hit);
+                let s = mesh.surface(triangle, &object_ray, shape_hit);
                 (s.local, s.shading_normal, m.material, transform)
             }
-        };
-        match transform {
-            None => Surface::from_local(local, shading_normal, material),
-            Some(t) => {
-                let (point, point_error) =
-                    t.point_with_error_to_world(local.point, local.point_error);
-                Surface {
-                    point,
-                    point_error,
-                    normal: t.normal_to_world(local.normal).normalize(),
-                    shading_normal: t.normal_to_world(shading_normal).normalize(),
-                    uv: local.uv,
-                    dpdu: t.vector_to_world(local.dpdu),
-                    dpdv: t.vector_to_world(local.dpdv),
-                    material,
-                }
+            PrimitiveRef::Placed {
+                instance,
+                primitive,
+            } => {
+                let i = &self.objects.instances[instance as usize];
+                let (definition, local_ray) = self.placed_ray(definitions, instance, ray);
+                let material = material.or(i.material);
+                let s =
+                    definition.surface_in(definitions, &local_ray, primitive, shape_hit, material);
+                return self.transform(i.transform).map_or(s, |t| s.to_outer(t));
             }
-        }
+        };
+        let s = Surface::from_local(local, shading_normal, material.unwrap_or(own));
+        transform.map_or(s, |t| s.to_outer(t))
     }
 }
 
@@ -844,6 +1051,43 @@ mod tests {
             }
             assert!(hits > 60, "{kind:?}: {hits} hits");
         }
+    }
+
+    #[test]
+    fn the_work_of_both_levels_is_counted() {
+        // Brute force at both levels: a ray through the instance tests the
+        // instance entry and then every triangle of the definition, nested
+        // one level deeper still.
+        let mut rng = Rng::new(3);
+        let mut leaf = Objects::default();
+        let positions: Vec<Vec3> = (0..150)
+            .map(|_| rng.point_in(Vec3::splat(-1.0), Vec3::splat(1.0)))
+            .collect();
+        let triangles: Vec<[u32; 3]> = (0..50).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        let mesh = leaf.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
+        leaf.add_mesh_instance(mesh, MaterialId(0), Transform::IDENTITY);
+        let mut objects = Objects::default();
+        let leaf = objects.add_definition(leaf);
+        let mut group = Objects::default();
+        group.add_instance(leaf, None, Transform::scale(Vec3::splat(2.0)).unwrap());
+        let group = objects.add_definition(group);
+        objects.add_instance(group, None, Transform::translate(Vec3::X).unwrap());
+        let world = World::build(&objects, AccelKind::Linear);
+        let ray = Ray::new(Vec3::new(1.0, 0.0, -10.0), Vec3::Z);
+        // The leaf alone, with the ray carried into its space.
+        let alone = World::build(&objects.definitions[0], AccelKind::Linear);
+        let local = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z * 0.5);
+        let mut leaf_ctx = QueryContext::default();
+        assert!(alone.intersect_with(&local, &mut leaf_ctx).is_some());
+        assert!(leaf_ctx.counters.primitives > 1);
+        let mut ctx = QueryContext::default();
+        assert!(world.intersect_with(&ray, &mut ctx).is_some());
+        // The group's entry, the leaf's entry, then the leaf's triangles.
+        assert_eq!(ctx.counters.primitives, 2 + leaf_ctx.counters.primitives);
+        assert_eq!(ctx.counters.nodes, 2 + leaf_ctx.counters.nodes);
+        let mut ctx = QueryContext::default();
+        assert!(world.occluded_with(&ray, &mut ctx));
+        assert!(ctx.counters.primitives > 2);
     }
 
     #[test]

@@ -85,12 +85,16 @@ pub fn parse_bpt(source: &str, path: &Path) -> Result<LoadedScene, SceneError> {
     scene.ambient = Color::splat(AMBIENT);
     scene.lights = vec![headlight(&scene.camera)];
     let material = scene.add_material(Material::default());
-    for patch in patches {
+    for (index, patch) in patches.into_iter().enumerate() {
         scene.add_primitive(
             Shape::BezierPatch(patch),
             material,
             crate::math::Transform::IDENTITY,
         );
+        scene.sources.primitives.push(crate::render::ObjectSource {
+            label: format!("patch {}", index + 1),
+            location: None,
+        });
     }
     Ok(LoadedScene {
         scene,

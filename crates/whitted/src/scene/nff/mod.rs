@@ -47,7 +47,7 @@ use self::shapes::{Placed, flat_shape, read_cone, read_polygon, read_sphere};
 use self::view::{View, read_view};
 use crate::image::ColorSpace;
 use crate::math::{Transform, Vec3};
-use crate::render::{RenderSettings, Scene};
+use crate::render::{LineIndex, ObjectSource, ObjectSources, RenderSettings, Scene};
 use crate::scene::{SceneError, without_bom};
 use crate::shading::Color;
 use crate::shading::Material;
@@ -67,9 +67,9 @@ pub fn parse_nff(source: &str, path: &Path) -> Result<Scene, SceneError> {
             "b" => read_background(&mut r).and_then(|b| document.set_background(&mut r, b, at)),
             "l" => read_light(&mut r).map(|light| document.lights.push(light)),
             "f" => read_fill(&mut r).map(|fill| document.set_fill(fill)),
-            "s" => read_sphere(&mut r, at).map(|placed| document.add(placed)),
-            "c" => read_cone(&mut r, at).map(|placed| document.add(placed)),
-            "p" => read_polygon(&mut r, at).map(|placed| document.add(placed)),
+            "s" => read_sphere(&mut r, at.clone()).map(|placed| document.add(placed, at, "s")),
+            "c" => read_cone(&mut r, at.clone()).map(|placed| document.add(placed, at, "c")),
+            "p" => read_polygon(&mut r, at.clone()).map(|placed| document.add(placed, at, "p")),
             "pp" => {
                 let material = document.material();
                 read_patch(&mut r, at, material).map(|patch| document.patches.patches.push(patch))
@@ -81,7 +81,11 @@ pub fn parse_nff(source: &str, path: &Path) -> Result<Scene, SceneError> {
             r.skip_to_entity();
         }
     }
-    let scene = document.finish(&mut r);
+    let sources = object_sources(source, &document);
+    let scene = document.finish(&mut r).map(|mut scene| {
+        scene.sources = sources;
+        scene
+    });
     let diagnostics = r.into_diagnostics();
     match scene {
         Some(scene) if diagnostics.is_empty() => Ok(scene),
@@ -115,6 +119,8 @@ struct Document {
     current: Option<MaterialId>,
     /// Shapes with their placements and materials, in file order.
     objects: Vec<(Placed, MaterialId)>,
+    /// Each shape's entity keyword and where it starts.
+    object_entities: Vec<(&'static str, usize)>,
     patches: PatchSet,
 }
 
@@ -164,9 +170,10 @@ impl Document {
         })
     }
 
-    fn add(&mut self, placed: Placed) {
+    fn add(&mut self, placed: Placed, at: Range<usize>, entity: &'static str) {
         let material = self.material();
         self.objects.push((placed, material));
+        self.object_entities.push((entity, at.start));
     }
 
     /// The scene, once every entity is read; `None` without a view.
@@ -215,6 +222,39 @@ impl Document {
             scene.add_mesh_instance(mesh, material, Transform::IDENTITY);
         }
         Some(scene)
+    }
+}
+
+/// Where each shape and each run of patches of `document` (read from
+/// `source`) is defined: `s 3` is the file's third sphere.
+fn object_sources(source: &str, document: &Document) -> ObjectSources {
+    let lines = LineIndex::new(source);
+    let mut seen: HashMap<&str, usize> = HashMap::new();
+    let primitives = document
+        .object_entities
+        .iter()
+        .map(|&(entity, start)| {
+            let count = seen.entry(entity).or_default();
+            *count += 1;
+            ObjectSource {
+                label: format!("{entity} {count}"),
+                location: Some(lines.location(start)),
+            }
+        })
+        .collect();
+    // One mesh per run of patches of one material (see `patches_to_meshes`).
+    let mesh_instances = document
+        .patches
+        .patches
+        .chunk_by(|a, b| a.material == b.material)
+        .map(|run| ObjectSource {
+            label: format!("pp ({} patches)", run.len()),
+            location: Some(lines.location(run[0].span.start)),
+        })
+        .collect();
+    ObjectSources {
+        primitives,
+        mesh_instances,
     }
 }
 

@@ -33,7 +33,7 @@ use self::mtl::read_library;
 use self::reader::{NONE, ObjData, read_obj};
 use crate::math::{Aabb, Transform};
 use crate::render::Camera;
-use crate::render::{RenderSettings, Scene};
+use crate::render::{LineIndex, ObjectSource, RenderSettings, Scene};
 use crate::scene::{
     Diagnostic, LoadedScene, SceneError, Severity, limit_warnings, push_limited, without_bom,
 };
@@ -144,6 +144,7 @@ fn build_scene(
     scene.settings = settings;
     scene.ambient = Color::splat(AMBIENT);
     scene.lights = vec![headlight(&scene.camera)];
+    let lines = LineIndex::new(source);
     for (slot, mesh) in meshes {
         let material = if slot == NONE {
             Material::default()
@@ -161,10 +162,17 @@ fn build_scene(
                 Material::default()
             })
         };
-        let name = data.material_uses.get(slot as usize).map_or("", |(n, _)| n);
+        let used = data.material_uses.get(slot as usize);
+        let name = used.map_or("", |(n, _)| n);
         let material: MaterialId = scene.add_named_material(name, material);
         let mesh = scene.add_mesh(mesh);
         scene.add_mesh_instance(mesh, material, Transform::IDENTITY);
+        scene.sources.mesh_instances.push(ObjectSource {
+            label: used.map_or("the faces before any usemtl".into(), |(name, _)| {
+                format!("the faces of usemtl {name}")
+            }),
+            location: used.map(|(_, span)| lines.location(span.start)),
+        });
     }
     warnings.sort_by_key(|d| (d.path.clone(), d.line, d.column));
     Ok(scene)

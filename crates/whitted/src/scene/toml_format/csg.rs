@@ -19,6 +19,7 @@
 
 use toml_span::value::Value;
 
+use super::definition::Item;
 use super::object::{Object, read_object, read_transform, unknown_material};
 use super::reader::{Parsed, Reader, all, list};
 use crate::math::{Transform, magnitude};
@@ -112,7 +113,18 @@ pub(super) fn read(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) 
 
 /// One child: an object that must be a closed solid.
 fn read_child(r: &mut Reader<'_>, value: &Value<'_>, materials: &[String]) -> Parsed<CsgChild> {
-    let objects = read_object(r, value, materials)?;
+    let items = read_object(r, value, materials)?;
+    let objects = items
+        .into_iter()
+        .map(|item| match item {
+            Item::Object(object) => Ok(object),
+            Item::Instance(_) => Err(r.error(
+                value.span,
+                "an instance cannot be a CSG child yet: place the shapes themselves as children"
+                    .to_string(),
+            )),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
     let [object] = <[Object; 1]>::try_from(objects).map_err(|objects| {
         r.error(
             value.span,

@@ -20,11 +20,13 @@
 //! falloff = 4                     # Warn exponent, default 0
 //! ```
 //!
-//! Directions are normalised; a zero direction is an error.
+//! Directions are normalised; a zero direction is an error. Area lights
+//! (`rect`, `disk`, `sphere`) are read in `area_light.rs`.
 
 use toml_span::Span;
 use toml_span::value::Value;
 
+use super::area_light::{AREA_KINDS, read_area_light};
 use super::reader::{Parsed, Reader, all, list};
 use crate::shading::Color;
 use crate::shading::{Attenuation, Light};
@@ -45,6 +47,9 @@ const KINDS: &[(&str, &[&str])] = &[
             "falloff",
         ],
     ),
+    AREA_KINDS[0],
+    AREA_KINDS[1],
+    AREA_KINDS[2],
 ];
 
 /// Reads the `[[lights]]` array, if any.
@@ -81,6 +86,11 @@ fn read_light(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Light> {
                 intensity: intensity?,
                 attenuation: attenuation?,
             }
+        }
+        "rect" | "disk" | "sphere" => {
+            let light = read_area_light(r, &f, kind);
+            keys?;
+            return light;
         }
         "directional" => {
             let direction = r.require(&f, "direction", Reader::direction);
@@ -244,7 +254,7 @@ mod tests {
         assert_eq!(
             errors(&format!(
                 "{CAMERA}[[lights]]\nposition = [0, 0, 0]\ncolour = 3\nfoo = 1\n\
-                 [[lights]]\ntype = 'sun'\nangle = 10\nintensity = -1\nradius = 2\n\
+                 [[lights]]\ntype = 'sun'\nangle = 10\nintensity = -1\nsize = 2\n\
                  [[lights]]\ntype = 'point'\npositon = [0, 0, 0]\nattenuation = [0, 0, 0]\n\
                  [[lights]]\ntype = 'directional'\ndirection = [0, 0, 0]\nangle = 3\n\
                  [[lights]]\ntype = 'spot'\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n\
@@ -253,13 +263,17 @@ mod tests {
             [
                 "missing required key `type` in light",
                 "unknown key `colour` in light; none of the light types has it; expected one \
-                 of: type, position, intensity, attenuation, direction, angle, falloff",
+                 of: type, position, intensity, attenuation, direction, angle, falloff, origin, \
+                 edge_u, edge_v, radiance, power, samples, center, normal, radius",
                 "unknown key `foo` in light; none of the light types has it; expected one \
-                 of: type, position, intensity, attenuation, direction, angle, falloff",
-                "unknown light type `sun`; expected one of: point, directional, spot",
+                 of: type, position, intensity, attenuation, direction, angle, falloff, origin, \
+                 edge_u, edge_v, radiance, power, samples, center, normal, radius",
+                "unknown light type `sun`; expected one of: point, directional, spot, rect, disk, \
+                 sphere",
                 "`intensity` must not be negative, got -1",
-                "unknown key `radius` in light; none of the light types has it; expected one \
-                 of: type, position, intensity, attenuation, direction, angle, falloff",
+                "unknown key `size` in light; none of the light types has it; expected one \
+                 of: type, position, intensity, attenuation, direction, angle, falloff, origin, \
+                 edge_u, edge_v, radiance, power, samples, center, normal, radius",
                 "missing required key `position` in point light",
                 "unknown key `positon` in point light; expected one of: type, position, \
                  intensity, attenuation",

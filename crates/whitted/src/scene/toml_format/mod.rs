@@ -35,7 +35,9 @@
 //! constructors refuse.
 
 mod anti_aliasing;
+mod area_light;
 mod csg;
+mod definition;
 mod light;
 mod material;
 mod object;
@@ -50,12 +52,13 @@ use std::path::Path;
 use toml_span::Span;
 use toml_span::value::Value;
 
+use self::definition::Item;
 use self::reader::{Parsed, Reader};
 use crate::image::ColorSpace;
 use crate::math::Vec3;
 use crate::render::{Camera, CameraError};
 use crate::render::{MAX_DEPTH, MAX_SAMPLES, MAX_SIDE, check_image_size};
-use crate::render::{RenderSettings, Scene};
+use crate::render::{ObjectSource, RenderSettings, Scene};
 use crate::scene::{Diagnostic, SceneError, without_bom};
 use crate::shading::Color;
 use crate::shading::Material;
@@ -103,7 +106,14 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
 }
 
 /// The keys allowed at the top level.
-const SECTIONS: &[&str] = &["render", "camera", "materials", "lights", "objects"];
+const SECTIONS: &[&str] = &[
+    "render",
+    "camera",
+    "materials",
+    "lights",
+    "objects",
+    "definitions",
+];
 
 /// Walks the whole document.
 fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
@@ -123,6 +133,7 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
     let materials = material::read_materials(r, top.get("materials"));
     let lights = light::read_lights(r, top.get("lights"));
     let objects = object::read_objects(r, top.get("objects"), &materials.names);
+    let definitions = definition::read_definitions(r, top.get("definitions"), &materials.names);
     keys?;
     let render = render?;
     let mut scene = Scene::new(camera?);
@@ -130,20 +141,49 @@ fn read_document(r: &mut Reader<'_>, root: &Value<'_>) -> Parsed<Scene> {
     scene.background = render.background;
     scene.ambient = render.ambient;
     scene.color_space = render.color_space;
-    scene.lights = lights?;
+    let lights = lights?;
     for (material, name) in materials.list?.into_iter().zip(&materials.names) {
         scene.add_named_material(name, material);
     }
-    let objects = objects?;
+    let (objects, definitions) = (objects?, definitions?);
     let default_material = MaterialId(scene.materials.len() as u32);
-    if objects.iter().any(|object| object.material.is_none()) {
+    let (tables, objects): (Vec<usize>, Vec<Item>) = objects.into_iter().unzip();
+    if definition::needs_default_material(&objects, &definitions) {
         scene.add_material(Material::default());
     }
-    for object in objects {
-        let material = object
-            .material
-            .map_or(default_material, |index| MaterialId(index as u32));
-        scene.add_primitive(object.shape, material, object.transform);
+    // Where each shape the scene places itself is defined, in the order
+    // they are added (instances are not shapes of the top level).
+    let arrays = top.get("objects").and_then(|value| value.as_array());
+    let lines = r.line_index();
+    for (table, _) in tables
+        .iter()
+        .zip(&objects)
+        .filter(|(_, item)| matches!(item, Item::Object(_)))
+    {
+        let span = arrays.and_then(|arrays| arrays.get(*table)).map(|t| t.span);
+        scene.sources.primitives.push(ObjectSource {
+            label: format!("objects[{table}]"),
+            location: span.map(|span| lines.location(span.start)),
+        });
+    }
+    definition::place_all(r, &mut scene, objects, definitions, default_material)?;
+    let light_tables = top.get("lights").and_then(|value| value.as_array());
+    for (index, light) in lights.into_iter().enumerate() {
+        let shapes = scene.objects.primitives.len();
+        // Area lights' shapes were checked where they were read.
+        scene
+            .add_light(light)
+            .map_err(|e| r.error(Span::new(0, 0), e.to_string()))?;
+        if scene.objects.primitives.len() > shapes {
+            // The glowing shape of an area light, named as the light.
+            let span = light_tables
+                .and_then(|tables| tables.get(index))
+                .map(|t| t.span);
+            scene.sources.primitives.push(ObjectSource {
+                label: format!("lights[{index}]"),
+                location: span.map(|span| lines.location(span.start)),
+            });
+        }
     }
     Ok(scene)
 }
@@ -167,6 +207,8 @@ const RENDER_KEYS: &[&str] = &[
     "background",
     "ambient",
     "accel",
+    "accel_top",
+    "accel_bottom",
     "colours",
     photons::PHOTON_KEYS[0],
     photons::PHOTON_KEYS[1],
@@ -204,6 +246,8 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
     let background = r.or_default(&f, "background", Color::ZERO, Reader::color);
     let ambient = r.or_default(&f, "ambient", Color::ZERO, Reader::color);
     let accel = r.or_default(&f, "accel", d.accel, read_accel);
+    let accel_top = r.optional(&f, "accel_top", read_accel);
+    let accel_bottom = r.optional(&f, "accel_bottom", read_accel);
     let color_space = r.or_default(&f, "colours", ColorSpace::Linear, read_color_space);
     let photons = photons::read_photons(r, &f);
     let aa = anti_aliasing::read_anti_aliasing(r, &f);
@@ -218,6 +262,8 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
             min_weight: min_weight?,
             accel: accel?,
             photons: photons?,
+            accel_top: accel_top?,
+            accel_bottom: accel_bottom?,
             aa: aa?,
             ..d
         },
@@ -369,7 +415,8 @@ pub(super) mod tests {
                 "expected 3 numbers for `background`, found 2",
                 "`ambient` must not be negative, got -1",
                 "unknown key `size` in [render]; expected one of: width, height, samples, \
-                 max_depth, min_weight, background, ambient, accel, colours, photons, gather, radius, aa, aa_threshold, aa_depth, aa_min_depth",
+                 max_depth, min_weight, background, ambient, accel, accel_top, accel_bottom, colours, \
+                 photons, gather, radius, aa, aa_threshold, aa_depth, aa_min_depth",
                 "unknown acceleration structure `octree`; expected one of: bvh, kdtree, grid, linear",
                 "unknown colour convention `srgb` for `colours`; expected one of: linear, display",
             ]
@@ -444,7 +491,7 @@ pub(super) mod tests {
             errors(&format!("title = 'x'\n{CAMERA}")),
             [
                 "unknown key `title` in the top level; expected one of: render, camera, \
-              materials, lights, objects"
+              materials, lights, objects, definitions"
             ]
         );
     }

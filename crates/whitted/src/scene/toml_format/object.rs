@@ -20,9 +20,10 @@
 
 use toml_span::value::Value;
 
-use super::reader::{Parsed, Reader, all, list};
+use super::definition::{INSTANCE_KEY, Item, read_placement};
+use super::reader::{Fields, Parsed, Reader, all, list};
 use super::{csg, patches, shapes};
-use crate::math::{Transform, TransformError, Vec3, magnitude};
+use crate::math::{Aabb, Transform, TransformError, Vec3, magnitude};
 use crate::shape::Shape;
 
 /// An object read from the file.
@@ -40,11 +41,12 @@ pub(super) struct Object {
 const COMMON_KEYS: &[&str] = &["shape", "material", "transform"];
 
 /// Reads the `[[objects]]` array, if any; `materials` are the names defined.
+/// Each object comes with the index of the table that defined it.
 pub(super) fn read_objects(
     r: &mut Reader<'_>,
     value: Option<&Value<'_>>,
     materials: &[String],
-) -> Parsed<Vec<Object>> {
+) -> Parsed<Vec<(usize, Item)>> {
     let Some(value) = value else {
         return Ok(Vec::new());
     };
@@ -52,21 +54,25 @@ pub(super) fn read_objects(
     let objects = all(objects
         .iter()
         .map(|object| read_object(r, object, materials)))?;
-    Ok(objects.into_iter().flatten().collect())
+    let by_table = objects.into_iter().enumerate();
+    Ok(by_table
+        .flat_map(|(table, objects)| objects.into_iter().map(move |object| (table, object)))
+        .collect())
 }
 
-/// One object, or one per patch of a `shape = "patches"` file.
+/// One object, or one per patch of a `shape = "patches"` file, or an
+/// instance of a definition.
 pub(super) fn read_object(
     r: &mut Reader<'_>,
     value: &Value<'_>,
     materials: &[String],
-) -> Parsed<Vec<Object>> {
+) -> Parsed<Vec<Item>> {
     if value.as_table().is_some_and(|t| t.get(csg::KEY).is_some()) {
-        return csg::read(r, value, materials).map(|object| vec![object]);
+        return csg::read(r, value, materials).map(|object| vec![Item::Object(object)]);
     }
     let f = r.table(value, "objects", "object")?;
     let is_patches = f.get("shape").and_then(|v| v.as_str()) == Some(patches::KIND);
-    let kind = (!is_patches).then(|| {
+    let kind = (!is_patches && f.get(INSTANCE_KEY).is_none()).then(|| {
         r.require(&f, "shape", Reader::string)
             .and_then(|(name, span)| Ok((shapes::find(r, name, span)?, span)))
     });
@@ -78,17 +84,25 @@ pub(super) fn read_object(
             .ok_or_else(|| r.error(span, unknown_material(name, materials)))
     });
     let transform = r.or_default(&f, "transform", Transform::IDENTITY, read_transform);
+    if f.get(INSTANCE_KEY).is_some() {
+        return read_placement(r, &f, material, transform).map(|item| vec![item]);
+    }
     let Some(kind) = kind else {
         let keys = r.check_keys(&f, &[COMMON_KEYS, patches::KEYS].concat());
         let shapes = patches::read(r, &f);
         let (material, transform) = (material?, transform?);
         keys?;
+        let shapes = shapes?;
+        let bounds = shapes
+            .iter()
+            .fold(Aabb::EMPTY, |all, shape| all.union(&shape.bounds()));
+        check_reach(r, &f, &transform, &bounds)?;
         let object = |shape| Object {
             shape,
             material,
             transform,
         };
-        return Ok(shapes?.into_iter().map(object).collect());
+        return Ok(shapes.into_iter().map(object).map(Item::Object).collect());
     };
     let (kind, kind_span) = match kind {
         Ok(kind) => kind,
@@ -106,22 +120,34 @@ pub(super) fn read_object(
     keys?;
     let placed = placed?;
     let transform = transform?.then_after(&placed.placement);
-    let world = transform.bounds_to_world(&placed.shape.bounds());
+    check_reach(r, &f, &transform, &placed.shape.bounds())?;
+    Ok(vec![Item::Object(Object {
+        shape: placed.shape,
+        material: material?,
+        transform,
+    })])
+}
+
+/// Refuses, at the object's `transform`, an object whose `bounds` carried
+/// by `transform` into the world reach beyond ±[`magnitude::MAX_COORDINATE`].
+fn check_reach(
+    r: &mut Reader<'_>,
+    f: &Fields<'_, '_>,
+    transform: &Transform,
+    bounds: &Aabb,
+) -> Parsed<()> {
+    let world = transform.bounds_to_world(bounds);
     if world.is_finite() {
         let reach = world.min.abs().max(world.max.abs()).max_element();
         if let Err(error) = magnitude::coordinate(reach) {
-            let span = r.value_span(&f, "transform");
+            let span = r.value_span(f, "transform");
             return Err(r.error(
                 span,
                 format!("the object reaches out of range in the world: {error}"),
             ));
         }
     }
-    Ok(vec![Object {
-        shape: placed.shape,
-        material: material?,
-        transform,
-    }])
+    Ok(())
 }
 
 pub(super) fn unknown_material(name: &str, materials: &[String]) -> String {

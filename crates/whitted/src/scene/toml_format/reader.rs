@@ -14,6 +14,7 @@ use toml_span::value::{Key, Table, Value};
 
 use crate::image::ColorSpace;
 use crate::math::{Vec3, magnitude, unit};
+use crate::render::LineIndex;
 use crate::scene::{Diagnostic, SceneError, Severity, push_limited};
 use crate::shading::texture::{Decoding, ImageCache, ImageData};
 use crate::shading::{Color, factor};
@@ -171,6 +172,11 @@ impl<'s> Reader<'s> {
                 })
             }
         }
+    }
+
+    /// The lines of the file, to locate its objects.
+    pub(super) fn line_index(&self) -> LineIndex<'s> {
+        LineIndex::new(self.source)
     }
 
     /// The text of the file at `span` (empty when out of bounds).

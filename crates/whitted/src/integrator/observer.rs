@@ -1,0 +1,108 @@
+//! What the Whitted integrator tells an observer as it traces one camera
+//! sample: each ray it starts and what it hit, how the surface is shaded,
+//! each light's shadow rays and verdict, the branches it leaves out, and
+//! the colour each ray passes up.
+//!
+//! The integrator is generic over the observer. The renderer passes
+//! [`Unobserved`], whose methods are the trait's empty defaults: once
+//! monomorphised, every call vanishes, so rendering costs the same and
+//! gives the same bits as with no observer at all. `whitted explain`
+//! passes a [`super::RayTreeRecorder`], which builds the ray tree.
+//!
+//! The calls of one camera sample come in this order (a grammar):
+//!
+//! ```text
+//! sample  = ray
+//! ray     = ray_start ray_hit [shade] ray_end
+//! shade   = shading light* [depth_limit | lobes branch*]
+//! light   = shadow_ray* light
+//! branch  = ray_start ray_hit [shade] ray_end | branch_skipped
+//! ```
+
+use crate::integrator::RayKind;
+use crate::math::{Ray, Vec3};
+use crate::shading::{Color, LightSample};
+use crate::world::{Hit, Surface};
+
+/// How one step of a shadow ray was answered.
+#[derive(Clone, Copy, Debug)]
+pub enum ShadowStep<'s> {
+    /// By the any-hit query (no surface in the scene lets light through):
+    /// whether anything blocks the segment.
+    AnyHit {
+        /// True when the segment is blocked.
+        blocked: bool,
+    },
+    /// By the closest-hit query (some surfaces let light through): the
+    /// surface crossed first, if any.
+    Closest {
+        /// The surface the segment meets first.
+        blocker: Option<(&'s Hit, &'s Surface)>,
+    },
+}
+
+/// Watches the Whitted integrator trace one camera sample. Every method
+/// does nothing unless implemented; see the module documentation for the
+/// order of the calls.
+pub trait RayObserver {
+    /// A ray of `kind` starts; the parent multiplies its colour by
+    /// `coefficient` (one for the camera ray), and `weight` is the largest
+    /// factor by which it reaches the pixel.
+    #[inline(always)]
+    fn ray_start(&mut self, _kind: RayKind, _ray: &Ray, _coefficient: Color, _weight: f64) {}
+
+    /// What the ray started last hit first, if anything.
+    #[inline(always)]
+    fn ray_hit(&mut self, _ray: &Ray, _hit: Option<(&Hit, &Surface)>) {}
+
+    /// The hit surface is shaded with the shading normal `normal` (turned
+    /// towards the viewer, tilted by a bump map); `entering` is true when
+    /// the ray arrives on the outward side.
+    #[inline(always)]
+    fn shading(&mut self, _normal: Vec3, _entering: bool) {}
+
+    /// One step of the shadow ray towards the light being considered.
+    #[inline(always)]
+    fn shadow_ray(&mut self, _ray: &Ray, _step: ShadowStep<'_>) {}
+
+    /// The verdict on light `index`: `None` as `sample` when none of its
+    /// light reaches the point (outside a spot's cone); `None` as
+    /// `transmittance` when the surface faces away from it, so no shadow
+    /// ray was traced; otherwise what of it arrives (zero: blocked).
+    #[inline(always)]
+    fn light(
+        &mut self,
+        _index: usize,
+        _sample: Option<&LightSample>,
+        _transmittance: Option<Color>,
+    ) {
+    }
+
+    /// The ray is at the deepest recursion allowed: no secondary rays.
+    #[inline(always)]
+    fn depth_limit(&mut self) {}
+
+    /// The surface's secondary rays: the weights of the mirror and
+    /// refracted rays, the refracted direction (`None` under total internal
+    /// reflection or for an opaque surface), and the indices of refraction
+    /// on either side.
+    #[inline(always)]
+    fn lobes(&mut self, _mirror: Color, _refraction: Color, _refracted: bool, _indices: [f64; 2]) {}
+
+    /// A secondary ray of `kind` with `coefficient` and pixel weight
+    /// `weight` was not traced (its weight is under the cut-off, or the
+    /// sample's budget of secondary rays is spent).
+    #[inline(always)]
+    fn branch_skipped(&mut self, _kind: RayKind, _coefficient: Color, _weight: f64) {}
+
+    /// The ray started last passes `color` up to its parent (for the camera
+    /// ray: the sample's colour).
+    #[inline(always)]
+    fn ray_end(&mut self, _color: Color) {}
+}
+
+/// The observer that watches nothing: what the renderer passes.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Unobserved;
+
+impl RayObserver for Unobserved {}

@@ -1,0 +1,430 @@
+//! The ray tree of one camera sample, as the Whitted integrator traced it:
+//! [`RayNode`]s for the camera, reflected and refracted rays, each with
+//! what it hit, the terms of the shading formula, every light's shadow
+//! rays and verdict, the branches left out and why, and the colour it
+//! passes up. [`RayTreeRecorder`] builds it as a [`RayObserver`]; the
+//! colour of the root is the colour the integrator returned, the very
+//! same bits.
+//!
+//! The shading terms are recomputed from the observed values with the
+//! shading layer's own functions ([`phong`], the material's textures), so
+//! they are what the integrator added up; they are shown one by one, and
+//! their sum may differ from the node's colour in the last bits.
+
+use crate::accel::{QueryContext, TraversalCounters};
+use crate::integrator::observer::{RayObserver, ShadowStep};
+use crate::integrator::{RayKind, RecursionLimits, Shading};
+use crate::math::{DVec2, Ray, Vec3};
+use crate::shading::{Color, LightSample, Material, phong};
+use crate::world::{Hit, MaterialId, PrimitiveId, Surface, World};
+
+/// One ray of the tree: a camera, reflected or refracted ray.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RayNode {
+    /// What it was traced for.
+    pub kind: RayKind,
+    /// Its depth: 0 for the camera ray, one more per bounce.
+    pub depth: u32,
+    /// Where it starts.
+    pub origin: Vec3,
+    /// Its unit direction.
+    pub direction: Vec3,
+    /// What the parent multiplies its colour by (`kr` or `kt` after
+    /// opacity and Fresnel; one for the camera ray).
+    pub coefficient: Color,
+    /// The largest factor by which its colour reaches the pixel.
+    pub weight: f64,
+    /// The work of its closest-hit query in the acceleration structure.
+    pub cost: TraversalCounters,
+    /// What it hit; `None` when it left the scene (its colour is then the
+    /// background).
+    pub hit: Option<HitNode>,
+    /// The colour it passes up, before the parent's coefficient.
+    pub color: Color,
+}
+
+/// A ray's hit and how the surface there was shaded.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HitNode {
+    /// The primitive's number in the world.
+    pub primitive: PrimitiveId,
+    /// The ray parameter of the hit (the distance, the direction being
+    /// unit).
+    pub t: f64,
+    /// The hit point.
+    pub point: Vec3,
+    /// The geometric normal, outward.
+    pub geometric_normal: Vec3,
+    /// The shading normal used, turned towards the viewer (interpolated,
+    /// bumped).
+    pub shading_normal: Vec3,
+    /// True when the ray arrived on the outward side (entering the
+    /// object's medium, for a transmissive one), false when leaving it.
+    pub entering: bool,
+    /// The texture coordinates there.
+    pub uv: DVec2,
+    /// The surface's material.
+    pub material: MaterialId,
+    /// The terms of the shading formula.
+    pub terms: ShadingTerms,
+    /// Each light's verdict, in the scene's order; empty when the material
+    /// has neither diffuse nor specular reflection (or is fully
+    /// dissolved), so no light was looked at.
+    pub lights: Vec<LightTerm>,
+    /// The indices of refraction on the incoming and the far side, when
+    /// secondary rays were considered.
+    pub indices: Option<[f64; 2]>,
+    /// The secondary rays traced, in order (reflected, then refracted).
+    pub children: Vec<RayNode>,
+    /// Why the tree has no more rays here, where it could have had some.
+    pub stops: Vec<Stop>,
+}
+
+/// The terms of the Phong-Whitted formula at a hit, each already
+/// multiplied by what scales it (except the opacity, applied to their sum).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadingTerms {
+    /// `ke`: the surface's own light.
+    pub emission: Color,
+    /// `ka Ia`: the ambient term.
+    pub ambient: Color,
+    /// `α`: the opacity that weighs the local terms and the mirror.
+    pub opacity: Color,
+}
+
+/// One light's contribution at a hit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightTerm {
+    /// The light's index in the scene.
+    pub index: usize,
+    /// Whether its light arrives.
+    pub verdict: LightVerdict,
+    /// Its diffuse term `S I kd (N·L)`.
+    pub diffuse: Color,
+    /// Its specular term `S I ks (R·V)^n`.
+    pub specular: Color,
+    /// The steps of its shadow ray, in order (several when it passes
+    /// through transmissive surfaces).
+    pub shadow_rays: Vec<ShadowSegment>,
+}
+
+/// Whether a light's light arrives at a point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightVerdict {
+    /// None of its light reaches the point (outside a spot's cone).
+    Unreached,
+    /// The surface faces away from it: no shadow ray.
+    FacesAway,
+    /// Nothing is in the way.
+    Lit,
+    /// An opaque surface is in the way: the nearest one on the shadow ray.
+    Blocked {
+        /// The blocking primitive.
+        by: Option<PrimitiveId>,
+    },
+    /// Transmissive or dissolved surfaces let this much through.
+    Attenuated {
+        /// The factor on the light's intensity.
+        transmittance: Color,
+    },
+}
+
+/// One step of a shadow ray: a segment towards the light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowSegment {
+    /// Where it starts.
+    pub origin: Vec3,
+    /// Its unit direction (towards the light).
+    pub direction: Vec3,
+    /// Its length (infinite towards a directional light).
+    pub t_max: f64,
+    /// What it met first, and where (`None`: nothing, the light is seen).
+    pub blocker: Option<(PrimitiveId, f64)>,
+    /// The work of its query (any hit or closest hit, as the integrator
+    /// asked it) in the acceleration structure.
+    pub cost: TraversalCounters,
+}
+
+/// Why a node has no more rays where its material could have had some.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Stop {
+    /// The ray is at the deepest recursion allowed (`max_depth`).
+    DepthLimit {
+        /// The limit.
+        max_depth: u32,
+    },
+    /// The material neither reflects nor transmits, and is opaque.
+    Opaque,
+    /// Total internal reflection: no refracted ray, its weight moved to
+    /// the reflected one.
+    TotalInternalReflection,
+    /// A secondary ray whose weight on the pixel was under `min_weight`.
+    WeightCutOff {
+        /// The ray left out.
+        kind: RayKind,
+        /// Its weight on the pixel.
+        weight: f64,
+        /// The cut-off.
+        min_weight: f64,
+    },
+    /// A secondary ray refused because the camera sample had traced its
+    /// budget of secondary rays.
+    RayBudget {
+        /// The ray left out.
+        kind: RayKind,
+        /// The budget.
+        budget: u32,
+    },
+}
+
+/// Builds the [`RayNode`] tree of one camera sample while the integrator
+/// traces it; [`RayTreeRecorder::finish`] returns it.
+#[derive(Debug)]
+pub struct RayTreeRecorder<'a> {
+    world: &'a World<'a>,
+    shading: Shading<'a>,
+    limits: RecursionLimits,
+    /// The rays started and not yet ended, outermost first.
+    open: Vec<RayNode>,
+    /// The shadow steps of the light being considered.
+    shadow: Vec<ShadowSegment>,
+    /// The camera ray once it has ended.
+    root: Option<RayNode>,
+}
+
+impl<'a> RayTreeRecorder<'a> {
+    /// A recorder for a sample traced in `world` with `shading` and
+    /// `limits` (those the integrator was given).
+    pub fn new(world: &'a World<'a>, shading: Shading<'a>, limits: RecursionLimits) -> Self {
+        Self {
+            world,
+            shading,
+            limits,
+            open: Vec::new(),
+            shadow: Vec::new(),
+            root: None,
+        }
+    }
+
+    /// The tree, once the camera ray has ended.
+    pub fn finish(self) -> Option<RayNode> {
+        self.root
+    }
+
+    fn node(&mut self) -> Option<&mut RayNode> {
+        self.open.last_mut()
+    }
+
+    fn hit(&mut self) -> Option<&mut HitNode> {
+        self.open.last_mut()?.hit.as_mut()
+    }
+
+    fn material(&self, id: MaterialId) -> Option<&'a Material> {
+        self.shading.materials.get(id.0 as usize)
+    }
+}
+
+impl RayObserver for RayTreeRecorder<'_> {
+    fn ray_start(&mut self, kind: RayKind, ray: &Ray, coefficient: Color, weight: f64) {
+        let depth = self.open.len() as u32;
+        let mut ctx = QueryContext::default();
+        self.world.intersect_with(ray, &mut ctx);
+        self.open.push(RayNode {
+            kind,
+            depth,
+            origin: ray.origin,
+            direction: ray.dir,
+            coefficient,
+            weight,
+            cost: ctx.counters,
+            hit: None,
+            color: Color::ZERO,
+        });
+    }
+
+    fn ray_hit(&mut self, _ray: &Ray, hit: Option<(&Hit, &Surface)>) {
+        let Some((hit, surface)) = hit else {
+            return;
+        };
+        let terms = match self.material(surface.material) {
+            Some(m) => ShadingTerms {
+                emission: m.emission.at(surface.uv),
+                ambient: m.ambient.at(surface.uv) * self.shading.ambient,
+                opacity: m.opacity.at(surface.uv),
+            },
+            None => ShadingTerms {
+                emission: Color::ZERO,
+                ambient: Color::ZERO,
+                opacity: Color::ONE,
+            },
+        };
+        if let Some(node) = self.node() {
+            node.hit = Some(HitNode {
+                primitive: hit.primitive,
+                t: hit.t(),
+                point: surface.point,
+                geometric_normal: surface.normal,
+                shading_normal: surface.shading_normal,
+                entering: true,
+                uv: surface.uv,
+                material: surface.material,
+                terms,
+                lights: Vec::new(),
+                indices: None,
+                children: Vec::new(),
+                stops: Vec::new(),
+            });
+        }
+    }
+
+    fn shading(&mut self, normal: Vec3, entering: bool) {
+        if let Some(hit) = self.hit() {
+            hit.shading_normal = normal;
+            hit.entering = entering;
+        }
+    }
+
+    fn shadow_ray(&mut self, ray: &Ray, step: ShadowStep<'_>) {
+        let mut ctx = QueryContext::default();
+        let blocker = match step {
+            ShadowStep::AnyHit { blocked } => {
+                self.world.occluded_with(ray, &mut ctx);
+                // The any-hit query stops at any occluder; name the nearest.
+                blocked
+                    .then(|| self.world.intersect(ray))
+                    .flatten()
+                    .map(|hit| (hit.primitive, hit.t()))
+            }
+            ShadowStep::Closest { blocker } => {
+                self.world.intersect_with(ray, &mut ctx);
+                blocker.map(|(hit, _)| (hit.primitive, hit.t()))
+            }
+        };
+        self.shadow.push(ShadowSegment {
+            origin: ray.origin,
+            direction: ray.dir,
+            t_max: ray.t_max,
+            blocker,
+            cost: ctx.counters,
+        });
+    }
+
+    fn light(&mut self, index: usize, sample: Option<&LightSample>, transmittance: Option<Color>) {
+        let shadow_rays = std::mem::take(&mut self.shadow);
+        let view = self.node().map_or(Vec3::ZERO, |node| -node.direction);
+        let Some(hit) = self.hit() else {
+            return;
+        };
+        let (n, uv, material) = (hit.shading_normal, hit.uv, hit.material);
+        let mut term = LightTerm {
+            index,
+            verdict: LightVerdict::Unreached,
+            diffuse: Color::ZERO,
+            specular: Color::ZERO,
+            shadow_rays,
+        };
+        match (sample, transmittance) {
+            (None, _) => {}
+            (Some(_), None) => term.verdict = LightVerdict::FacesAway,
+            (Some(sample), Some(through)) => {
+                term.verdict = if through == Color::ZERO {
+                    LightVerdict::Blocked {
+                        by: term
+                            .shadow_rays
+                            .iter()
+                            .find_map(|s| s.blocker.map(|(p, _)| p)),
+                    }
+                } else if through == Color::ONE {
+                    LightVerdict::Lit
+                } else {
+                    LightVerdict::Attenuated {
+                        transmittance: through,
+                    }
+                };
+                if through != Color::ZERO
+                    && let Some(m) = self.material(material)
+                {
+                    let (kd, ks) = (m.diffuse.at(uv), m.specular.at(uv));
+                    let scale = through * sample.intensity;
+                    let l = sample.to_light;
+                    term.diffuse = scale * phong(kd, Color::ZERO, m.shininess, n, l, view);
+                    term.specular = scale * phong(Color::ZERO, ks, m.shininess, n, l, view);
+                }
+            }
+        }
+        if let Some(hit) = self.hit() {
+            hit.lights.push(term);
+        }
+    }
+
+    fn depth_limit(&mut self) {
+        let max_depth = self.limits.max_depth;
+        let Some(hit) = self.hit() else {
+            return;
+        };
+        let (uv, material) = (hit.uv, hit.material);
+        let branches = self.material(material).is_some_and(|m| {
+            m.reflection.at(uv) != Color::ZERO
+                || m.transmission.at(uv) != Color::ZERO
+                || m.opacity.at(uv) != Color::ONE
+        });
+        if branches && let Some(hit) = self.hit() {
+            hit.stops.push(Stop::DepthLimit { max_depth });
+        }
+    }
+
+    fn lobes(&mut self, _mirror: Color, refraction: Color, refracted: bool, indices: [f64; 2]) {
+        let Some(hit) = self.hit() else {
+            return;
+        };
+        hit.indices = Some(indices);
+        let (uv, material) = (hit.uv, hit.material);
+        let transmits = self.material(material).is_some_and(|m| {
+            m.transmission.at(uv) != Color::ZERO || m.opacity.at(uv) != Color::ONE
+        });
+        if transmits
+            && !refracted
+            && refraction == Color::ZERO
+            && let Some(hit) = self.hit()
+        {
+            hit.stops.push(Stop::TotalInternalReflection);
+        }
+    }
+
+    fn branch_skipped(&mut self, kind: RayKind, _coefficient: Color, weight: f64) {
+        let limits = self.limits;
+        let stop = if weight < limits.min_weight {
+            Stop::WeightCutOff {
+                kind,
+                weight,
+                min_weight: limits.min_weight,
+            }
+        } else {
+            Stop::RayBudget {
+                kind,
+                budget: limits.ray_budget,
+            }
+        };
+        if let Some(hit) = self.hit() {
+            hit.stops.push(stop);
+        }
+    }
+
+    fn ray_end(&mut self, color: Color) {
+        let Some(mut node) = self.open.pop() else {
+            return;
+        };
+        node.color = color;
+        if let Some(hit) = &mut node.hit
+            && hit.children.is_empty()
+            && hit.stops.is_empty()
+            && hit.indices.is_none()
+        {
+            hit.stops.push(Stop::Opaque);
+        }
+        match self.open.last_mut().and_then(|parent| parent.hit.as_mut()) {
+            Some(parent) => parent.children.push(node),
+            None => self.root = Some(node),
+        }
+    }
+}

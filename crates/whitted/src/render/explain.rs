@@ -1,0 +1,186 @@
+//! Why a pixel has its colour: the ray tree of one of its samples, traced
+//! by the renderer's own integrator with a [`RayTreeRecorder`] watching
+//! (what `whitted explain` prints).
+//!
+//! The sample's camera ray is the renderer's ([`super::sample_ray`]), the
+//! world and the integrator are built as [`super::render`] builds them, and
+//! the pixel is the mean of its samples' colours summed in the renderer's
+//! order: so the tree's root colour is the sample's radiance, bit for bit,
+//! and [`PixelExplanation::pixel`] is the rendered pixel, bit for bit.
+
+use crate::accel::AccelKind;
+use crate::integrator::{
+    Integrator, RayCounts, RayNode, RayTreeRecorder, RecursionLimits, SECONDARY_RAY_BUDGET,
+    Shading, Unobserved,
+};
+use crate::math::DVec2;
+use crate::render::sample_ray::{pixel_pattern, sample_ray};
+use crate::render::{RenderError, Scene};
+use crate::shading::Color;
+use crate::world::MAX_PRIMITIVES;
+
+/// The ray tree of one sample of one pixel, and the pixel it ends in.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PixelExplanation {
+    /// The pixel's column.
+    pub x: u32,
+    /// The pixel's row (0 at the top).
+    pub y: u32,
+    /// Which of the pixel's samples is explained.
+    pub sample: u32,
+    /// The pixel's number of samples.
+    pub samples: u32,
+    /// Where the sample lies on the image, in pixels from the top left
+    /// corner.
+    pub position: DVec2,
+    /// The structure the rays were traced through (the costs are its).
+    pub accel: AccelKind,
+    /// The recursion limits the tree was traced with.
+    pub limits: RecursionLimits,
+    /// The ray tree; its root's colour is the sample's colour.
+    pub tree: RayNode,
+    /// Every sample's colour, in order.
+    pub sample_colors: Vec<Color>,
+    /// The pixel as the renderer stores it: the mean of the samples'
+    /// colours, in 32-bit floats.
+    pub pixel: [f32; 3],
+}
+
+/// Why a pixel cannot be explained.
+#[derive(Debug, thiserror::Error)]
+pub enum ExplainError {
+    /// The scene's settings cannot be rendered.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// The pixel is outside the image.
+    #[error(
+        "the pixel {x},{y} is outside the {width}x{height} image (columns 0 to {}, rows 0 to {})",
+        width - 1,
+        height - 1
+    )]
+    PixelOutside {
+        /// The column asked for.
+        x: u32,
+        /// The row asked for.
+        y: u32,
+        /// The image width.
+        width: u32,
+        /// The image height.
+        height: u32,
+    },
+    /// The sample is not one of the pixel's.
+    #[error("sample {sample} does not exist: the pixel has {samples} (0 to {})", samples - 1)]
+    SampleOutside {
+        /// The sample asked for.
+        sample: u32,
+        /// The samples per pixel.
+        samples: u32,
+    },
+}
+
+/// Explains sample `sample` of pixel (`x`, `y`) of `scene` rendered with
+/// its settings. The recursion runs on a thread with the renderer's stack
+/// size for the scene's depth.
+pub fn explain_pixel(
+    scene: &Scene,
+    (x, y): (u32, u32),
+    sample: u32,
+) -> Result<PixelExplanation, ExplainError> {
+    let settings = &scene.settings;
+    settings.check()?;
+    scene.objects.check_instances().map_err(RenderError::from)?;
+    let primitives = scene.objects.primitive_count();
+    if primitives > MAX_PRIMITIVES {
+        return Err(RenderError::TooManyPrimitives(primitives).into());
+    }
+    let (width, height) = (settings.width, settings.height);
+    if x >= width || y >= height {
+        return Err(ExplainError::PixelOutside {
+            x,
+            y,
+            width,
+            height,
+        });
+    }
+    let samples = settings.samples_per_pixel;
+    if sample >= samples {
+        return Err(ExplainError::SampleOutside { sample, samples });
+    }
+    let stack = super::worker_stack_bytes(settings.max_depth);
+    std::thread::scope(|scope| {
+        std::thread::Builder::new()
+            .stack_size(stack)
+            .spawn_scoped(scope, || trace_pixel(scene, (x, y), sample))
+            .map_err(|e| RenderError::Threads {
+                threads: 1,
+                message: e.to_string(),
+            })?
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+    })
+}
+
+/// [`explain_pixel`] once the arguments are checked, on the thread that
+/// recurses.
+fn trace_pixel(
+    scene: &Scene,
+    (x, y): (u32, u32),
+    sample: u32,
+) -> Result<PixelExplanation, ExplainError> {
+    let settings = &scene.settings;
+    // As `render` builds them.
+    let world = super::build_world(scene);
+    let shading = Shading {
+        materials: &scene.materials,
+        lights: &scene.lights,
+        background: scene.background,
+        ambient: scene.ambient,
+    };
+    let limits = RecursionLimits {
+        max_depth: settings.max_depth,
+        min_weight: settings.min_weight,
+        ray_budget: SECONDARY_RAY_BUDGET,
+    };
+    let caustics =
+        super::photon_pass::build(&world, &shading, settings).map_err(RenderError::from)?;
+    let integrator = Integrator::new(settings.integrator, &world, shading, limits)
+        .with_caustics(caustics.as_ref().map(|(map, _)| map));
+    let pattern = pixel_pattern(x, y);
+    let mut counts = RayCounts::default();
+    let mut sum = Color::ZERO;
+    let mut sample_colors = Vec::with_capacity(settings.samples_per_pixel as usize);
+    let mut tree = None;
+    for s in 0..settings.samples_per_pixel {
+        let ray = sample_ray(&scene.camera, settings, (x, y), pattern, s);
+        let color = if s == sample {
+            let mut recorder = RayTreeRecorder::new(&world, shading, limits);
+            let traced = integrator.trace_primary_observed(&ray, &mut counts, &mut recorder);
+            tree = recorder.finish();
+            traced.color
+        } else {
+            integrator
+                .trace_primary_observed(&ray, &mut counts, &mut Unobserved)
+                .color
+        };
+        sample_colors.push(color);
+        sum += color;
+    }
+    let pixel = (sum / f64::from(settings.samples_per_pixel)).to_f32();
+    let tree = tree.ok_or(ExplainError::SampleOutside {
+        sample,
+        samples: settings.samples_per_pixel,
+    })?;
+    let offset = crate::math::sampling::pixel_sample(sample, settings.samples_per_pixel, pattern);
+    Ok(PixelExplanation {
+        x,
+        y,
+        sample,
+        samples: settings.samples_per_pixel,
+        position: DVec2::new(f64::from(x) + offset.x, f64::from(y) + offset.y),
+        accel: settings.accel,
+        limits,
+        tree,
+        sample_colors,
+        pixel,
+    })
+}

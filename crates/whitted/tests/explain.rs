@@ -1,0 +1,148 @@
+//! `whitted explain`'s promise: the colour at the root of a pixel's ray
+//! tree is the rendered pixel, exactly. Checked on every example scene in
+//! `scenes/`, for seeded random pixels, with one sample per pixel (the
+//! root is the pixel) and with several (each sample's root is that
+//! sample's colour, and their mean is the pixel).
+
+use std::path::{Path, PathBuf};
+
+use whitted::accel::AccelKind;
+use whitted::integrator::RayNode;
+use whitted::math::random::hash64;
+use whitted::render::{Scene, explain_pixel, render};
+use whitted::scene::load_any;
+
+/// The example scenes of every format, sorted by name.
+fn example_scenes() -> Vec<PathBuf> {
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let mut scenes: Vec<PathBuf> = std::fs::read_dir(&folder)
+        .unwrap()
+        .map(|entry| entry.unwrap().path())
+        .filter(|path| {
+            path.extension()
+                .is_some_and(|e| ["toml", "nff", "obj", "bpt"].iter().any(|x| e == *x))
+        })
+        .collect();
+    scenes.sort();
+    assert!(scenes.len() >= 10, "too few scenes in {}", folder.display());
+    scenes
+}
+
+/// `path` at `width`x`height` with `spp` samples.
+fn small(path: &Path, (width, height): (u32, u32), spp: u32) -> Scene {
+    let mut scene = load_any(path).unwrap_or_else(|e| panic!("{e}"));
+    scene.settings.width = width;
+    scene.settings.height = height;
+    scene.settings.samples_per_pixel = spp;
+    scene.settings.threads = Some(1);
+    scene
+}
+
+/// `count` seeded pixels of a `width`x`height` image, for the scene `name`.
+fn pixels(name: &str, (width, height): (u32, u32), count: u64) -> Vec<(u32, u32)> {
+    let seed = name.bytes().fold(0u64, |h, b| hash64(h ^ u64::from(b)));
+    (0..count)
+        .map(|i| {
+            let h = hash64(seed ^ i);
+            (
+                (h % u64::from(width)) as u32,
+                ((h >> 32) % u64::from(height)) as u32,
+            )
+        })
+        .collect()
+}
+
+/// How many rays the tree holds, and its deepest depth.
+fn size(node: &RayNode) -> (usize, u32) {
+    let children = node.hit.iter().flat_map(|hit| &hit.children);
+    children.fold((1, node.depth), |(count, depth), child| {
+        let (c, d) = size(child);
+        (count + c, depth.max(d))
+    })
+}
+
+#[test]
+fn the_root_of_every_explained_pixel_is_the_rendered_pixel_with_one_sample() {
+    let resolution = (24, 18);
+    let mut deepest = 0;
+    for path in example_scenes() {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let scene = small(&path, resolution, 1);
+        let film = render(&scene, &|_| {}).unwrap().image;
+        for (x, y) in pixels(&name, resolution, 12) {
+            let explained = explain_pixel(&scene, (x, y), 0).unwrap();
+            let root = explained.tree.color.to_f32();
+            assert_eq!(root, film.pixel(x, y), "{name} pixel {x},{y}");
+            assert_eq!(explained.pixel, root, "{name} pixel {x},{y}");
+            deepest = deepest.max(size(&explained.tree).1);
+        }
+    }
+    // The scenes have mirrors and glass: some tree goes deeper than the
+    // camera ray, so the comparison covers secondary rays.
+    assert!(deepest >= 2, "no explained tree went past depth {deepest}");
+}
+
+#[test]
+fn each_sample_s_root_is_its_colour_and_their_mean_the_rendered_pixel() {
+    let resolution = (12, 9);
+    for path in example_scenes() {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let scene = small(&path, resolution, 3);
+        let film = render(&scene, &|_| {}).unwrap().image;
+        for (x, y) in pixels(&name, resolution, 3) {
+            let first = explain_pixel(&scene, (x, y), 0).unwrap();
+            assert_eq!(first.pixel, film.pixel(x, y), "{name} pixel {x},{y}");
+            for k in 0..3 {
+                let explained = explain_pixel(&scene, (x, y), k).unwrap();
+                assert_eq!(
+                    explained.tree.color, first.sample_colors[k as usize],
+                    "{name} pixel {x},{y} sample {k}"
+                );
+                assert_eq!(explained.pixel, first.pixel);
+            }
+        }
+    }
+}
+
+#[test]
+fn every_structure_explains_the_same_tree_at_its_own_cost() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/whitted.toml");
+    let mut trees = Vec::new();
+    for accel in AccelKind::ALL {
+        let mut scene = small(&path, (32, 24), 1);
+        scene.settings.accel = accel;
+        let mut explained = explain_pixel(&scene, (16, 14), 0).unwrap();
+        assert!(explained.tree.cost.nodes + explained.tree.cost.primitives > 0);
+        clear_costs(&mut explained.tree);
+        trees.push(explained.tree);
+    }
+    assert!(trees.windows(2).all(|w| w[0] == w[1]));
+}
+
+fn clear_costs(node: &mut RayNode) {
+    node.cost = Default::default();
+    if let Some(hit) = &mut node.hit {
+        for light in &mut hit.lights {
+            for segment in &mut light.shadow_rays {
+                segment.cost = Default::default();
+            }
+        }
+        hit.children.iter_mut().for_each(clear_costs);
+    }
+}
+
+#[test]
+fn a_pixel_or_sample_outside_the_image_is_refused_with_the_range() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/whitted.toml");
+    let scene = small(&path, (32, 24), 2);
+    let error = explain_pixel(&scene, (32, 0), 0).unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        "the pixel 32,0 is outside the 32x24 image (columns 0 to 31, rows 0 to 23)"
+    );
+    let error = explain_pixel(&scene, (0, 0), 2).unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        "sample 2 does not exist: the pixel has 2 (0 to 1)"
+    );
+}
