@@ -25,6 +25,7 @@ use std::fmt;
 
 use crate::image::ColorSpace;
 use crate::integrator::{Integrator, RayCounts};
+use crate::math::DVec2;
 use crate::shading::Color;
 use crate::world::MaterialId;
 
@@ -212,6 +213,35 @@ impl<'a> AdaptivePixels<'a> {
     pub(super) fn pixel(&mut self, x: u32, y: u32, cost: &mut Cost<'_>) -> Color {
         let side = 1 << self.adaptive.depth;
         self.square(x * side, y * side, side, cost)
+    }
+
+    /// The colour of pixel (`x`, `y`), as [`Self::pixel`] gives it, and
+    /// the corners its subdivision traced, in reading order on the fine
+    /// grid (row by row, top to bottom), each with its position on the
+    /// image in pixels and its colour: what `whitted explain` shows. Takes
+    /// an empty cache, so the corners are this pixel's alone.
+    pub(super) fn pixel_alone(
+        mut self,
+        x: u32,
+        y: u32,
+        cost: &mut Cost<'_>,
+    ) -> (Color, Vec<(DVec2, Color)>) {
+        debug_assert!(
+            self.corners.is_empty(),
+            "the cache holds other pixels' corners"
+        );
+        let color = self.pixel(x, y, cost);
+        let scale = f64::from(1u32 << self.adaptive.depth);
+        let mut corners: Vec<_> = self.corners.into_iter().collect();
+        corners.sort_unstable_by_key(|&((fx, fy), _)| (fy, fx));
+        let corners = corners
+            .into_iter()
+            .map(|((fx, fy), corner)| {
+                let position = DVec2::new(f64::from(fx) / scale, f64::from(fy) / scale);
+                (position, corner.color)
+            })
+            .collect();
+        (color, corners)
     }
 
     /// The mean colour over the square of `side` fine steps whose top-left
