@@ -3,6 +3,7 @@
 //! It prints only through [`report`], which never panics.
 #![deny(clippy::print_stdout, clippy::print_stderr, clippy::dbg_macro)]
 
+mod anti_aliasing;
 mod arguments;
 mod bench_command;
 mod explain_command;

@@ -1,7 +1,7 @@
 //! The arguments that say which scene and how it is seen, shared by the
 //! commands that render it (`render`, `explain`): the scene file, the
-//! image size and samples, the depth, the acceleration structures, the
-//! photons, the camera and the memory budget.
+//! image size, the samples and anti-aliasing, the depth, the acceleration
+//! structures, the photons, the camera and the memory budget.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -13,6 +13,7 @@ use whitted::math::Vec3;
 use whitted::render::{Scene, check_image_size};
 use whitted::scene::{CameraOverride, LoadOptions, load_any_with};
 
+use crate::anti_aliasing::AaArgs;
 use crate::arguments;
 use crate::report::note;
 
@@ -61,6 +62,9 @@ pub struct SceneArgs {
     /// off, the default; at most 100000000).
     #[arg(long, value_name = "N", value_parser = arguments::photons, allow_negative_numbers = true)]
     photons: Option<u64>,
+
+    #[command(flatten)]
+    aa: Box<AaArgs>,
 
     /// Put the camera's eye here (replaces the scene's).
     #[arg(long, value_name = "X,Y,Z", value_parser = arguments::vec3, allow_hyphen_values = true)]
@@ -164,6 +168,7 @@ impl SceneArgs {
         settings.accel_top = self.accel_top.or(settings.accel_top);
         settings.accel_bottom = self.accel_bottom.or(settings.accel_bottom);
         settings.photons.count = self.photons.unwrap_or(settings.photons.count);
+        settings.aa = self.aa.apply(settings.aa)?;
         Ok(scene)
     }
 }

@@ -2,6 +2,7 @@
 //! samples placed by a pattern seeded from the pixel's position, so the
 //! picture is identical bit for bit whatever the number of threads.
 
+mod adaptive;
 mod camera;
 mod explain;
 mod gradient_note;
@@ -16,6 +17,9 @@ mod settings;
 mod sources;
 mod trace_timing;
 
+pub use adaptive::{
+    Adaptive, AdaptiveError, AntiAliasing, DEFAULT_AA_DEPTH, DEFAULT_AA_THRESHOLD, MAX_AA_DEPTH,
+};
 pub use camera::{Camera, CameraError};
 pub use explain::{ExplainError, PixelExplanation, explain_pixel};
 pub use gradient_note::GradientExceeded;
@@ -39,13 +43,15 @@ use std::sync::{Mutex, PoisonError};
 
 use rayon::prelude::*;
 
-use crate::image::Film;
+use crate::image::{ColorSpace, Film};
 use crate::integrator::{
     Integrator, RayCounts, RayKind, RecursionLimits, SECONDARY_RAY_BUDGET, Shading,
 };
 use crate::limits::{MemoryBudget, MemoryError};
+use crate::math::Ray;
 use crate::shading::Color;
-use crate::world::{MAX_PRIMITIVES, MaterialId, World};
+use crate::world::{Hit, MAX_PRIMITIVES, MaterialId, Surface, World};
+use adaptive::{AdaptivePixels, Cost};
 use sample_ray::{pixel_pattern, sample_ray};
 
 /// Side of the square tiles the image is cut into, in pixels.
@@ -170,6 +176,9 @@ pub enum RenderError {
         /// The first one's row.
         y: u32,
     },
+    /// The adaptive anti-aliasing parameters are out of range.
+    #[error(transparent)]
+    AntiAliasing(#[from] AdaptiveError),
     /// The pixels asked for are not in the image.
     #[error(transparent)]
     Selection(#[from] SelectionError),
@@ -315,6 +324,7 @@ pub fn render_selected(
                 render_tile(
                     &integrator,
                     &scene.camera,
+                    scene.color_space,
                     settings,
                     selection,
                     index % tiles_x,
@@ -333,7 +343,7 @@ pub fn render_selected(
     let trace = clock.finish(pool.current_num_threads());
     let films = films.into_inner().unwrap_or_else(PoisonError::into_inner);
     check_finite(&films.image)?;
-    let ray_budget_cut = budget_cut(scene, &films.cuts);
+    let ray_budget_cut = budget_cut(scene, &films.cuts, films.rays[RayKind::Primary]);
     Ok(RenderOutput {
         image: films.image,
         aovs: films.aovs,
@@ -350,17 +360,27 @@ pub fn render_selected(
 
 /// The report of the samples the ray budget cut short, by the material
 /// they were cut at: the material with the most (the lowest id among
-/// equals, so the report does not depend on the threads).
-fn budget_cut(scene: &Scene, cuts: &HashMap<MaterialId, u64>) -> Option<RayBudgetCut> {
+/// equals, so the report does not depend on the threads). `camera_rays` is
+/// the total when the pixels were sampled adaptively.
+fn budget_cut(
+    scene: &Scene,
+    cuts: &HashMap<MaterialId, u64>,
+    camera_rays: u64,
+) -> Option<RayBudgetCut> {
     let (&material, _) = cuts
         .iter()
         .max_by_key(|&(material, &samples)| (samples, std::cmp::Reverse(material.0)))?;
     let settings = &scene.settings;
     Some(RayBudgetCut {
         samples: cuts.values().sum(),
-        total: u64::from(settings.width)
-            * u64::from(settings.height)
-            * u64::from(settings.samples_per_pixel),
+        total: match settings.aa {
+            AntiAliasing::Stratified => {
+                u64::from(settings.width)
+                    * u64::from(settings.height)
+                    * u64::from(settings.samples_per_pixel)
+            }
+            AntiAliasing::Adaptive(_) => camera_rays,
+        },
         material,
         material_name: scene.material_name(material),
         max_depth: settings.max_depth,
@@ -399,6 +419,7 @@ fn tile_is_selected(selection: &PixelSelection, tile_x: u32, tile_y: u32) -> boo
 fn render_tile(
     integrator: &Integrator,
     camera: &Camera,
+    color_space: ColorSpace,
     settings: &RenderSettings,
     selection: &PixelSelection,
     tile_x: u32,
@@ -425,6 +446,16 @@ fn render_tile(
         selected: 0,
     };
     let spp = settings.samples_per_pixel;
+    let mut adaptive = match settings.aa {
+        AntiAliasing::Stratified => None,
+        AntiAliasing::Adaptive(a) => Some(AdaptivePixels::new(
+            integrator,
+            camera,
+            (settings.width, settings.height),
+            color_space,
+            a,
+        )),
+    };
     for y in y0..y0 + height {
         for x in x0..x0 + width {
             if !selection.contains(x, y) {
@@ -435,6 +466,16 @@ fn render_tile(
                 continue;
             }
             tile.selected += 1;
+            if let Some(adaptive) = &mut adaptive {
+                let mut cost = Cost {
+                    rays: &mut tile.rays,
+                    cuts: &mut tile.cuts,
+                };
+                let color = adaptive.pixel(x, y, &mut cost);
+                tile.color.extend_from_slice(&color.to_f32());
+                push_aovs(integrator, camera, settings, x, y, None, &mut tile.aovs);
+                continue;
+            }
             let pattern = pixel_pattern(x, y);
             let mut sum = Color::ZERO;
             let mut centre = None;
@@ -451,55 +492,69 @@ fn render_tile(
             }
             let color = sum / f64::from(spp);
             tile.color.extend_from_slice(&color.to_f32());
-            if settings.aovs.is_empty() {
-                continue;
-            }
-            let (ray, first_hit) = centre.unwrap_or_else(|| {
-                let ray = camera.ray(
-                    settings.width,
-                    settings.height,
-                    f64::from(x) + 0.5,
-                    f64::from(y) + 0.5,
-                );
-                let hit = integrator.first_hit(&ray);
-                (ray, hit)
-            });
-            for (aov, data) in settings.aovs.iter().zip(&mut tile.aovs) {
-                match (aov, &first_hit) {
-                    (Aov::Depth, Some((hit, _))) => data.push(hit.t() as f32),
-                    (Aov::Depth, None) => data.push(f32::INFINITY),
-                    (Aov::Normal, Some((_, surface))) => {
-                        let n = if ray.dir.dot(surface.normal) < 0.0 {
-                            surface.normal
-                        } else {
-                            -surface.normal
-                        };
-                        data.extend_from_slice(&[n.x as f32, n.y as f32, n.z as f32]);
-                    }
-                    (Aov::Normal, None) => data.extend_from_slice(&[0.0; 3]),
-                    (Aov::Id, Some((hit, _))) => data.push(
-                        integrator
-                            .world()
-                            .placement(hit.primitive)
-                            .map_or(hit.primitive.0, |(_, p)| p) as f32,
-                    ),
-                    (Aov::Instance, Some((hit, _))) => data.push(
-                        integrator
-                            .world()
-                            .placement(hit.primitive)
-                            .map_or(-1.0, |(k, _)| k as f32),
-                    ),
-                    (Aov::Instance, None) => data.push(-1.0),
-                    (Aov::Id, None) => data.push(-1.0),
-                    (Aov::Cost, _) => {
-                        let counters = integrator.traversal_cost(&ray);
-                        data.push((counters.nodes + counters.primitives) as f32);
-                    }
-                }
-            }
+            push_aovs(integrator, camera, settings, x, y, centre, &mut tile.aovs);
         }
     }
     tile
+}
+
+/// Appends the AOVs of pixel (`x`, `y`): those of the ray through its
+/// centre, given as `centre` with its first hit when it was traced.
+fn push_aovs(
+    integrator: &Integrator,
+    camera: &Camera,
+    settings: &RenderSettings,
+    x: u32,
+    y: u32,
+    centre: Option<(Ray, Option<(Hit, Surface)>)>,
+    aovs: &mut [Vec<f32>],
+) {
+    if settings.aovs.is_empty() {
+        return;
+    }
+    let (ray, first_hit) = centre.unwrap_or_else(|| {
+        let ray = camera.ray(
+            settings.width,
+            settings.height,
+            f64::from(x) + 0.5,
+            f64::from(y) + 0.5,
+        );
+        let hit = integrator.first_hit(&ray);
+        (ray, hit)
+    });
+    for (aov, data) in settings.aovs.iter().zip(aovs.iter_mut()) {
+        match (aov, &first_hit) {
+            (Aov::Depth, Some((hit, _))) => data.push(hit.t() as f32),
+            (Aov::Depth, None) => data.push(f32::INFINITY),
+            (Aov::Normal, Some((_, surface))) => {
+                let n = if ray.dir.dot(surface.normal) < 0.0 {
+                    surface.normal
+                } else {
+                    -surface.normal
+                };
+                data.extend_from_slice(&[n.x as f32, n.y as f32, n.z as f32]);
+            }
+            (Aov::Normal, None) => data.extend_from_slice(&[0.0; 3]),
+            (Aov::Id, Some((hit, _))) => data.push(
+                integrator
+                    .world()
+                    .placement(hit.primitive)
+                    .map_or(hit.primitive.0, |(_, p)| p) as f32,
+            ),
+            (Aov::Instance, Some((hit, _))) => data.push(
+                integrator
+                    .world()
+                    .placement(hit.primitive)
+                    .map_or(-1.0, |(k, _)| k as f32),
+            ),
+            (Aov::Instance, None) => data.push(-1.0),
+            (Aov::Id, None) => data.push(-1.0),
+            (Aov::Cost, _) => {
+                let counters = integrator.traversal_cost(&ray);
+                data.push((counters.nodes + counters.primitives) as f32);
+            }
+        }
+    }
 }
 
 #[cfg(test)]

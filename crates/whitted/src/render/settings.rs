@@ -2,7 +2,7 @@
 //! part (size, samples, depth, structure), the command line may replace any
 //! of it and adds the rest (threads, per-pixel data).
 
-use super::RenderError;
+use super::{AntiAliasing, RenderError};
 use crate::accel::AccelKind;
 use crate::integrator::{IntegratorKind, PhotonSettings};
 
@@ -97,8 +97,11 @@ pub struct RenderSettings {
     pub width: u32,
     /// Image height in pixels.
     pub height: u32,
-    /// Samples per pixel (1 means exactly the pixel centre).
+    /// Samples per pixel (1 means exactly the pixel centre), when `aa` is
+    /// stratified.
     pub samples_per_pixel: u32,
+    /// How the camera samples each pixel.
+    pub aa: AntiAliasing,
     /// Deepest reflection/refraction recursion; 0 traces primary rays only.
     pub max_depth: u32,
     /// A branch whose weight on the pixel falls below this stops early
@@ -137,6 +140,7 @@ impl RenderSettings {
             return Err(RenderError::DepthTooLarge(self.max_depth));
         }
         self.photons.check()?;
+        self.aa.check()?;
         Ok(())
     }
 }
@@ -147,6 +151,7 @@ impl Default for RenderSettings {
             width: 640,
             height: 480,
             samples_per_pixel: 1,
+            aa: AntiAliasing::Stratified,
             max_depth: 8,
             min_weight: 1e-3,
             accel: AccelKind::default(),

@@ -34,6 +34,7 @@
 //! out of range, unknown names, and shapes, transforms or cameras their
 //! constructors refuse.
 
+mod anti_aliasing;
 mod area_light;
 mod csg;
 mod definition;
@@ -212,6 +213,10 @@ const RENDER_KEYS: &[&str] = &[
     photons::PHOTON_KEYS[0],
     photons::PHOTON_KEYS[1],
     photons::PHOTON_KEYS[2],
+    anti_aliasing::AA_KEYS[0],
+    anti_aliasing::AA_KEYS[1],
+    anti_aliasing::AA_KEYS[2],
+    anti_aliasing::AA_KEYS[3],
 ];
 
 fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
@@ -245,6 +250,7 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
     let accel_bottom = r.optional(&f, "accel_bottom", read_accel);
     let color_space = r.or_default(&f, "colours", ColorSpace::Linear, read_color_space);
     let photons = photons::read_photons(r, &f);
+    let aa = anti_aliasing::read_anti_aliasing(r, &f);
     keys?;
     let (width, height) = size?;
     Ok(Render {
@@ -258,6 +264,7 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
             photons: photons?,
             accel_top: accel_top?,
             accel_bottom: accel_bottom?,
+            aa: aa?,
             ..d
         },
         background: background?,
@@ -409,7 +416,7 @@ pub(super) mod tests {
                 "`ambient` must not be negative, got -1",
                 "unknown key `size` in [render]; expected one of: width, height, samples, \
                  max_depth, min_weight, background, ambient, accel, accel_top, accel_bottom, colours, \
-                 photons, gather, radius",
+                 photons, gather, radius, aa, aa_threshold, aa_depth, aa_min_depth",
                 "unknown acceleration structure `octree`; expected one of: bvh, kdtree, grid, linear",
                 "unknown colour convention `srgb` for `colours`; expected one of: linear, display",
             ]
