@@ -16,6 +16,7 @@ mod render_command;
 mod render_stats;
 mod report;
 mod scene_arguments;
+mod serve;
 #[cfg(unix)]
 mod signals;
 mod split;
@@ -45,6 +46,7 @@ enum Command {
     Bench(bench_command::BenchArgs),
     Merge(merge_command::MergeArgs),
     Explain(explain_command::ExplainArgs),
+    Serve(serve::ServeArgs),
 }
 
 fn main() -> ExitCode {
@@ -58,6 +60,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench_command::run(&args),
         Command::Merge(args) => merge_command::run(&args),
         Command::Explain(args) => explain_command::run(&args),
+        Command::Serve(args) => serve::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
