@@ -160,8 +160,8 @@ fn check_origin(
     Ok(())
 }
 
-/// Sends the session's newest frame or error, then each newer one, until
-/// the page goes away.
+/// Sends the session's newest frame or error, then each newer one (those
+/// still kept), until the page goes away.
 fn stream_events(session: &Session, stream: &TcpStream) {
     let mut out = stream;
     if http::start_events(&mut out).is_err() {
@@ -169,10 +169,13 @@ fn stream_events(session: &Session, stream: &TcpStream) {
     }
     let mut seen = 0;
     loop {
-        let (now, event) = session.next_event(seen, KEEP_ALIVE);
-        let sent = match event.filter(|_| now > seen) {
-            Some(event) => http::send_event(&mut out, event.name, &event.data),
-            None => out.write_all(b": still here\n\n").and_then(|()| out.flush()),
+        let (now, events) = session.next_events(seen, KEEP_ALIVE);
+        let sent = if events.is_empty() {
+            out.write_all(b": still here\n\n").and_then(|()| out.flush())
+        } else {
+            events
+                .iter()
+                .try_for_each(|e| http::send_event(&mut out, e.name, &e.data))
         };
         if sent.is_err() {
             return;

@@ -8,6 +8,7 @@
 //! (there within a fraction of a second), 1/2, then the full picture; a
 //! view asked for while the mouse moves gets only a 1/4 pass.
 
+use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
@@ -21,6 +22,10 @@ use whitted::render::{Aov, Camera, RenderError, RenderOutput, Scene, render_canc
 use crate::explain_svg::base64;
 use crate::scene_arguments::SceneArgs;
 use crate::serve::picture::display_film;
+
+/// How many of the newest events are kept for a page that reads them
+/// late (older ones are skipped: a page needs the newest picture).
+const EVENTS_KEPT: usize = 8;
 
 /// A camera as the page moves it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -109,9 +114,10 @@ struct Inner {
     requested: u64,
     /// The scene file changed: read it again.
     reload: bool,
-    /// Counts what was published (events and state).
+    /// Counts the events published.
     published: u64,
-    event: Option<Event>,
+    /// The newest events (at most [`EVENTS_KEPT`]), each with its number.
+    events: VecDeque<(u64, Event)>,
     /// The scene's camera (the arguments applied), when one was read.
     scene_camera: Option<CameraView>,
     /// The scene as the newest request renders it at full size.
@@ -137,7 +143,7 @@ impl Session {
                 requested: 1,
                 reload: true,
                 published: 0,
-                event: None,
+                events: VecDeque::new(),
                 scene_camera: None,
                 scene: None,
                 full: None,
@@ -210,25 +216,40 @@ impl Session {
         })
     }
 
-    /// Waits until something newer than `seen` is published (or
-    /// `timeout` passes) and returns it with its number.
-    pub fn next_event(&self, seen: u64, timeout: Duration) -> (u64, Option<Event>) {
+    /// Waits until an event newer than `seen` is published (or `timeout`
+    /// passes) and returns the number of the newest with the events after
+    /// `seen` still kept; for a page that saw nothing yet (`seen` 0), the
+    /// newest only.
+    pub fn next_events(&self, seen: u64, timeout: Duration) -> (u64, Vec<Event>) {
         let inner = self.lock();
         let (inner, _) = self
             .changed
             .wait_timeout_while(inner, timeout, |i| i.published <= seen)
             .unwrap_or_else(PoisonError::into_inner);
-        (inner.published, inner.event.clone())
+        let newer = inner.events.iter().filter(|(n, _)| *n > seen);
+        let events = if seen == 0 {
+            newer.last().map(|(_, e)| e.clone()).into_iter().collect()
+        } else {
+            newer.map(|(_, e)| e.clone()).collect()
+        };
+        (inner.published, events)
     }
 
     fn publish(&self, name: &'static str, mut data: Value) {
         data["state"] = self.state();
         let mut inner = self.lock();
         inner.published += 1;
-        inner.event = Some(Event {
-            name,
-            data: Arc::new(data.to_string()),
-        });
+        let number = inner.published;
+        if inner.events.len() == EVENTS_KEPT {
+            inner.events.pop_front();
+        }
+        inner.events.push_back((
+            number,
+            Event {
+                name,
+                data: Arc::new(data.to_string()),
+            },
+        ));
         self.changed.notify_all();
     }
 
