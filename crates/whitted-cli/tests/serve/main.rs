@@ -2,4 +2,5 @@
 //! browser, headless chromium driven over WebDriver (`browser.rs`).
 
 mod api;
+mod browser;
 mod support;
