@@ -84,10 +84,16 @@ pub fn read_request(input: &mut impl BufRead) -> Result<Option<Request>, Refusal
     let (Some(method), Some(target), Some(version), None) =
         (parts.next(), parts.next(), parts.next(), parts.next())
     else {
-        return Err(Refusal::new(400, "the request line is not `METHOD PATH HTTP/1.1`"));
+        return Err(Refusal::new(
+            400,
+            "the request line is not `METHOD PATH HTTP/1.1`",
+        ));
     };
     if !version.starts_with("HTTP/1.") || method.is_empty() || !target.starts_with('/') {
-        return Err(Refusal::new(400, "the request line is not `METHOD PATH HTTP/1.1`"));
+        return Err(Refusal::new(
+            400,
+            "the request line is not `METHOD PATH HTTP/1.1`",
+        ));
     }
     let (method, target) = (method.to_string(), target.to_string());
     let mut headers = Vec::new();
@@ -122,7 +128,10 @@ pub fn read_request(input: &mut impl BufRead) -> Result<Option<Request>, Refusal
         return Err(Refusal::new(413, "the request's body is too long"));
     }
     if request.header("transfer-encoding").is_some() {
-        return Err(Refusal::new(411, "a body must come with its Content-Length"));
+        return Err(Refusal::new(
+            411,
+            "a body must come with its Content-Length",
+        ));
     }
     request.body = vec![0; length];
     input
@@ -309,6 +318,9 @@ mod tests {
         );
         let long = format!("GET /{} HTTP/1.1\r\n\r\n", "a".repeat(MAX_HEAD));
         assert_eq!(status(&long), 431);
-        assert_eq!(status("POST / HTTP/1.1\r\nContent-Length: 5\r\n\r\nab"), 400);
+        assert_eq!(
+            status("POST / HTTP/1.1\r\nContent-Length: 5\r\n\r\nab"),
+            400
+        );
     }
 }

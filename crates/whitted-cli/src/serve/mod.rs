@@ -134,7 +134,10 @@ fn check_origin(
         return Ok(());
     }
     if peer.is_some_and(|p| !p.ip().is_loopback()) {
-        return Err(Refusal::new(403, "requests from other machines are refused"));
+        return Err(Refusal::new(
+            403,
+            "requests from other machines are refused",
+        ));
     }
     let port = address.port();
     let hosts = [
@@ -171,7 +174,8 @@ fn stream_events(session: &Session, stream: &TcpStream) {
     loop {
         let (now, events) = session.next_events(seen, KEEP_ALIVE);
         let sent = if events.is_empty() {
-            out.write_all(b": still here\n\n").and_then(|()| out.flush())
+            out.write_all(b": still here\n\n")
+                .and_then(|()| out.flush())
         } else {
             events
                 .iter()
@@ -217,15 +221,24 @@ mod tests {
         assert_eq!(check(&with_headers("GET", &[]), local), Err(403));
         let posted = with_headers(
             "POST",
-            &[("host", "127.0.0.1:7878"), ("origin", "http://evil.example")],
+            &[
+                ("host", "127.0.0.1:7878"),
+                ("origin", "http://evil.example"),
+            ],
         );
         assert_eq!(check(&posted, local), Err(403));
         let own = with_headers(
             "POST",
-            &[("host", "127.0.0.1:7878"), ("origin", "http://127.0.0.1:7878")],
+            &[
+                ("host", "127.0.0.1:7878"),
+                ("origin", "http://127.0.0.1:7878"),
+            ],
         );
         assert_eq!(check(&own, local), Ok(()));
         let open: SocketAddr = "0.0.0.0:7878".parse().unwrap();
-        assert_eq!(check_origin(&rebound, open, Some(far)).map_err(|e| e.status), Ok(()));
+        assert_eq!(
+            check_origin(&rebound, open, Some(far)).map_err(|e| e.status),
+            Ok(())
+        );
     }
 }

@@ -40,7 +40,9 @@ fn map_pixels(film: &Film, f: impl Fn([f32; 3]) -> [f32; 3]) -> Film {
 /// Depth as grey: the nearest hit white, the farthest dark, misses black.
 fn depth_picture(film: &Film) -> Film {
     let finite = film.data().iter().copied().filter(|d| d.is_finite());
-    let (near, far) = finite.fold((f32::INFINITY, 0.0f32), |(lo, hi), d| (lo.min(d), hi.max(d)));
+    let (near, far) = finite.fold((f32::INFINITY, 0.0f32), |(lo, hi), d| {
+        (lo.min(d), hi.max(d))
+    });
     let span = (far - near).max(f32::MIN_POSITIVE);
     map_pixels(film, |d| {
         let d = d[0];
@@ -58,7 +60,9 @@ fn id_color(id: f32) -> [f32; 3] {
     if id < 0.0 {
         return [0.0; 3];
     }
-    let mut h = (id as u64).wrapping_add(1).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    let mut h = (id as u64)
+        .wrapping_add(1)
+        .wrapping_mul(0x9e37_79b9_7f4a_7c15);
     h ^= h >> 29;
     std::array::from_fn(|c| 0.15 + 0.85 * ((h >> (16 * c)) & 0xffff) as f32 / 65535.0)
 }

@@ -82,19 +82,21 @@ fn change_view(session: &Session, request: &Request) -> Result<Response, Refusal
             }
             "camera" if value == "scene" => view.camera = None,
             "aov" => {
-                view.aov = match value.as_str() {
-                    "color" => None,
-                    name => Some(Aov::from_name(name).ok_or_else(|| {
-                        bad("aov", format!("`{name}` is not color or an AOV"))
-                    })?),
-                }
+                view.aov =
+                    match value.as_str() {
+                        "color" => None,
+                        name => Some(Aov::from_name(name).ok_or_else(|| {
+                            bad("aov", format!("`{name}` is not color or an AOV"))
+                        })?),
+                    }
             }
             "accel" => {
                 view.accel = match value.as_str() {
                     "scene" => None,
-                    name => Some(AccelKind::from_name(name).ok_or_else(|| {
-                        bad("accel", format!("`{name}` is not a structure"))
-                    })?),
+                    name => Some(
+                        AccelKind::from_name(name)
+                            .ok_or_else(|| bad("accel", format!("`{name}` is not a structure")))?,
+                    ),
                 }
             }
             "preview" => view.preview = value == "1",
@@ -131,7 +133,11 @@ fn explain(session: &Session, request: &Request, svg: bool) -> Result<Response, 
         explain_pixel(&scene, pixel, sample).map_err(|e| Refusal::new(400, e.to_string()))?;
     let file = session.file();
     if !svg {
-        return Ok(Response::json(&explanation_json(&scene, file, &explanation)));
+        return Ok(Response::json(&explanation_json(
+            &scene,
+            file,
+            &explanation,
+        )));
     }
     let frame = session
         .full_frame()
@@ -231,9 +237,17 @@ mod tests {
         assert_eq!(status(request("POST", "/api/view", &[], "aov=colour")), 400);
         assert_eq!(status(request("POST", "/api/view", &[], "nonsense=1")), 400);
         assert_eq!(status(request("POST", "/api/view", &[], "fov=200")), 400);
-        assert_eq!(status(request("GET", "/api/explain", &[("x", "1")], "")), 400);
         assert_eq!(
-            status(request("GET", "/api/explain", &[("x", "-1"), ("y", "0")], "")),
+            status(request("GET", "/api/explain", &[("x", "1")], "")),
+            400
+        );
+        assert_eq!(
+            status(request(
+                "GET",
+                "/api/explain",
+                &[("x", "-1"), ("y", "0")],
+                ""
+            )),
             400
         );
         assert_eq!(status(request("GET", "/api/save.png", &[], "")), 409);

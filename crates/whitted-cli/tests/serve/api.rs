@@ -18,8 +18,16 @@ fn the_page_is_served_and_frames_come_coarse_first_then_full() {
     assert_eq!(server.get("/page.css").0, 200);
     let mut events = server.events();
     let first = events.full_frame();
-    assert_eq!((&first["width"], &first["height"]), (&64.into(), &48.into()));
-    assert!(first["png"].as_str().unwrap().starts_with("data:image/png;base64,iVBOR"));
+    assert_eq!(
+        (&first["width"], &first["height"]),
+        (&64.into(), &48.into())
+    );
+    assert!(
+        first["png"]
+            .as_str()
+            .unwrap()
+            .starts_with("data:image/png;base64,iVBOR")
+    );
     assert!(first["rays_per_second"].as_f64().unwrap() > 0.0);
     assert!(first["build_seconds"].as_f64().unwrap() >= 0.0);
     // A new request: every pass of it is seen, the coarse one first.
@@ -148,7 +156,10 @@ fn views_switch_between_aovs_and_saves_use_the_writers() {
     }
     let (status, exr) = server.get("/api/save.exr");
     assert_eq!(status, 200);
-    assert!(exr.starts_with(&[0x76, 0x2f, 0x31, 0x01]), "an OpenEXR file");
+    assert!(
+        exr.starts_with(&[0x76, 0x2f, 0x31, 0x01]),
+        "an OpenEXR file"
+    );
     assert_eq!(server.view("aov=color").0, 200);
 }
 
@@ -157,13 +168,15 @@ fn bad_and_foreign_requests_are_refused_and_the_server_stays_up() {
     let mut server = Server::start(&scene_text(), &SIZE);
     let port = server.port;
     assert_eq!(server.raw("GARBAGE", b"").0, 400);
-    assert_eq!(server.raw("GET / HTTP/1.1\r\nHost: evil.example", b"").0, 403);
+    assert_eq!(
+        server.raw("GET / HTTP/1.1\r\nHost: evil.example", b"").0,
+        403
+    );
     assert_eq!(server.get("/../scene.toml").0, 404);
     assert_eq!(server.get("/scene.toml").0, 404);
     assert_eq!(server.get("/%2e%2e/etc/passwd").0, 404);
-    let foreign = format!(
-        "POST /api/view HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nOrigin: http://evil.example"
-    );
+    let foreign =
+        format!("POST /api/view HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nOrigin: http://evil.example");
     assert_eq!(server.raw(&foreign, b"aov=depth").0, 403);
     assert_eq!(server.view("aov=nothing").0, 400);
     assert_eq!(server.view("fov=0").0, 400);

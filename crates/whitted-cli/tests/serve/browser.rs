@@ -120,7 +120,11 @@ impl Browser {
 
     /// Runs `script` (a function body) in the page; what it returns.
     fn run(&self, script: &str) -> Value {
-        self.command("POST", "/execute/sync", &json!({ "script": script, "args": [] }))
+        self.command(
+            "POST",
+            "/execute/sync",
+            &json!({ "script": script, "args": [] }),
+        )
     }
 
     /// Runs `script` until it returns something true (within PATIENCE).
@@ -231,7 +235,14 @@ fn the_page_in_headless_chromium_shows_the_picture_trees_views_and_edits() {
     let pixel = "100,150";
     let printed: Value = serde_json::from_slice(&whitted(
         &[
-            "explain", "scene.toml", "--pixel", pixel, "--json", "--width", "320", "--height",
+            "explain",
+            "scene.toml",
+            "--pixel",
+            pixel,
+            "--json",
+            "--width",
+            "320",
+            "--height",
             "240",
         ],
         server.dir.path(),
@@ -246,7 +257,13 @@ fn the_page_in_headless_chromium_shows_the_picture_trees_views_and_edits() {
     // The depth view.
     browser.command(
         "POST",
-        &format!("/element/{}/click", browser.element("#aov option[value=depth]").as_str().unwrap()),
+        &format!(
+            "/element/{}/click",
+            browser
+                .element("#aov option[value=depth]")
+                .as_str()
+                .unwrap()
+        ),
         &json!({}),
     );
     let depth = browser.wait_for(
@@ -256,11 +273,7 @@ fn the_page_in_headless_chromium_shows_the_picture_trees_views_and_edits() {
 
     // An edit of the scene file is seen (a narrower view: the depth changes).
     let before = browser.run("return document.getElementById('picture').src;");
-    std::fs::write(
-        server.scene(),
-        scene_text().replace("fov = 45", "fov = 35"),
-    )
-    .unwrap();
+    std::fs::write(server.scene(), scene_text().replace("fov = 45", "fov = 35")).unwrap();
     browser.wait_for(
         "the edited scene",
         &format!("return {FULL_FRAME} && window.whitted.frame.request > {depth};"),
@@ -269,7 +282,8 @@ fn the_page_in_headless_chromium_shows_the_picture_trees_views_and_edits() {
     assert_ne!(before, after, "the picture changed");
 
     // Drag the camera for a while, counting the frames shown.
-    let before = browser.run("return [window.whitted.frames, performance.now(), window.whitted.state.flags];");
+    let before = browser
+        .run("return [window.whitted.frames, performance.now(), window.whitted.state.flags];");
     let mut steps = vec![json!({ "type": "pointerDown", "button": 0 })];
     for i in 1..=40 {
         steps.push(json!({ "type": "pointerMove", "x": 2 * i, "y": i / 2, "duration": 50 }));
@@ -291,7 +305,10 @@ fn the_page_in_headless_chromium_shows_the_picture_trees_views_and_edits() {
         ),
     );
     assert!(moved.as_str().unwrap().starts_with("--eye "), "{moved}");
-    browser.wait_for("the picture after the drag", &format!("return {FULL_FRAME};"));
+    browser.wait_for(
+        "the picture after the drag",
+        &format!("return {FULL_FRAME};"),
+    );
 
     let screenshot = browser.command("GET", "/screenshot", &json!({}));
     let png = decode_base64(screenshot.as_str().unwrap());
@@ -306,11 +323,9 @@ fn as_floats(value: &Value) -> Value {
     match value {
         Value::Number(n) => json!(n.as_f64()),
         Value::Array(items) => Value::Array(items.iter().map(as_floats).collect()),
-        Value::Object(map) => Value::Object(
-            map.iter()
-                .map(|(k, v)| (k.clone(), as_floats(v)))
-                .collect(),
-        ),
+        Value::Object(map) => {
+            Value::Object(map.iter().map(|(k, v)| (k.clone(), as_floats(v))).collect())
+        }
         other => other.clone(),
     }
 }

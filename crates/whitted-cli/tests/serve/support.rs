@@ -14,9 +14,15 @@ pub const PATIENCE: Duration = Duration::from_secs(60);
 
 /// The scene the tests serve: the built-in scene's file.
 pub fn scene_text() -> String {
-    let path: PathBuf = [env!("CARGO_MANIFEST_DIR"), "..", "..", "scenes", "whitted.toml"]
-        .iter()
-        .collect();
+    let path: PathBuf = [
+        env!("CARGO_MANIFEST_DIR"),
+        "..",
+        "..",
+        "scenes",
+        "whitted.toml",
+    ]
+    .iter()
+    .collect();
     std::fs::read_to_string(path).unwrap()
 }
 
@@ -55,10 +61,7 @@ impl Server {
             .and_then(|rest| rest.split('/').next())
             .and_then(|port| port.parse().ok())
             .unwrap_or_else(|| panic!("no URL in `{line}`"));
-        assert!(
-            line.contains("only this machine can connect"),
-            "{line}"
-        );
+        assert!(line.contains("only this machine can connect"), "{line}");
         eprintln!("whitted serve started: {}", line.trim());
         Server { child, port, dir }
     }
