@@ -152,13 +152,14 @@ fn check_origin(
             format!("requests for host `{host}` are refused: this server is {address}"),
         ));
     }
-    if let Some(origin) = request.header("origin") {
-        if request.method != "GET" && origin != format!("http://{host}") {
-            return Err(Refusal::new(
-                403,
-                format!("posts from `{origin}` are refused"),
-            ));
-        }
+    if let Some(origin) = request.header("origin")
+        && request.method != "GET"
+        && origin != format!("http://{host}")
+    {
+        return Err(Refusal::new(
+            403,
+            format!("posts from `{origin}` are refused"),
+        ));
     }
     Ok(())
 }

@@ -226,9 +226,13 @@ impl Session {
             .changed
             .wait_timeout_while(inner, timeout, |i| i.published <= seen)
             .unwrap_or_else(PoisonError::into_inner);
-        let newer = inner.events.iter().filter(|(n, _)| *n > seen);
+        let mut newer = inner.events.iter().filter(|(n, _)| *n > seen);
         let events = if seen == 0 {
-            newer.last().map(|(_, e)| e.clone()).into_iter().collect()
+            newer
+                .next_back()
+                .map(|(_, e)| e.clone())
+                .into_iter()
+                .collect()
         } else {
             newer.map(|(_, e)| e.clone()).collect()
         };
@@ -300,10 +304,8 @@ impl Session {
                     Err(message) => self.publish_error(done, &message),
                 }
             }
-            if let Some(base) = &base {
-                if let Err(message) = self.render_view(done, base, &view) {
-                    self.publish_error(done, &message);
-                }
+            if let Some(Err(message)) = base.as_ref().map(|b| self.render_view(done, b, &view)) {
+                self.publish_error(done, &message);
             }
         }
     }
