@@ -17,6 +17,7 @@ mod render_command;
 mod render_stats;
 mod report;
 mod scene_arguments;
+mod serve;
 #[cfg(unix)]
 mod signals;
 mod split;
@@ -46,6 +47,7 @@ enum Command {
     Bench(bench_command::BenchArgs),
     Merge(merge_command::MergeArgs),
     Explain(explain_command::ExplainArgs),
+    Serve(serve::ServeArgs),
 }
 
 fn main() -> ExitCode {
@@ -59,6 +61,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench_command::run(&args),
         Command::Merge(args) => merge_command::run(&args),
         Command::Explain(args) => explain_command::run(&args),
+        Command::Serve(args) => serve::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

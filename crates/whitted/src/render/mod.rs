@@ -38,7 +38,7 @@ pub use sources::{LineIndex, ObjectSource, ObjectSources, PrimitiveDescription, 
 pub use trace_timing::TraceTiming;
 
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Mutex, PoisonError};
 
 use rayon::prelude::*;
@@ -182,6 +182,9 @@ pub enum RenderError {
     /// The pixels asked for are not in the image.
     #[error(transparent)]
     Selection(#[from] SelectionError),
+    /// The render was cancelled ([`render_cancellable`]) before it ended.
+    #[error("the render was cancelled")]
+    Cancelled,
     /// The thread pool could not be created.
     #[error("could not start {threads} worker threads: {message}")]
     Threads {
@@ -253,6 +256,20 @@ pub fn render(
     render_selected(scene, &whole, progress)
 }
 
+/// Renders `scene` as [`render`] does, but stops early with
+/// [`RenderError::Cancelled`] once `cancel` is set: each tile checks it
+/// before it starts, so a cancelled render ends within a tile's time per
+/// thread (the live preview of `whitted serve` cancels a render when a
+/// newer one is asked for).
+pub fn render_cancellable(
+    scene: &Scene,
+    cancel: &AtomicBool,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<RenderOutput, RenderError> {
+    let whole = PixelSelection::whole(scene.settings.width, scene.settings.height);
+    render_pixels(scene, &whole, Some(cancel), progress)
+}
+
 /// Renders the pixels of `scene` that `selection` holds, as [`render`]
 /// does (each bit for bit as a whole render has it), and leaves the others
 /// black. Progress counts the selected pixels.
@@ -261,6 +278,17 @@ pub fn render_selected(
     selection: &PixelSelection,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<RenderOutput, RenderError> {
+    render_pixels(scene, selection, None, progress)
+}
+
+/// [`render_selected`], stopping early when `cancel` is given and set.
+fn render_pixels(
+    scene: &Scene,
+    selection: &PixelSelection,
+    cancel: Option<&AtomicBool>,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<RenderOutput, RenderError> {
+    let cancelled = || cancel.is_some_and(|c| c.load(Ordering::Relaxed));
     let settings = &scene.settings;
     let (width, height) = (settings.width, settings.height);
     settings.check()?;
@@ -320,6 +348,9 @@ pub fn render_selected(
     let clock = trace_timing::TraceClock::start();
     pool.install(|| {
         tiles.into_par_iter().for_each(|index| {
+            if cancelled() {
+                return;
+            }
             let tile = clock.tile(|| {
                 render_tile(
                     &integrator,
@@ -341,6 +372,9 @@ pub fn render_selected(
         });
     });
     let trace = clock.finish(pool.current_num_threads());
+    if cancelled() {
+        return Err(RenderError::Cancelled);
+    }
     let films = films.into_inner().unwrap_or_else(PoisonError::into_inner);
     check_finite(&films.image)?;
     let ray_budget_cut = budget_cut(scene, &films.cuts, films.rays[RayKind::Primary]);
@@ -615,6 +649,26 @@ mod tests {
         assert_eq!(clamp.tiles, 4);
         assert!(clamp.used <= clamp.tiles, "{clamp:?}");
         assert_eq!(clamped.image, output.image);
+    }
+
+    #[test]
+    fn a_cancelled_render_stops_and_an_uncancelled_one_is_the_plain_render() {
+        let mut scene = crate::scene::default_scene();
+        scene.settings.width = 64;
+        scene.settings.height = 48;
+        scene.settings.threads = Some(1);
+        let cancel = AtomicBool::new(false);
+        let plain = render(&scene, &|_| {}).unwrap();
+        let kept = render_cancellable(&scene, &cancel, &|_| {}).unwrap();
+        assert_eq!(kept.image, plain.image);
+        let tiles = std::sync::atomic::AtomicU64::new(0);
+        let stopped = render_cancellable(&scene, &cancel, &|_| {
+            if tiles.fetch_add(1, Ordering::Relaxed) == 2 {
+                cancel.store(true, Ordering::Relaxed);
+            }
+        });
+        assert!(matches!(stopped, Err(RenderError::Cancelled)));
+        assert_eq!(tiles.load(Ordering::Relaxed), 3, "tiles rendered of 12");
     }
 
     #[test]
