@@ -7,6 +7,7 @@
 
 pub mod area_light;
 pub mod bump;
+pub mod differential;
 mod color;
 pub mod emission;
 pub mod factor;
@@ -20,6 +21,7 @@ pub mod texture;
 
 pub use area_light::{AreaLight, Emitter};
 pub use bump::{Bump, shading_normal};
+pub use differential::{Footprint, RayDifferential, TextureFilter};
 pub use color::Color;
 pub use emission::EmittedRay;
 pub use light::{Attenuation, Light, LightSample, direct_samples};
