@@ -14,7 +14,7 @@ use crate::integrator::{
     Shading, Unobserved,
 };
 use crate::math::DVec2;
-use crate::render::sample_ray::{pixel_pattern, sample_ray};
+use crate::render::sample_ray::{pixel_pattern, sample_differential, sample_ray};
 use crate::render::{RenderError, Scene};
 use crate::shading::Color;
 use crate::world::MAX_PRIMITIVES;
@@ -152,14 +152,15 @@ fn trace_pixel(
     let mut tree = None;
     for s in 0..settings.samples_per_pixel {
         let ray = sample_ray(&scene.camera, settings, (x, y), pattern, s);
+        let differential = sample_differential(&scene.camera, settings, (x, y), pattern, s);
         let color = if s == sample {
             let mut recorder = RayTreeRecorder::new(&world, shading, limits);
-            let traced = integrator.trace_primary_observed(&ray, &mut counts, &mut recorder);
+            let traced = integrator.trace_primary_observed(&ray, differential, &mut counts, &mut recorder);
             tree = recorder.finish();
             traced.color
         } else {
             integrator
-                .trace_primary_observed(&ray, &mut counts, &mut Unobserved)
+                .trace_primary_observed(&ray, differential, &mut counts, &mut Unobserved)
                 .color
         };
         sample_colors.push(color);

@@ -46,7 +46,7 @@ use crate::integrator::{
 use crate::limits::{MemoryBudget, MemoryError};
 use crate::shading::Color;
 use crate::world::{MAX_PRIMITIVES, MaterialId, World};
-use sample_ray::{pixel_pattern, sample_ray};
+use sample_ray::{pixel_pattern, sample_differential, sample_ray};
 
 /// Side of the square tiles the image is cut into, in pixels.
 const TILE_SIZE: u32 = 16;
@@ -440,7 +440,8 @@ fn render_tile(
             let mut centre = None;
             for s in 0..spp {
                 let ray = sample_ray(camera, settings, (x, y), pattern, s);
-                let sample = integrator.trace_primary(&ray, &mut tile.rays);
+                let differential = sample_differential(camera, settings, (x, y), pattern, s);
+                let sample = integrator.trace_camera_ray(&ray, differential, &mut tile.rays);
                 if let Some(material) = sample.cut_at {
                     *tile.cuts.entry(material).or_default() += 1;
                 }

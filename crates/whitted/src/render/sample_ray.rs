@@ -2,6 +2,7 @@
 //! `whitted explain` agree on which ray a sample is.
 
 use crate::math::Ray;
+use crate::shading::{RayDifferential, TextureFilter};
 use crate::math::random::hash64;
 use crate::math::sampling::pixel_sample;
 use crate::render::{Camera, RenderSettings};
@@ -30,4 +31,30 @@ pub(crate) fn sample_ray(
         f64::from(x) + offset.x,
         f64::from(y) + offset.y,
     )
+}
+
+/// The ray differential of sample `s` of pixel (`x`, `y`) (see
+/// [`sample_ray`]) when the settings filter textures, else `None`: one
+/// pixel's step, scaled by `1/√spp` for several samples per pixel (the
+/// spacing of their grid).
+#[inline]
+pub(crate) fn sample_differential(
+    camera: &Camera,
+    settings: &RenderSettings,
+    (x, y): (u32, u32),
+    pattern: u32,
+    s: u32,
+) -> Option<RayDifferential> {
+    if settings.texture_filter == TextureFilter::None {
+        return None;
+    }
+    let spp = settings.samples_per_pixel;
+    let offset = pixel_sample(s, spp, pattern);
+    let differential = camera.ray_differential(
+        settings.width,
+        settings.height,
+        f64::from(x) + offset.x,
+        f64::from(y) + offset.y,
+    );
+    Some(differential.scaled(1.0 / f64::from(spp).sqrt()))
 }

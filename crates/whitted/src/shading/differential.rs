@@ -259,3 +259,58 @@ pub fn normal_differentials(
         change(differential.doy, differential.ddy, hit.dpdy),
     )
 }
+
+/// What a hit needs to pass a differential on to its reflected and
+/// refracted rays: the differential there and the normal's change.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bend {
+    hit: HitDifferential,
+    incident: Vec3,
+    n: Vec3,
+    dndx: Vec3,
+    dndy: Vec3,
+}
+
+impl Bend {
+    /// At the hit `s` of `ray` (whose differential is `differential`,
+    /// `hit` there), where the unit shading normal `n` faces the incoming
+    /// side `facing`; measures the normal's change in `world`
+    /// ([`normal_differentials`]).
+    pub fn new(
+        world: &World<'_>,
+        ray: &Ray,
+        differential: &RayDifferential,
+        hit: HitDifferential,
+        s: &Surface,
+        facing: Vec3,
+        n: Vec3,
+    ) -> Self {
+        let (dndx, dndy) = normal_differentials(world, ray, differential, &hit, s, facing);
+        Self {
+            hit,
+            incident: ray.dir,
+            n,
+            dndx,
+            dndy,
+        }
+    }
+
+    /// The differential of the mirror-reflected ray.
+    pub fn reflected(&self) -> RayDifferential {
+        reflected(&self.hit, self.incident, self.n, self.dndx, self.dndy)
+    }
+
+    /// The differential of the ray refracted into `direction` (unit) with
+    /// relative index `eta = n_from / n_to`.
+    pub fn refracted(&self, direction: Vec3, eta: f64) -> RayDifferential {
+        refracted(
+            &self.hit,
+            self.incident,
+            direction,
+            self.n,
+            eta,
+            self.dndx,
+            self.dndy,
+        )
+    }
+}
