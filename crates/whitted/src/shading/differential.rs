@@ -314,3 +314,158 @@ impl Bend {
         )
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::AccelKind;
+    use crate::math::Transform;
+    use crate::shading::optics::{reflect, refract};
+    use crate::shape::{Plane, Shape, Sphere};
+    use crate::world::{MaterialId, Objects};
+
+    /// A pinhole at the origin looking along +z: the ray through image
+    /// position (x, y), where one unit of x or y turns the view by
+    /// `PIXEL` radians (to first order), and its differential.
+    const PIXEL: f64 = 2e-3;
+
+    fn pixel_ray(x: f64, y: f64) -> Ray {
+        let v = Vec3::new(PIXEL * x, PIXEL * y, 1.0);
+        Ray::new(Vec3::new(0.0, 0.0, -6.0), v.normalize())
+    }
+
+    fn pixel_differential(x: f64, y: f64) -> RayDifferential {
+        let v = Vec3::new(PIXEL * x, PIXEL * y, 1.0);
+        let d = v.normalize();
+        let unit = |dv: Vec3| (dv - d.dot(dv) * d) / v.length();
+        RayDifferential {
+            dox: Vec3::ZERO,
+            ddx: unit(Vec3::new(PIXEL, 0.0, 0.0)),
+            doy: Vec3::ZERO,
+            ddy: unit(Vec3::new(0.0, PIXEL, 0.0)),
+        }
+    }
+
+    /// The hit of `ray` and its shading normal turned against the ray.
+    fn hit(world: &World<'_>, ray: &Ray) -> (Surface, Vec3) {
+        let h = world.intersect(ray).expect("the ray hits");
+        let s = world.surface(ray, &h);
+        let n = if s.shading_normal.dot(ray.dir) > 0.0 {
+            -s.shading_normal
+        } else {
+            s.shading_normal
+        };
+        (s, n)
+    }
+
+    /// A sphere squashed by a transform (an ellipsoid: the differential
+    /// goes through the instance's transform), and a tilted plane.
+    fn objects() -> Vec<Objects> {
+        let mut ellipsoid = Objects::default();
+        let squash = Transform::scale(Vec3::new(1.3, 0.8, 1.0)).unwrap();
+        let sphere = Sphere::new(Vec3::ZERO, 1.5).unwrap();
+        ellipsoid.add_primitive(Shape::Sphere(sphere), MaterialId(0), squash);
+        let mut plane = Objects::default();
+        let p = Plane::new(Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.3, -0.2, -1.0)).unwrap();
+        plane.add_primitive(Shape::Plane(p), MaterialId(0), Transform::IDENTITY);
+        vec![ellipsoid, plane]
+    }
+
+    fn close(a: Vec3, b: Vec3, tolerance: f64) -> bool {
+        (a - b).length() <= tolerance * b.length().max(1e-9)
+    }
+
+    const PIXELS: [(f64, f64); 4] = [(40.0, -20.0), (120.0, 40.0), (-90.0, 40.0), (60.0, -90.0)];
+
+    #[test]
+    fn the_transferred_differential_matches_neighbouring_hits_and_their_uv() {
+        for objects in objects() {
+            let world = World::build(&objects, AccelKind::default());
+            for (x, y) in PIXELS {
+                let ray = pixel_ray(x, y);
+                let (s, _) = hit(&world, &ray);
+                let h = pixel_differential(x, y).at_hit(&ray, &s).unwrap();
+                let e = 1e-3;
+                let (sx0, _) = hit(&world, &pixel_ray(x - e, y));
+                let (sx1, _) = hit(&world, &pixel_ray(x + e, y));
+                let (sy0, _) = hit(&world, &pixel_ray(x, y - e));
+                let (sy1, _) = hit(&world, &pixel_ray(x, y + e));
+                let fx = (sx1.point - sx0.point) / (2.0 * e);
+                let fy = (sy1.point - sy0.point) / (2.0 * e);
+                assert!(close(h.dpdx, fx, 1e-5), "{} {fx}", h.dpdx);
+                assert!(close(h.dpdy, fy, 1e-5), "{} {fy}", h.dpdy);
+                let ux = (sx1.uv - sx0.uv) / (2.0 * e);
+                let uy = (sy1.uv - sy0.uv) / (2.0 * e);
+                let f = h.footprint;
+                assert!((f.duv_dx - ux).length() < 1e-5 * ux.length().max(1e-6), "{f:?} {ux}");
+                assert!((f.duv_dy - uy).length() < 1e-5 * uy.length().max(1e-6), "{f:?} {uy}");
+            }
+        }
+    }
+
+    /// The reflected and refracted differentials against the reflected and
+    /// refracted rays of the neighbouring pixels (a quarter pixel either
+    /// side, the differential scaled to that step as for 16 samples per
+    /// pixel). The normal's change is measured over one step forward, so it
+    /// is first-order accurate in the step: 0.3% to 4% off over a whole
+    /// pixel here, a quarter of that over a quarter pixel.
+    #[test]
+    fn reflection_and_refraction_match_traced_neighbour_rays() {
+        let eta = 1.0 / 1.5;
+        let step = 0.25;
+        for objects in objects() {
+            let world = World::build(&objects, AccelKind::default());
+            for (x, y) in PIXELS {
+                let ray = pixel_ray(x, y);
+                let differential = pixel_differential(x, y).scaled(step);
+                let (s, n) = hit(&world, &ray);
+                let h = differential.at_hit(&ray, &s).unwrap();
+                let bend = Bend::new(&world, &ray, &differential, h, &s, n, n);
+                let t = refract(ray.dir, n, eta).unwrap();
+                let (r_diff, t_diff) = (bend.reflected(), bend.refracted(t, eta));
+                let outgoing = |x: f64, y: f64| {
+                    let ray = pixel_ray(x, y);
+                    let (s, n) = hit(&world, &ray);
+                    let r = reflect(ray.dir, n);
+                    (s.point, r, refract(ray.dir, n, eta).unwrap())
+                };
+                let (px0, rx0, tx0) = outgoing(x - step, y);
+                let (px1, rx1, tx1) = outgoing(x + step, y);
+                let (py0, ry0, ty0) = outgoing(x, y - step);
+                let (py1, ry1, ty1) = outgoing(x, y + step);
+                let fd = |a: Vec3, b: Vec3| (b - a) / 2.0;
+                let tolerance = 0.02;
+                assert!(close(r_diff.dox, fd(px0, px1), tolerance));
+                assert!(close(r_diff.doy, fd(py0, py1), tolerance));
+                let (frx, fry) = (fd(rx0, rx1), fd(ry0, ry1));
+                assert!(close(r_diff.ddx, frx, tolerance), "{} {frx}", r_diff.ddx);
+                assert!(close(r_diff.ddy, fry, tolerance), "{} {fry}", r_diff.ddy);
+                let (ftx, fty) = (fd(tx0, tx1), fd(ty0, ty1));
+                assert!(close(t_diff.ddx, ftx, tolerance), "{} {ftx}", t_diff.ddx);
+                assert!(close(t_diff.ddy, fty, tolerance), "{} {fty}", t_diff.ddy);
+            }
+        }
+    }
+
+    /// Taking the surface as flat gets a curved mirror wrong: the test
+    /// above can fail.
+    #[test]
+    fn a_flat_normal_misses_the_curvature_of_the_ellipsoid() {
+        let objects = objects();
+        let world = World::build(&objects[0], AccelKind::default());
+        let (x, y) = PIXELS[1];
+        let ray = pixel_ray(x, y);
+        let (s, n) = hit(&world, &ray);
+        let h = pixel_differential(x, y).at_hit(&ray, &s).unwrap();
+        let flat = reflected(&h, ray.dir, n, Vec3::ZERO, Vec3::ZERO);
+        let curved = Bend::new(&world, &ray, &pixel_differential(x, y), h, &s, n, n).reflected();
+        assert!(!close(flat.ddx, curved.ddx, 0.5), "{} {}", flat.ddx, curved.ddx);
+    }
+
+    #[test]
+    fn tangents_without_area_give_no_footprint() {
+        let dp = Vec3::new(1.0, 0.0, 0.0);
+        assert_eq!(uv_footprint(dp, 2.0 * dp, dp, dp), None);
+        assert_eq!(uv_footprint(dp, Vec3::ZERO, dp, dp), None);
+    }
+}
