@@ -8,8 +8,9 @@
 //! pixel's square under a box filter, as the supersampled reference sees
 //! it): exactly along the pixel axis that crosses more squares (the
 //! squares met along that line, found from where u and v cross whole
-//! squares), at 1 to 16 evenly spaced lines across the other axis (32 per
-//! square crossed, at least 4). Where the footprint crosses so many squares that
+//! squares), at 1 to 16 evenly spaced lines across the other axis (16 as
+//! soon as it crosses a sixteenth of a square, as a 16 × 16 grid of
+//! samples would). Where the footprint crosses so many squares that
 //! this would cost more than a few hundred steps (near the horizon), the
 //! closed-form mean over an axis-aligned box (pbrt's filtered
 //! checkerboard) is taken instead: its sides are the footprint's spread,
@@ -56,7 +57,7 @@ impl Checker {
         if crossings(across) > crossings(along) {
             std::mem::swap(&mut along, &mut across);
         }
-        let lines = (32.0 * crossings(across)).ceil().clamp(1.0, MAX_LINES);
+        let lines = (256.0 * crossings(across)).ceil().clamp(1.0, MAX_LINES);
         if !(crossings(along) <= MAX_CROSSINGS && crossings(across) <= MAX_LINES / 4.0) {
             return self.box_filtered(uv, footprint);
         }
