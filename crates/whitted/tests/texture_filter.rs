@@ -45,7 +45,10 @@ fn the_filtered_grazing_checker_is_much_closer_to_the_reference() {
     let reference = picture(&scene, 64, TextureFilter::None);
     let plain = mean_error(&picture(&scene, 1, TextureFilter::None), &reference);
     let filtered = mean_error(&picture(&scene, 1, TextureFilter::Mipmap), &reference);
-    assert!(filtered < plain / 3.0, "filtered {filtered}, unfiltered {plain}");
+    assert!(
+        filtered < plain / 3.0,
+        "filtered {filtered}, unfiltered {plain}"
+    );
 }
 
 #[test]
@@ -56,6 +59,9 @@ fn the_filtered_picture_is_the_same_with_every_structure_and_thread_count() {
         let mut other = scene.clone();
         other.settings.accel = accel;
         other.settings.threads = Some(3);
-        assert!(picture(&other, 1, TextureFilter::Mipmap) == first, "{accel:?}");
+        assert!(
+            picture(&other, 1, TextureFilter::Mipmap) == first,
+            "{accel:?}"
+        );
     }
 }

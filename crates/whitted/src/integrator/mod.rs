@@ -146,7 +146,9 @@ impl<'a> Integrator<'a> {
         counts: &mut RayCounts,
     ) -> PrimarySample {
         match self {
-            Integrator::Whitted(w) => w.trace_primary_observed(ray, differential, counts, &mut Unobserved),
+            Integrator::Whitted(w) => {
+                w.trace_primary_observed(ray, differential, counts, &mut Unobserved)
+            }
         }
     }
 

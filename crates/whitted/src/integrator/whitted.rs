@@ -32,8 +32,8 @@ use crate::math::{Ray, Vec3, offset_ray_origin};
 use crate::shading::differential::Bend;
 use crate::shading::optics::reflect;
 use crate::shading::{
-    Color, Crossing, Light, Lobes, Material, MediumStack, RayDifferential, Weights,
-    direct_samples, phong, shading_normal,
+    Color, Crossing, Light, Lobes, Material, MediumStack, RayDifferential, Weights, direct_samples,
+    phong, shading_normal,
 };
 use crate::world::{MaterialId, Surface, World};
 

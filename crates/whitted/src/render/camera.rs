@@ -223,8 +223,14 @@ mod tests {
             let e = 1e-4;
             let fx = (c.ray(w, h, x + e, y).dir - c.ray(w, h, x - e, y).dir) / (2.0 * e);
             let fy = (c.ray(w, h, x, y + e).dir - c.ray(w, h, x, y - e).dir) / (2.0 * e);
-            assert!((d.ddx - fx).length() < 1e-8 * fx.length().max(1e-3), "{d:?} {fx}");
-            assert!((d.ddy - fy).length() < 1e-8 * fy.length().max(1e-3), "{d:?} {fy}");
+            assert!(
+                (d.ddx - fx).length() < 1e-8 * fx.length().max(1e-3),
+                "{d:?} {fx}"
+            );
+            assert!(
+                (d.ddy - fy).length() < 1e-8 * fy.length().max(1e-3),
+                "{d:?} {fy}"
+            );
             // A whole pixel step agrees to first order.
             let step = c.ray(w, h, x + 1.0, y).dir - c.ray(w, h, x, y).dir;
             assert!((d.ddx - step).length() < 0.01 * step.length());

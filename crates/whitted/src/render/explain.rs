@@ -155,7 +155,8 @@ fn trace_pixel(
         let differential = sample_differential(&scene.camera, settings, (x, y), pattern, s);
         let color = if s == sample {
             let mut recorder = RayTreeRecorder::new(&world, shading, limits);
-            let traced = integrator.trace_primary_observed(&ray, differential, &mut counts, &mut recorder);
+            let traced =
+                integrator.trace_primary_observed(&ray, differential, &mut counts, &mut recorder);
             tree = recorder.finish();
             traced.color
         } else {

@@ -2,10 +2,10 @@
 //! `whitted explain` agree on which ray a sample is.
 
 use crate::math::Ray;
-use crate::shading::{RayDifferential, TextureFilter};
 use crate::math::random::hash64;
 use crate::math::sampling::pixel_sample;
 use crate::render::{Camera, RenderSettings};
+use crate::shading::{RayDifferential, TextureFilter};
 
 /// The seed of pixel (`x`, `y`)'s sample pattern: a hash of its position,
 /// so the picture does not depend on the order pixels are rendered in.

@@ -162,7 +162,7 @@ impl RayDifferential {
 fn uv_footprint(dpdu: Vec3, dpdv: Vec3, dpdx: Vec3, dpdy: Vec3) -> Option<Footprint> {
     let (a, b, c) = (dpdu.dot(dpdu), dpdu.dot(dpdv), dpdv.dot(dpdv));
     let det = a * c - b * b;
-    if !(det > 1e-12 * a * c) || !det.is_finite() {
+    if !det.is_finite() || det <= 1e-12 * a * c {
         return None;
     }
     let solve = |dp: Vec3| {
@@ -179,7 +179,13 @@ fn uv_footprint(dpdu: Vec3, dpdv: Vec3, dpdx: Vec3, dpdy: Vec3) -> Option<Footpr
 /// The differential of the ray leaving `s.point` in the mirror direction
 /// of `incident` (unit) about the unit normal `n` (facing the incoming
 /// side), whose change per pixel is `dndx`, `dndy`.
-pub fn reflected(hit: &HitDifferential, incident: Vec3, n: Vec3, dndx: Vec3, dndy: Vec3) -> RayDifferential {
+pub fn reflected(
+    hit: &HitDifferential,
+    incident: Vec3,
+    n: Vec3,
+    dndx: Vec3,
+    dndy: Vec3,
+) -> RayDifferential {
     // r = d − 2 (d·n) n  ⇒  ∂r = ∂d − 2 [(d·n) ∂n + (∂d·n + d·∂n) n].
     let d_n = incident.dot(n);
     let turn = |dd: Vec3, dn: Vec3| dd - 2.0 * (d_n * dn + (dd.dot(n) + incident.dot(dn)) * n);
@@ -249,7 +255,7 @@ pub fn normal_differentials(
         let there = world.surface(&neighbour, &other);
         let predicted = s.point + dp;
         let off_plane = (there.point - predicted).length();
-        if !(off_plane <= 0.25 * dp.length()) {
+        if off_plane.is_nan() || off_plane > 0.25 * dp.length() {
             return Vec3::ZERO;
         }
         oriented(there.shading_normal) - n
@@ -397,8 +403,14 @@ mod tests {
                 let ux = (sx1.uv - sx0.uv) / (2.0 * e);
                 let uy = (sy1.uv - sy0.uv) / (2.0 * e);
                 let f = h.footprint;
-                assert!((f.duv_dx - ux).length() < 1e-5 * ux.length().max(1e-6), "{f:?} {ux}");
-                assert!((f.duv_dy - uy).length() < 1e-5 * uy.length().max(1e-6), "{f:?} {uy}");
+                assert!(
+                    (f.duv_dx - ux).length() < 1e-5 * ux.length().max(1e-6),
+                    "{f:?} {ux}"
+                );
+                assert!(
+                    (f.duv_dy - uy).length() < 1e-5 * uy.length().max(1e-6),
+                    "{f:?} {uy}"
+                );
             }
         }
     }
@@ -459,7 +471,12 @@ mod tests {
         let h = pixel_differential(x, y).at_hit(&ray, &s).unwrap();
         let flat = reflected(&h, ray.dir, n, Vec3::ZERO, Vec3::ZERO);
         let curved = Bend::new(&world, &ray, &pixel_differential(x, y), h, &s, n, n).reflected();
-        assert!(!close(flat.ddx, curved.ddx, 0.5), "{} {}", flat.ddx, curved.ddx);
+        assert!(
+            !close(flat.ddx, curved.ddx, 0.5),
+            "{} {}",
+            flat.ddx,
+            curved.ddx
+        );
     }
 
     #[test]

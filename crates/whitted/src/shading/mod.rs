@@ -7,8 +7,8 @@
 
 pub mod area_light;
 pub mod bump;
-pub mod differential;
 mod color;
+pub mod differential;
 pub mod emission;
 pub mod factor;
 pub mod light;
@@ -21,8 +21,8 @@ pub mod texture;
 
 pub use area_light::{AreaLight, Emitter};
 pub use bump::{Bump, shading_normal};
-pub use differential::{Footprint, RayDifferential, TextureFilter};
 pub use color::Color;
+pub use differential::{Footprint, RayDifferential, TextureFilter};
 pub use emission::EmittedRay;
 pub use light::{Attenuation, Light, LightSample, direct_samples};
 pub use material::Material;

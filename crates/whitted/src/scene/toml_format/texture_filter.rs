@@ -14,10 +14,7 @@ use toml_span::value::Value;
 pub(super) const TEXTURE_FILTER_KEY: &str = "texture_filter";
 
 /// The texture filter of a `[render]` table; none where the key is absent.
-pub(super) fn read_texture_filter(
-    r: &mut Reader<'_>,
-    f: &Fields<'_, '_>,
-) -> Parsed<TextureFilter> {
+pub(super) fn read_texture_filter(r: &mut Reader<'_>, f: &Fields<'_, '_>) -> Parsed<TextureFilter> {
     r.or_default(f, TEXTURE_FILTER_KEY, TextureFilter::None, read_name)
 }
 

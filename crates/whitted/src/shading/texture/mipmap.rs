@@ -150,7 +150,7 @@ impl ImageTexture {
         let f = footprint.scaled(self.scale);
         let size = DVec2::new(data.width() as f64, data.height() as f64);
         let width = (f.duv_dx * size).length().max((f.duv_dy * size).length());
-        if !(width > 1.0) {
+        if width.is_nan() || width <= 1.0 {
             return self.at(uv);
         }
         let pyramid = data.mipmap();
@@ -193,7 +193,13 @@ mod tests {
     fn random_image(width: usize, height: usize, seed: u64) -> Vec<[f32; 3]> {
         let mut rng = Rng::new(seed);
         (0..width * height)
-            .map(|_| [rng.uniform() as f32, rng.uniform() as f32, rng.uniform() as f32])
+            .map(|_| {
+                [
+                    rng.uniform() as f32,
+                    rng.uniform() as f32,
+                    rng.uniform() as f32,
+                ]
+            })
             .collect()
     }
 
