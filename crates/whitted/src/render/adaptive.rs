@@ -31,7 +31,8 @@ use crate::math::DVec2;
 use crate::shading::Color;
 use crate::world::MaterialId;
 
-use super::Camera;
+use super::sample_ray::{position_differential, position_ray};
+use super::{Camera, RenderSettings};
 
 /// The deepest subdivision accepted: squares 1/64 of a pixel wide, at most
 /// 65² = 4225 camera rays in a pixel.
@@ -173,8 +174,7 @@ struct Corner {
 pub(super) struct AdaptivePixels<'a> {
     integrator: &'a Integrator<'a>,
     camera: &'a Camera,
-    width: u32,
-    height: u32,
+    settings: &'a RenderSettings,
     color_space: ColorSpace,
     adaptive: Adaptive,
     /// Traced corners by their position on the fine grid of the image
@@ -194,19 +194,18 @@ pub(super) struct Cost<'t> {
 }
 
 impl<'a> AdaptivePixels<'a> {
-    /// An empty cache for a `width` × `height` image.
+    /// An empty cache for the image `settings` describe.
     pub(super) fn new(
         integrator: &'a Integrator<'a>,
         camera: &'a Camera,
-        (width, height): (u32, u32),
+        settings: &'a RenderSettings,
         color_space: ColorSpace,
         adaptive: Adaptive,
     ) -> Self {
         Self {
             integrator,
             camera,
-            width,
-            height,
+            settings,
             color_space,
             adaptive,
             corners: FxHashMap::default(),
@@ -285,13 +284,12 @@ impl<'a> AdaptivePixels<'a> {
             return corner;
         }
         let scale = f64::from(1u32 << self.adaptive.depth);
-        let ray = self.camera.ray(
-            self.width,
-            self.height,
-            f64::from(fx) / scale,
-            f64::from(fy) / scale,
-        );
-        let sample = self.integrator.trace_primary(&ray, cost.rays);
+        let position = DVec2::new(f64::from(fx) / scale, f64::from(fy) / scale);
+        let ray = position_ray(self.camera, self.settings, position);
+        let differential = position_differential(self.camera, self.settings, position, 1.0);
+        let sample = self
+            .integrator
+            .trace_camera_ray(&ray, differential, cost.rays);
         if let Some(material) = sample.cut_at {
             *cost.cuts.entry(material).or_default() += 1;
         }

@@ -20,7 +20,9 @@ use crate::integrator::{
 };
 use crate::math::DVec2;
 use crate::render::adaptive::{AdaptivePixels, Cost};
-use crate::render::sample_ray::{pixel_pattern, sample_ray};
+use crate::render::sample_ray::{
+    pixel_pattern, position_differential, position_ray, sample_differential, sample_ray,
+};
 use crate::render::{AntiAliasing, RenderError, Scene};
 use crate::shading::Color;
 use crate::world::MAX_PRIMITIVES;
@@ -164,7 +166,7 @@ fn trace_pixel(
             let pixels = AdaptivePixels::new(
                 &integrator,
                 &scene.camera,
-                (settings.width, settings.height),
+                settings,
                 scene.color_space,
                 adaptive,
             );
@@ -182,13 +184,18 @@ fn trace_pixel(
             samples: count,
         });
     };
-    // The sample's own ray again, watched: the same ray through the same
-    // integrator, so the root's colour is the sample's bit for bit.
-    let ray = scene
-        .camera
-        .ray(settings.width, settings.height, position.x, position.y);
+    // The sample's own ray and differential again, watched: the same ray
+    // through the same integrator, so the root's colour is the sample's
+    // bit for bit.
+    let ray = position_ray(&scene.camera, settings, position);
+    let differential = match settings.aa {
+        AntiAliasing::Stratified => {
+            sample_differential(&scene.camera, settings, (x, y), pixel_pattern(x, y), sample)
+        }
+        AntiAliasing::Adaptive(_) => position_differential(&scene.camera, settings, position, 1.0),
+    };
     let mut recorder = RayTreeRecorder::new(&world, shading, limits);
-    integrator.trace_primary_observed(&ray, &mut counts, &mut recorder);
+    integrator.trace_primary_observed(&ray, differential, &mut counts, &mut recorder);
     let tree = recorder.finish().ok_or(ExplainError::SampleOutside {
         sample,
         samples: count,
@@ -223,8 +230,9 @@ fn stratified_samples(
     let mut samples = Vec::with_capacity(spp as usize);
     for s in 0..spp {
         let ray = sample_ray(&scene.camera, settings, (x, y), pattern, s);
+        let differential = sample_differential(&scene.camera, settings, (x, y), pattern, s);
         let color = integrator
-            .trace_primary_observed(&ray, counts, &mut Unobserved)
+            .trace_primary_observed(&ray, differential, counts, &mut Unobserved)
             .color;
         let offset = crate::math::sampling::pixel_sample(s, spp, pattern);
         samples.push((
