@@ -57,6 +57,7 @@ use self::hierarchy::{Hierarchy, MAX_DEPTH};
 use self::newton::RayFrame;
 use super::{LocalSurface, ShapeError, ShapeHit, finite, not_tiny};
 use crate::math::{Aabb, DVec2, Ray, Vec3, gamma, magnitude, unit};
+use std::sync::Arc;
 
 /// Entries of the traversal stack: each level pushes at most four children
 /// and pops one.
@@ -73,10 +74,14 @@ const LIMIT_STEPS: [f64; 3] = [1e-7, 1e-5, 1e-3];
 /// fraction of their extent squared.
 const COLLINEAR: f64 = 1e-12;
 
-/// A bicubic Bézier patch.
+/// A bicubic Bézier patch, or one piece of it: a leaf of its hierarchy
+/// ([`BezierPatch::pieces`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct BezierPatch {
-    data: Box<PatchData>,
+    data: Arc<PatchData>,
+    /// The hierarchy's node the shape is: 0 for the whole patch, a leaf
+    /// for a piece.
+    root: u32,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -137,7 +142,8 @@ impl BezierPatch {
         let fallback_normal = unit(diagonals).unwrap_or(Vec3::Z);
         let margin = 1e-9 * size + gamma(16) * magnitude.max_element();
         Ok(Self {
-            data: Box::new(PatchData {
+            root: 0,
+            data: Arc::new(PatchData {
                 net: points,
                 bounds,
                 size,
@@ -146,6 +152,33 @@ impl BezierPatch {
                 hierarchy: Hierarchy::build(&points, margin),
             }),
         })
+    }
+
+    /// The leaves of the patch's hierarchy, each a shape of its own with
+    /// the leaf's box as bounds, reporting hits and surfaces in the whole
+    /// patch's (u, v); together they are the patch. Many pieces of many
+    /// patches under the scene's acceleration structure are walked faster
+    /// than one hierarchy per patch (docs/performance.md, "Bézier patches
+    /// against their tessellation").
+    pub fn pieces(&self) -> impl Iterator<Item = BezierPatch> + '_ {
+        let nodes = &self.data.hierarchy.nodes;
+        let first = self.root as usize;
+        nodes
+            .iter()
+            .enumerate()
+            .skip(first)
+            .filter(move |&(index, node)| node.is_leaf() && self.holds(index))
+            .map(|(index, _)| Self {
+                data: Arc::clone(&self.data),
+                root: index as u32,
+            })
+    }
+
+    /// True when node `index` is in the subtree of the shape's root.
+    fn holds(&self, index: usize) -> bool {
+        let nodes = &self.data.hierarchy.nodes;
+        let (root, node) = (&nodes[self.root as usize], &nodes[index]);
+        (0..2).all(|k| root.low[k] <= node.low[k] && node.high[k] <= root.high[k])
     }
 
     /// The control points, `[i][j]` with i along u.
@@ -168,12 +201,12 @@ impl BezierPatch {
     /// hit.
     fn search(&self, ray: &Ray, any: bool) -> Option<ShapeHit> {
         let nodes = &self.data.hierarchy.nodes;
-        let (entry, _) = nodes[0].bounds.intersect_ray(ray)?;
-        let frame = RayFrame::new(&self.data.net, ray)?;
+        let nets = &self.data.hierarchy.nets;
+        let (entry, _) = nodes[self.root as usize].bounds.intersect_ray(ray)?;
         let mut best: Option<ShapeHit> = None;
         let mut t_max = ray.t_max;
         let mut stack = [(0u32, 0.0f64); STACK];
-        stack[0] = (0, entry);
+        stack[0] = (self.root, entry);
         let mut len = 1;
         while len > 0 {
             len -= 1;
@@ -183,7 +216,11 @@ impl BezierPatch {
             }
             let node = &nodes[index as usize];
             if node.is_leaf() {
-                if let Some(root) = frame.solve(node, ray.t_min, t_max) {
+                let frame = RayFrame::new(&nets[node.net as usize], ray)?;
+                if !frame.faces() {
+                    continue;
+                }
+                if let Some(root) = frame.solve(node, &self.data.net, ray.t_min, t_max) {
                     t_max = root.t;
                     best = Some(ShapeHit {
                         t: root.t,
@@ -252,9 +289,14 @@ impl BezierPatch {
             .unwrap_or(d.fallback_normal)
     }
 
-    /// The bounding box of the control points (which contains the patch).
+    /// The bounding box of the control points (which contains the patch),
+    /// or of a piece's.
     pub fn bounds(&self) -> Aabb {
-        self.data.bounds
+        if self.root == 0 {
+            self.data.bounds
+        } else {
+            self.data.hierarchy.nodes[self.root as usize].bounds
+        }
     }
 }
 
