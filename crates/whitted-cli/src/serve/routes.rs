@@ -141,7 +141,8 @@ fn explain(session: &Session, request: &Request, svg: bool) -> Result<Response, 
     );
     let file = session.file();
     if !svg {
-        let mut response = Response::json(&explanation_json(&scene, file, &explanation));
+        let json = explanation_json(&scene, file, &explanation);
+        let mut response = Response::ok("application/json", json);
         response.headers.push(("Server-Timing", timing));
         return Ok(response);
     }
