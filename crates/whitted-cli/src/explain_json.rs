@@ -277,6 +277,7 @@ struct Material {
 #[derive(Serialize)]
 struct Terms {
     ambient: [f64; 3],
+    caustic: [f64; 3],
     emission: [f64; 3],
     opacity: [f64; 3],
 }
@@ -305,6 +306,7 @@ impl Serialize for Hit<'_> {
             t: hit.t,
             terms: Terms {
                 ambient: rgb(hit.terms.ambient),
+                caustic: rgb(hit.terms.caustic),
                 emission: rgb(hit.terms.emission),
                 opacity: rgb(hit.terms.opacity),
             },
@@ -495,7 +497,11 @@ mod tests {
         }
 
         /// The whole explanation, as a JSON value built first.
-        pub(super) fn explanation_json(scene: &Scene, file: Option<&Path>, e: &PixelExplanation) -> Value {
+        pub(super) fn explanation_json(
+            scene: &Scene,
+            file: Option<&Path>,
+            e: &PixelExplanation,
+        ) -> Value {
             let settings = &scene.settings;
             json!({
                 "schema": SCHEMA,
@@ -548,6 +554,7 @@ mod tests {
                 "terms": {
                     "emission": rgb(hit.terms.emission),
                     "ambient": rgb(hit.terms.ambient),
+                    "caustic": rgb(hit.terms.caustic),
                     "opacity": rgb(hit.terms.opacity),
                 },
                 "lights": hit.lights.iter().map(|l| light_json(scene, file, l)).collect::<Vec<_>>(),
@@ -563,7 +570,9 @@ mod tests {
                 LightVerdict::FacesAway => ("faces_away", None, None),
                 LightVerdict::Lit => ("lit", None, Some(Color::ONE)),
                 LightVerdict::Blocked { by } => ("blocked", by, Some(Color::ZERO)),
-                LightVerdict::Attenuated { transmittance } => ("attenuated", None, Some(transmittance)),
+                LightVerdict::Attenuated { transmittance } => {
+                    ("attenuated", None, Some(transmittance))
+                }
             };
             let shadow_rays: Vec<Value> = light
                 .shadow_rays
@@ -619,7 +628,9 @@ mod tests {
     }
 
     fn scene(path: &str, spp: u32) -> (PathBuf, Scene) {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(path);
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../..")
+            .join(path);
         let mut scene = load_any(&path).unwrap_or_else(|e| panic!("{e}"));
         scene.settings.width = 40;
         scene.settings.height = 30;
@@ -640,7 +651,10 @@ mod tests {
             ("scenes/caustics.toml", 1),
             ("scenes/instances.toml", 1),
             ("scenes/textured.toml", 1),
-            ("crates/whitted/tests/hostile_scenes/glass_in_mirrors.toml", 1),
+            (
+                "crates/whitted/tests/hostile_scenes/glass_in_mirrors.toml",
+                1,
+            ),
         ];
         for (name, spp) in cases {
             let (path, mut scene) = scene(name, spp);

@@ -320,7 +320,11 @@ impl Session {
             let Some(base) = &base else { continue };
             let world = match &world {
                 Some((accel, w)) if *accel == view.accel => w,
-                _ => &world.insert((view.accel, Arc::new(with_accel(base, view.accel)))).1,
+                _ => {
+                    &world
+                        .insert((view.accel, Arc::new(with_accel(base, view.accel))))
+                        .1
+                }
             };
             if let Err(message) = self.render_view(done, world, &view) {
                 self.publish_error(done, &message);

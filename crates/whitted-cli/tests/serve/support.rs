@@ -29,8 +29,10 @@ pub fn scene_text() -> String {
 /// The `whitted` binary the tests run: the one `WHITTED_BIN` names (a
 /// release build, to measure the page's speed), else the one cargo built.
 pub fn binary() -> PathBuf {
-    std::env::var_os("WHITTED_BIN")
-        .map_or_else(|| PathBuf::from(env!("CARGO_BIN_EXE_whitted")), PathBuf::from)
+    std::env::var_os("WHITTED_BIN").map_or_else(
+        || PathBuf::from(env!("CARGO_BIN_EXE_whitted")),
+        PathBuf::from,
+    )
 }
 
 /// A running `whitted serve`, stopped when dropped.
