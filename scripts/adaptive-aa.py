@@ -5,6 +5,11 @@ reference, with the camera rays and times of both.
 
     scripts/adaptive-aa.py BINARY [--size N] [--threshold T] [--depth D]
                            [--min-depth M] [--threads T] [--scenes DIR]
+                           [--spd NAME ...] [--only NAME ...]
+
+The defaults are the setting docs/performance.md reports (512x512,
+threshold 0.1, depth 4, minimum depth 1) on balls, gears and teapot from
+../shared/scenes/spd; `--spd` names other SPD scenes.
 
 For each scene it renders the reference (`--spp 64`) and the adaptive
 picture (`--aa adaptive --aa-threshold T --aa-depth D --aa-min-depth M`)
@@ -58,7 +63,7 @@ def render(binary, scene, out, extra, size, threads):
         args += ["--threads", str(threads)]
     done = subprocess.run(args, capture_output=True, text=True, check=True)
     summary = done.stderr
-    seconds = float(re.search(r" in ([0-9.]+) s;", summary).group(1))
+    seconds = float(re.search(r" in ([0-9.]+) s[; ]", summary).group(1))
     primary = int(re.search(r"(\d+) primary", summary).group(1))
     total = sum(int(n) for n in re.findall(r"(\d+) [a-z]+(?:,|;)", summary.split("rays:")[1]))
     return seconds, primary, total
@@ -67,16 +72,18 @@ def render(binary, scene, out, extra, size, threads):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("binary")
-    parser.add_argument("--size", type=int, default=256)
+    parser.add_argument("--size", type=int, default=512)
     parser.add_argument("--threshold", type=float, default=0.1)
-    parser.add_argument("--depth", type=int, default=3)
-    parser.add_argument("--min-depth", type=int, default=0)
+    parser.add_argument("--depth", type=int, default=4)
+    parser.add_argument("--min-depth", type=int, default=1)
     parser.add_argument("--threads", type=int, default=0)
-    parser.add_argument("--scenes", default="/work/shared/scenes/spd")
+    parser.add_argument("--scenes", default=os.path.join(ROOT, "..", "shared", "scenes", "spd"))
+    parser.add_argument("--spd", nargs="*", default=["balls", "gears", "teapot"],
+                        help="SPD scenes (names without .nff) besides scenes/whitted.toml")
     parser.add_argument("--only", nargs="*", help="scene names to run")
     a = parser.parse_args()
     scenes = [os.path.join(ROOT, "scenes/whitted.toml")] + [
-        os.path.join(a.scenes, n) for n in ("balls.nff", "gears.nff", "teapot.nff")]
+        os.path.join(a.scenes, n + ".nff") for n in a.spd]
     if a.only:
         scenes = [s for s in scenes if os.path.basename(s).split(".")[0] in a.only]
     print(f"{a.size}x{a.size}; adaptive threshold {a.threshold}, depth {a.depth}, "

@@ -12,6 +12,7 @@ use whitted::limits::MemoryBudget;
 use whitted::math::Vec3;
 use whitted::render::{Scene, check_image_size};
 use whitted::scene::{CameraOverride, LoadOptions, load_any_with};
+use whitted::shading::TextureFilter;
 
 use crate::anti_aliasing::AaArgs;
 use crate::arguments;
@@ -66,6 +67,13 @@ pub struct SceneArgs {
     #[command(flatten)]
     aa: Box<AaArgs>,
 
+    /// Filter textures over each pixel's footprint (overrides the scene's
+    /// `texture_filter`): `mipmap` carries ray differentials and samples
+    /// images from mipmaps and checkers box-filtered; `none` (the default)
+    /// looks them up at the hit point.
+    #[arg(long, value_name = "NAME", value_parser = parse_texture_filter)]
+    texture_filter: Option<TextureFilter>,
+
     /// Put the camera's eye here (replaces the scene's).
     #[arg(long, value_name = "X,Y,Z", value_parser = arguments::vec3, allow_hyphen_values = true)]
     eye: Option<Vec3>,
@@ -93,6 +101,13 @@ pub struct SceneArgs {
 fn parse_accel(name: &str) -> Result<AccelKind, String> {
     AccelKind::from_name(name).ok_or_else(|| {
         let names: Vec<&str> = AccelKind::ALL.iter().map(AccelKind::name).collect();
+        format!("expected one of: {}", names.join(", "))
+    })
+}
+
+fn parse_texture_filter(name: &str) -> Result<TextureFilter, String> {
+    TextureFilter::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = TextureFilter::ALL.iter().map(|f| f.name()).collect();
         format!("expected one of: {}", names.join(", "))
     })
 }
@@ -169,6 +184,7 @@ impl SceneArgs {
         settings.accel_bottom = self.accel_bottom.or(settings.accel_bottom);
         settings.photons.count = self.photons.unwrap_or(settings.photons.count);
         settings.aa = self.aa.apply(settings.aa)?;
+        settings.texture_filter = self.texture_filter.unwrap_or(settings.texture_filter);
         Ok(scene)
     }
 }

@@ -13,7 +13,7 @@ use whitted::integrator::RayNode;
 use whitted::math::random::hash64;
 use whitted::render::{Adaptive, AntiAliasing, Explainer, Scene, explain_pixel, render};
 use whitted::scene::load_any;
-use whitted::shading::Color;
+use whitted::shading::{Color, TextureFilter};
 
 /// The example scenes of every format, sorted by name.
 fn example_scenes() -> Vec<PathBuf> {
@@ -160,6 +160,37 @@ fn adaptive_corners_roots_are_their_colours_and_their_area_average_the_rendered_
     }
     // Some pixel was subdivided, so the corners inside a pixel are covered.
     assert!(corners > 4 * explained_pixels, "{corners} corners");
+}
+
+#[test]
+fn with_filtered_textures_the_explained_pixel_is_the_rendered_pixel() {
+    // The samples' and the corners' ray differentials must be the
+    // renderer's, or a filtered texture gives another colour.
+    let resolution = (12, 9);
+    let adaptive = AntiAliasing::Adaptive(Adaptive {
+        threshold: 0.1,
+        depth: 2,
+        min_depth: 1,
+    });
+    for path in example_scenes() {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        for (aa, spp) in [(AntiAliasing::Stratified, 2), (adaptive, 1)] {
+            let mut scene = small(&path, resolution, spp);
+            scene.settings.texture_filter = TextureFilter::Mipmap;
+            scene.settings.aa = aa;
+            let film = render(&scene, &|_| {}).unwrap().image;
+            for (x, y) in pixels(&name, resolution, 2) {
+                let first = explain_pixel(&scene, (x, y), 0).unwrap();
+                assert_eq!(first.pixel, film.pixel(x, y), "{name} {aa:?} pixel {x},{y}");
+                let last = first.samples - 1;
+                let explained = explain_pixel(&scene, (x, y), last).unwrap();
+                assert_eq!(
+                    explained.tree.color, first.sample_colors[last as usize],
+                    "{name} {aa:?} pixel {x},{y} sample {last}"
+                );
+            }
+        }
+    }
 }
 
 #[test]

@@ -20,7 +20,9 @@ use crate::integrator::{
 };
 use crate::math::DVec2;
 use crate::render::adaptive::{AdaptivePixels, Cost};
-use crate::render::sample_ray::{pixel_pattern, sample_ray};
+use crate::render::sample_ray::{
+    pixel_pattern, position_differential, position_ray, sample_differential, sample_ray,
+};
 use crate::render::{AntiAliasing, Camera, RenderError, RenderSettings, Scene};
 use crate::shading::Color;
 use crate::world::{MAX_PRIMITIVES, World};
@@ -183,13 +185,8 @@ impl<'s> Explainer<'s> {
                 stratified_samples(scene, camera, &integrator, (x, y), &mut counts)
             }
             AntiAliasing::Adaptive(adaptive) => {
-                let pixels = AdaptivePixels::new(
-                    &integrator,
-                    camera,
-                    (settings.width, settings.height),
-                    scene.color_space,
-                    adaptive,
-                );
+                let pixels =
+                    AdaptivePixels::new(&integrator, camera, settings, scene.color_space, adaptive);
                 let mut cost = Cost {
                     rays: &mut counts,
                     cuts: &mut HashMap::new(),
@@ -204,11 +201,18 @@ impl<'s> Explainer<'s> {
                 samples: count,
             });
         };
-        // The sample's own ray again, watched: the same ray through the same
-        // integrator, so the root's colour is the sample's bit for bit.
-        let ray = camera.ray(settings.width, settings.height, position.x, position.y);
+        // The sample's own ray and differential again, watched: the same
+        // ray through the same integrator, so the root's colour is the
+        // sample's bit for bit.
+        let ray = position_ray(camera, settings, position);
+        let differential = match settings.aa {
+            AntiAliasing::Stratified => {
+                sample_differential(camera, settings, (x, y), pixel_pattern(x, y), sample)
+            }
+            AntiAliasing::Adaptive(_) => position_differential(camera, settings, position, 1.0),
+        };
         let mut recorder = RayTreeRecorder::new(world, shading, limits);
-        integrator.trace_primary_observed(&ray, &mut counts, &mut recorder);
+        integrator.trace_primary_observed(&ray, differential, &mut counts, &mut recorder);
         let tree = recorder.finish().ok_or(ExplainError::SampleOutside {
             sample,
             samples: count,
@@ -284,8 +288,9 @@ fn stratified_samples(
     let mut samples = Vec::with_capacity(spp as usize);
     for s in 0..spp {
         let ray = sample_ray(camera, settings, (x, y), pattern, s);
+        let differential = sample_differential(camera, settings, (x, y), pattern, s);
         let color = integrator
-            .trace_primary_observed(&ray, counts, &mut Unobserved)
+            .trace_primary_observed(&ray, differential, counts, &mut Unobserved)
             .color;
         let offset = crate::math::sampling::pixel_sample(s, spp, pattern);
         samples.push((

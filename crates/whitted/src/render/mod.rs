@@ -52,7 +52,7 @@ use crate::math::Ray;
 use crate::shading::Color;
 use crate::world::{Hit, MAX_PRIMITIVES, MaterialId, Surface, World};
 use adaptive::{AdaptivePixels, Cost};
-use sample_ray::{pixel_pattern, sample_ray};
+use sample_ray::{pixel_pattern, sample_differential, sample_ray};
 
 /// Side of the square tiles the image is cut into, in pixels.
 const TILE_SIZE: u32 = 16;
@@ -485,7 +485,7 @@ fn render_tile(
         AntiAliasing::Adaptive(a) => Some(AdaptivePixels::new(
             integrator,
             camera,
-            (settings.width, settings.height),
+            settings,
             color_space,
             a,
         )),
@@ -515,7 +515,8 @@ fn render_tile(
             let mut centre = None;
             for s in 0..spp {
                 let ray = sample_ray(camera, settings, (x, y), pattern, s);
-                let sample = integrator.trace_primary(&ray, &mut tile.rays);
+                let differential = sample_differential(camera, settings, (x, y), pattern, s);
+                let sample = integrator.trace_camera_ray(&ray, differential, &mut tile.rays);
                 if let Some(material) = sample.cut_at {
                     *tile.cuts.entry(material).or_default() += 1;
                 }

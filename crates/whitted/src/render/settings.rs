@@ -5,6 +5,7 @@
 use super::{AntiAliasing, RenderError};
 use crate::accel::AccelKind;
 use crate::integrator::{IntegratorKind, PhotonSettings};
+use crate::shading::TextureFilter;
 
 /// The deepest recursion a render accepts. Each level takes a few
 /// kilobytes of a worker's stack, which is sized for it.
@@ -118,6 +119,9 @@ pub struct RenderSettings {
     pub integrator: IntegratorKind,
     /// Photon-mapped caustics: off unless photons are asked for.
     pub photons: PhotonSettings,
+    /// How textures are filtered: off (a point lookup, as always) unless
+    /// asked for.
+    pub texture_filter: TextureFilter,
     /// Worker threads; `None` uses every core. The picture is the same for
     /// any count.
     pub threads: Option<usize>,
@@ -159,6 +163,7 @@ impl Default for RenderSettings {
             accel_bottom: None,
             integrator: IntegratorKind::default(),
             photons: PhotonSettings::default(),
+            texture_filter: TextureFilter::None,
             threads: None,
             aovs: Vec::new(),
         }

@@ -45,6 +45,7 @@ mod patches;
 mod photons;
 mod reader;
 mod shapes;
+mod texture_filter;
 
 use crate::accel::AccelKind;
 use std::path::Path;
@@ -217,6 +218,7 @@ const RENDER_KEYS: &[&str] = &[
     anti_aliasing::AA_KEYS[1],
     anti_aliasing::AA_KEYS[2],
     anti_aliasing::AA_KEYS[3],
+    texture_filter::TEXTURE_FILTER_KEY,
 ];
 
 fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
@@ -251,6 +253,7 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
     let color_space = r.or_default(&f, "colours", ColorSpace::Linear, read_color_space);
     let photons = photons::read_photons(r, &f);
     let aa = anti_aliasing::read_anti_aliasing(r, &f);
+    let texture_filter = texture_filter::read_texture_filter(r, &f);
     keys?;
     let (width, height) = size?;
     Ok(Render {
@@ -262,6 +265,7 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
             min_weight: min_weight?,
             accel: accel?,
             photons: photons?,
+            texture_filter: texture_filter?,
             accel_top: accel_top?,
             accel_bottom: accel_bottom?,
             aa: aa?,
@@ -416,7 +420,7 @@ pub(super) mod tests {
                 "`ambient` must not be negative, got -1",
                 "unknown key `size` in [render]; expected one of: width, height, samples, \
                  max_depth, min_weight, background, ambient, accel, accel_top, accel_bottom, colours, \
-                 photons, gather, radius, aa, aa_threshold, aa_depth, aa_min_depth",
+                 photons, gather, radius, aa, aa_threshold, aa_depth, aa_min_depth, texture_filter",
                 "unknown acceleration structure `octree`; expected one of: bvh, kdtree, grid, linear",
                 "unknown colour convention `srgb` for `colours`; expected one of: linear, display",
             ]
