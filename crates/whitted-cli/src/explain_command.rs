@@ -86,8 +86,7 @@ pub fn run(args: &ExplainArgs) -> Result<(), String> {
     let explanation = explain_pixel(&scene, args.pixel, args.sample).map_err(|e| e.to_string())?;
     let file = args.scene.scene.as_deref();
     let text = if args.json {
-        let mut json = serde_json::to_string(&explanation_json(&scene, file, &explanation))
-            .map_err(|e| e.to_string())?;
+        let mut json = explanation_json(&scene, file, &explanation);
         json.push('\n');
         json
     } else {

@@ -210,6 +210,9 @@ fn hit_text(out: &mut String, scene: &Scene, file: Option<&Path>, hit: &HitNode,
             );
         }
     }
+    if terms.caustic != Color::ZERO {
+        let _ = writeln!(out, "{at}  caustic kd E         {}", color(terms.caustic));
+    }
     if terms.opacity != Color::ONE {
         let _ = writeln!(
             out,

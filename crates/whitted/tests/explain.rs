@@ -11,9 +11,9 @@ use std::path::{Path, PathBuf};
 use whitted::accel::AccelKind;
 use whitted::integrator::RayNode;
 use whitted::math::random::hash64;
-use whitted::render::{Adaptive, AntiAliasing, Scene, explain_pixel, render};
+use whitted::render::{Adaptive, AntiAliasing, Explainer, Scene, explain_pixel, render};
 use whitted::scene::load_any;
-use whitted::shading::TextureFilter;
+use whitted::shading::{Color, TextureFilter};
 
 /// The example scenes of every format, sorted by name.
 fn example_scenes() -> Vec<PathBuf> {
@@ -234,4 +234,58 @@ fn a_pixel_or_sample_outside_the_image_is_refused_with_the_range() {
         error.to_string(),
         "sample 2 does not exist: the pixel has 2 (0 to 1)"
     );
+}
+
+/// Checks that every hit's listed terms add up to the colour it passes
+/// up: `α (ke + ka Ia + Σ lights (diffuse + specular) + caustic)` plus each
+/// child's `coefficient × colour`. Returns how many hits had a caustic term.
+fn terms_sum_to_the_colour(node: &RayNode) -> usize {
+    let Some(hit) = &node.hit else {
+        return 0;
+    };
+    let t = &hit.terms;
+    let lights = hit
+        .lights
+        .iter()
+        .fold(Color::ZERO, |sum, l| sum + l.diffuse + l.specular);
+    let local = t.emission + t.ambient + lights + t.caustic;
+    let children = hit
+        .children
+        .iter()
+        .fold(Color::ZERO, |sum, c| sum + c.coefficient * c.color);
+    let sum = t.opacity * local + children;
+    for (listed, colour) in [
+        (sum.r, node.color.r),
+        (sum.g, node.color.g),
+        (sum.b, node.color.b),
+    ] {
+        assert!(
+            (listed - colour).abs() <= 1e-9 * (1.0 + colour.abs()),
+            "the terms add up to {sum:?}, the node passes up {:?} (depth {})",
+            node.color,
+            node.depth
+        );
+    }
+    let own = usize::from(t.caustic != Color::ZERO);
+    own + hit
+        .children
+        .iter()
+        .map(terms_sum_to_the_colour)
+        .sum::<usize>()
+}
+
+#[test]
+fn the_caustic_term_is_listed_and_the_terms_add_up_to_each_rays_colour() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/caustics.toml");
+    let resolution = (64, 40);
+    let scene = small(&path, resolution, 1);
+    let explainer = Explainer::new(&scene).unwrap();
+    let mut caustic = 0;
+    for y in (0..40).step_by(3) {
+        for x in (0..64).step_by(3) {
+            let explained = explainer.explain(&scene.camera, (x, y), 0).unwrap();
+            caustic += terms_sum_to_the_colour(&explained.tree);
+        }
+    }
+    assert!(caustic > 0, "some pixels see the caustic");
 }

@@ -4,6 +4,7 @@
 //! asks for views, ray trees and saves with plain requests. See
 //! docs/serve.md; ARCHITECTURE.md says why this stack.
 
+mod explaining;
 mod http;
 mod picture;
 mod routes;
@@ -69,6 +70,7 @@ pub fn run(args: ServeArgs) -> Result<(), String> {
     let connections = AtomicUsize::new(0);
     std::thread::scope(|scope| {
         scope.spawn(|| session.render_loop());
+        scope.spawn(|| session.explaining.run());
         if let Some(path) = session.file() {
             let path = path.to_path_buf();
             let session = &session;

@@ -5,7 +5,7 @@
 
 use whitted::accel::AccelKind;
 use whitted::image::Film;
-use whitted::render::{Aov, explain_pixel};
+use whitted::render::Aov;
 use whitted::scene::parse_whole_number;
 
 use crate::arguments;
@@ -126,18 +126,25 @@ fn number(request: &Request, name: &str, default: Option<u32>) -> Result<u32, Re
 fn explain(session: &Session, request: &Request, svg: bool) -> Result<Response, Refusal> {
     let pixel = (number(request, "x", None)?, number(request, "y", None)?);
     let sample = number(request, "sample", Some(0))?;
-    let scene = session
-        .scene()
+    let (scene, world) = session
+        .explain_target()
         .ok_or_else(|| Refusal::new(409, "the scene could not be read; nothing to explain"))?;
-    let explanation =
-        explain_pixel(&scene, pixel, sample).map_err(|e| Refusal::new(400, e.to_string()))?;
+    let answer = session
+        .explaining
+        .explain(world, scene.camera.clone(), pixel, sample)
+        .map_err(|e| Refusal::new(500, e))?;
+    let explanation = answer.explanation.map_err(|e| Refusal::new(400, e))?;
+    let timing = format!(
+        "world;desc=\"world built\";dur={:.3}, explain;desc=\"pixel traced\";dur={:.3}",
+        answer.build_seconds * 1e3,
+        answer.explain_seconds * 1e3
+    );
     let file = session.file();
     if !svg {
-        return Ok(Response::json(&explanation_json(
-            &scene,
-            file,
-            &explanation,
-        )));
+        let json = explanation_json(&scene, file, &explanation);
+        let mut response = Response::ok("application/json", json);
+        response.headers.push(("Server-Timing", timing));
+        return Ok(response);
     }
     let frame = session
         .full_frame()

@@ -21,6 +21,7 @@ use whitted::render::{Aov, Camera, RenderError, RenderOutput, Scene, render_canc
 
 use crate::explain_svg::base64;
 use crate::scene_arguments::SceneArgs;
+use crate::serve::explaining::Explaining;
 use crate::serve::picture::display_film;
 
 /// How many of the newest events are kept for a page that reads them
@@ -122,6 +123,9 @@ struct Inner {
     scene_camera: Option<CameraView>,
     /// The scene as the newest request renders it at full size.
     scene: Option<Arc<Scene>>,
+    /// The scene the ray trees' world is built from: the same one while
+    /// only the camera or the view changes.
+    world: Option<Arc<Scene>>,
     full: Option<Arc<FullFrame>>,
 }
 
@@ -131,6 +135,8 @@ pub struct Session {
     inner: Mutex<Inner>,
     changed: Condvar,
     cancel: AtomicBool,
+    /// The thread that explains clicked pixels, and its queue.
+    pub explaining: Explaining,
 }
 
 impl Session {
@@ -146,10 +152,12 @@ impl Session {
                 events: VecDeque::new(),
                 scene_camera: None,
                 scene: None,
+                world: None,
                 full: None,
             }),
             changed: Condvar::new(),
             cancel: AtomicBool::new(false),
+            explaining: Explaining::new(),
         }
     }
 
@@ -186,9 +194,11 @@ impl Session {
         inner.view.camera.or(inner.scene_camera)
     }
 
-    /// The scene as the newest request renders it, if it could be read.
-    pub fn scene(&self) -> Option<Arc<Scene>> {
-        self.lock().scene.clone()
+    /// The scene as the newest request renders it and the scene its
+    /// world is built from, if it could be read.
+    pub fn explain_target(&self) -> Option<(Arc<Scene>, Arc<Scene>)> {
+        let inner = self.lock();
+        Some((inner.scene.clone()?, inner.world.clone()?))
     }
 
     /// The last full frame.
@@ -281,6 +291,8 @@ impl Session {
     pub fn render_loop(&self) {
         let mut done = 0;
         let mut base: Option<Scene> = None;
+        // The scene with the structure chosen, and that choice.
+        let mut world: Option<(Option<AccelKind>, Arc<Scene>)> = None;
         loop {
             let (view, reload) = {
                 let mut inner = self.lock();
@@ -296,6 +308,7 @@ impl Session {
             };
             if reload {
                 base = None;
+                world = None;
                 match self.args.load(true) {
                     Ok(scene) => {
                         self.lock().scene_camera = Some(CameraView::of(&scene.camera));
@@ -304,32 +317,44 @@ impl Session {
                     Err(message) => self.publish_error(done, &message),
                 }
             }
-            if let Some(Err(message)) = base.as_ref().map(|b| self.render_view(done, b, &view)) {
+            let Some(base) = &base else { continue };
+            let world = match &world {
+                Some((accel, w)) if *accel == view.accel => w,
+                _ => {
+                    &world
+                        .insert((view.accel, Arc::new(with_accel(base, view.accel))))
+                        .1
+                }
+            };
+            if let Err(message) = self.render_view(done, world, &view) {
                 self.publish_error(done, &message);
             }
         }
     }
 
     fn publish_error(&self, request: u64, message: &str) {
-        self.lock().scene = None;
+        let mut inner = self.lock();
+        inner.scene = None;
+        inner.world = None;
+        drop(inner);
         self.publish("error", json!({ "request": request, "message": message }));
     }
 
-    /// Renders `view` of `base` in passes, publishing each frame, until
-    /// the last or until a newer request cancels it.
-    fn render_view(&self, request: u64, base: &Scene, view: &View) -> Result<(), String> {
-        let mut scene = base.clone();
+    /// Renders `view` of `world` (the scene with the view's structure) in
+    /// passes, publishing each frame, until the last or until a newer
+    /// request cancels it.
+    fn render_view(&self, request: u64, world: &Arc<Scene>, view: &View) -> Result<(), String> {
+        let mut scene = Scene::clone(world);
         if let Some(camera) = &view.camera {
             scene.camera = camera.camera()?;
         }
-        if let Some(accel) = view.accel {
-            scene.settings.accel = accel;
-            scene.settings.accel_top = None;
-            scene.settings.accel_bottom = None;
-        }
         scene.settings.aovs = view.aov.into_iter().collect();
         let full = Arc::new(scene.clone());
-        self.lock().scene = Some(Arc::clone(&full));
+        {
+            let mut inner = self.lock();
+            inner.scene = Some(Arc::clone(&full));
+            inner.world = Some(Arc::clone(world));
+        }
         let passes: &[(&str, u32)] = if view.preview {
             &[("preview", 4)]
         } else {
@@ -381,6 +406,17 @@ impl Session {
         }
         Ok(())
     }
+}
+
+/// `base` with the structure `accel`, if one is chosen.
+fn with_accel(base: &Scene, accel: Option<AccelKind>) -> Scene {
+    let mut scene = base.clone();
+    if let Some(accel) = accel {
+        scene.settings.accel = accel;
+        scene.settings.accel_top = None;
+        scene.settings.accel_bottom = None;
+    }
+    scene
 }
 
 #[cfg(test)]

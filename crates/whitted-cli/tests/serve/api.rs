@@ -87,6 +87,53 @@ fn a_pixels_ray_tree_is_explain_json_and_its_root_is_the_rendered_pixel() {
     assert_eq!(server.get("/api/explain?x=a&y=0").0, 400);
 }
 
+/// Milliseconds the server says it spent on `name` (`Server-Timing`).
+fn server_timing(head: &str, name: &str) -> f64 {
+    let line = head
+        .lines()
+        .find_map(|l| l.strip_prefix("Server-Timing: "))
+        .unwrap_or_else(|| panic!("no Server-Timing in {head}"));
+    let entry = line
+        .split(", ")
+        .find(|e| e.starts_with(&format!("{name};")))
+        .unwrap_or_else(|| panic!("no {name} in {line}"));
+    entry.split("dur=").nth(1).unwrap().parse().unwrap()
+}
+
+#[test]
+fn the_world_is_built_once_for_many_clicks_and_again_for_another_structure() {
+    let server = Server::start(&scene_text(), &SIZE);
+    let mut events = server.events();
+    events.full_frame();
+    let click = |x: u32, y: u32| {
+        let (status, head, body) = server.get_with_head(&format!("/api/explain?x={x}&y={y}"));
+        assert_eq!(status, 200, "{}", String::from_utf8_lossy(&body));
+        let tree: serde_json::Value = serde_json::from_slice(&body).unwrap();
+        (server_timing(&head, "world"), tree)
+    };
+    let (first, _) = click(10, 10);
+    assert!(first > 0.0, "the first click builds the world");
+    assert_eq!(click(20, 30).0, 0.0, "the second keeps it");
+    // A moved camera keeps the world, and explains through the camera.
+    let (status, state) = server.view("eye=1.5,2,-4.5&fov=50");
+    assert_eq!(status, 200, "{state}");
+    events.until(|_, data| data["pass"] == "full" && data["state"]["camera"]["fov"] == 50.0);
+    let (kept, tree) = click(20, 30);
+    assert_eq!(kept, 0.0, "the camera is not part of the world");
+    let mut args = vec!["explain", "scene.toml", "--pixel", "20,30", "--json"];
+    args.extend(SIZE);
+    args.extend("--eye 1.5,2,-4.5 --look-at 0.2,0.9,0.5 --up 0,1,0 --fov 50".split(' '));
+    let printed: serde_json::Value =
+        serde_json::from_slice(&whitted(&args, server.dir.path())).unwrap();
+    assert_eq!(tree, printed, "the moved camera's tree");
+    // Another structure: built again, and the tree's costs are its.
+    assert_eq!(server.view("accel=kdtree").0, 200);
+    events.until(|_, data| data["pass"] == "full" && data["accel"] == "kdtree");
+    let (rebuilt, tree) = click(20, 30);
+    assert!(rebuilt > 0.0, "another structure builds the world again");
+    assert_eq!(tree["accel"], "kdtree");
+}
+
 #[test]
 fn a_bad_edit_is_shown_located_and_a_good_one_renders_again() {
     let mut server = Server::start(&scene_text(), &SIZE);

@@ -209,8 +209,9 @@ fn the_page_in_headless_chromium_shows_the_picture_trees_views_and_edits() {
     browser.wait_for("the full picture", &format!("return {FULL_FRAME};"));
     let timings = browser.run("return window.whitted.timings;");
     eprintln!(
-        "page timings (ms from navigation start): first frame {}, first full frame {}",
-        timings["firstFrame"], timings["firstFull"]
+        "page timings (ms from navigation start): script running {}, event stream open {}, \
+         first frame {}, first full frame {}",
+        timings["script"], timings["events"], timings["firstFrame"], timings["firstFull"]
     );
 
     // Click a pixel: the tree shown is explain --json's.
@@ -285,8 +286,9 @@ fn the_page_in_headless_chromium_shows_the_picture_trees_views_and_edits() {
     let before = browser
         .run("return [window.whitted.frames, performance.now(), window.whitted.state.flags];");
     let mut steps = vec![json!({ "type": "pointerDown", "button": 0 })];
-    for i in 1..=40 {
-        steps.push(json!({ "type": "pointerMove", "x": 2 * i, "y": i / 2, "duration": 50 }));
+    // A move every 16 ms (a 60 Hz mouse), for about 3 s.
+    for i in 1..=180 {
+        steps.push(json!({ "type": "pointerMove", "x": i / 2, "y": i / 8, "duration": 16 }));
     }
     steps.push(json!({ "type": "pointerUp", "button": 0 }));
     browser.mouse(&picture, steps);
@@ -316,6 +318,49 @@ fn the_page_in_headless_chromium_shows_the_picture_trees_views_and_edits() {
     let path = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("serve-browser.png");
     std::fs::write(&path, &png).unwrap();
     eprintln!("screenshot: {}", path.display());
+
+    // A pixel of several samples: the page offers each, and explains the
+    // one chosen as explain --json --sample does.
+    let size = ["--width", "64", "--height", "48", "--spp", "4"];
+    let several = Server::start(&scene_text(), &size);
+    browser.command("POST", "/url", &json!({ "url": several.url("/") }));
+    browser.wait_for("the full picture", &format!("return {FULL_FRAME};"));
+    let picture = browser.element("#picture");
+    browser.mouse(
+        &picture,
+        vec![
+            json!({ "type": "pointerDown", "button": 0 }),
+            json!({ "type": "pointerUp", "button": 0 }),
+        ],
+    );
+    browser.wait_for(
+        "the sample chooser",
+        "return !!document.getElementById('sample');",
+    );
+    let option = browser.element("#sample option[value='2']");
+    let click = format!("/element/{}/click", option.as_str().unwrap());
+    browser.command("POST", &click, &json!({}));
+    let tree = browser.wait_for(
+        "sample 2's tree",
+        "const p = window.whitted; \
+         return p.lastTree && p.lastTree.sample.index === 2 \
+             && document.getElementById('tree').textContent.includes('terms: emission') \
+             && [p.lastTree, p.explained];",
+    );
+    let (shown, pixel) = (&tree[0], &tree[1]);
+    let pixel = format!("{},{}", pixel["x"], pixel["y"]);
+    let mut args = vec![
+        "explain",
+        "scene.toml",
+        "--pixel",
+        &pixel,
+        "--sample",
+        "2",
+        "--json",
+    ];
+    args.extend(size);
+    let printed: Value = serde_json::from_slice(&whitted(&args, several.dir.path())).unwrap();
+    assert_eq!(as_floats(shown), as_floats(&printed), "sample 2's tree");
 }
 
 /// `value` with every number a float (JavaScript writes 1.0 as 1).

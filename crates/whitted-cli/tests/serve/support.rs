@@ -26,6 +26,15 @@ pub fn scene_text() -> String {
     std::fs::read_to_string(path).unwrap()
 }
 
+/// The `whitted` binary the tests run: the one `WHITTED_BIN` names (a
+/// release build, to measure the page's speed), else the one cargo built.
+pub fn binary() -> PathBuf {
+    std::env::var_os("WHITTED_BIN").map_or_else(
+        || PathBuf::from(env!("CARGO_BIN_EXE_whitted")),
+        PathBuf::from,
+    )
+}
+
 /// A running `whitted serve`, stopped when dropped.
 pub struct Server {
     child: Child,
@@ -41,7 +50,7 @@ impl Server {
     pub fn start(scene: &str, args: &[&str]) -> Server {
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(dir.path().join("scene.toml"), scene).unwrap();
-        let mut child = Command::new(env!("CARGO_BIN_EXE_whitted"))
+        let mut child = Command::new(binary())
             .arg("serve")
             .arg("scene.toml")
             .args(["--port", "0"])
@@ -79,6 +88,13 @@ impl Server {
     /// Sends `head` (the request line and headers, without the blank
     /// line) and `body`; the status and body of the answer.
     pub fn raw(&self, head: &str, body: &[u8]) -> (u16, Vec<u8>) {
+        let (status, _, body) = self.exchange(head, body);
+        (status, body)
+    }
+
+    /// [`Self::raw`], with the answer's head (its status line and
+    /// headers) as text.
+    pub fn exchange(&self, head: &str, body: &[u8]) -> (u16, String, Vec<u8>) {
         let mut stream = TcpStream::connect(("127.0.0.1", self.port)).unwrap();
         stream.set_read_timeout(Some(PATIENCE)).unwrap();
         let mut request = format!("{head}\r\n");
@@ -96,12 +112,20 @@ impl Server {
             .unwrap_or_else(|| panic!("no head in {:?}", String::from_utf8_lossy(&answer)));
         let head = String::from_utf8_lossy(&answer[..end]).into_owned();
         let status = head.split(' ').nth(1).unwrap().parse().unwrap();
-        (status, answer[end + 4..].to_vec())
+        (status, head, answer[end + 4..].to_vec())
     }
 
     /// `GET path`.
     pub fn get(&self, path: &str) -> (u16, Vec<u8>) {
         self.raw(
+            &format!("GET {path} HTTP/1.1\r\nHost: 127.0.0.1:{}", self.port),
+            b"",
+        )
+    }
+
+    /// `GET path`: the status, the head and the body.
+    pub fn get_with_head(&self, path: &str) -> (u16, String, Vec<u8>) {
+        self.exchange(
             &format!("GET {path} HTTP/1.1\r\nHost: 127.0.0.1:{}", self.port),
             b"",
         )
@@ -244,7 +268,7 @@ pub fn read_pfm(bytes: &[u8]) -> (usize, Vec<[f32; 3]>) {
 
 /// Runs `whitted ARGS` in `dir`; its standard output (it must succeed).
 pub fn whitted(args: &[&str], dir: &Path) -> Vec<u8> {
-    let output = Command::new(env!("CARGO_BIN_EXE_whitted"))
+    let output = Command::new(binary())
         .args(args)
         .current_dir(dir)
         .output()

@@ -14,7 +14,7 @@
 //! ```text
 //! sample  = ray
 //! ray     = ray_start ray_hit [shade] ray_end
-//! shade   = shading light* [depth_limit | lobes branch*]
+//! shade   = shading light* [caustic] [depth_limit | lobes branch*]
 //! light   = shadow_ray* light
 //! branch  = ray_start ray_hit [shade] ray_end | branch_skipped
 //! ```
@@ -77,6 +77,11 @@ pub trait RayObserver {
         _transmittance: Option<Color>,
     ) {
     }
+
+    /// The caustic map's light at the point, `kd` times the irradiance of
+    /// the photons gathered there, added to the local terms.
+    #[inline(always)]
+    fn caustic(&mut self, _term: Color) {}
 
     /// The ray is at the deepest recursion allowed: no secondary rays.
     #[inline(always)]

@@ -90,6 +90,9 @@ pub struct ShadingTerms {
     pub ambient: Color,
     /// `α`: the opacity that weighs the local terms and the mirror.
     pub opacity: Color,
+    /// `kd E`: the caustic map's irradiance `E` at the point (zero
+    /// without a caustic map).
+    pub caustic: Color,
 }
 
 /// One light's contribution at a hit.
@@ -251,11 +254,13 @@ impl RayObserver for RayTreeRecorder<'_> {
                 emission: m.emission.at(surface.uv),
                 ambient: m.ambient.at(surface.uv) * self.shading.ambient,
                 opacity: m.opacity.at(surface.uv),
+                caustic: Color::ZERO,
             },
             None => ShadingTerms {
                 emission: Color::ZERO,
                 ambient: Color::ZERO,
                 opacity: Color::ONE,
+                caustic: Color::ZERO,
             },
         };
         if let Some(node) = self.node() {
@@ -307,6 +312,12 @@ impl RayObserver for RayTreeRecorder<'_> {
             blocker,
             cost: ctx.counters,
         });
+    }
+
+    fn caustic(&mut self, term: Color) {
+        if let Some(hit) = self.hit() {
+            hit.terms.caustic = term;
+        }
     }
 
     fn light(&mut self, index: usize, sample: Option<&LightSample>, transmittance: Option<Color>) {

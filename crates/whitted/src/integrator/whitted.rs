@@ -232,7 +232,9 @@ impl<'a> Whitted<'a> {
             && alpha != Color::ZERO
             && diffuse != Color::ZERO
         {
-            local += diffuse * caustics.irradiance(s.point, n);
+            let caustic = diffuse * caustics.irradiance(s.point, n);
+            tally.observer.caustic(caustic);
+            local += caustic;
         }
         let mut color = alpha * local;
 

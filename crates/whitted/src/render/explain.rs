@@ -15,17 +15,17 @@ use std::collections::HashMap;
 
 use crate::accel::AccelKind;
 use crate::integrator::{
-    Integrator, RayCounts, RayNode, RayTreeRecorder, RecursionLimits, SECONDARY_RAY_BUDGET,
-    Shading, Unobserved,
+    CausticMap, Integrator, RayCounts, RayNode, RayTreeRecorder, RecursionLimits,
+    SECONDARY_RAY_BUDGET, Shading, Unobserved,
 };
 use crate::math::DVec2;
 use crate::render::adaptive::{AdaptivePixels, Cost};
 use crate::render::sample_ray::{
     pixel_pattern, position_differential, position_ray, sample_differential, sample_ray,
 };
-use crate::render::{AntiAliasing, RenderError, Scene};
+use crate::render::{AntiAliasing, Camera, RenderError, RenderSettings, Scene};
 use crate::shading::Color;
-use crate::world::MAX_PRIMITIVES;
+use crate::world::{MAX_PRIMITIVES, World};
 
 /// The ray tree of one sample of one pixel, and the pixel it ends in.
 #[derive(Clone, Debug, PartialEq)]
@@ -97,121 +97,178 @@ pub enum ExplainError {
 /// size for the scene's depth.
 pub fn explain_pixel(
     scene: &Scene,
-    (x, y): (u32, u32),
+    pixel: (u32, u32),
     sample: u32,
 ) -> Result<PixelExplanation, ExplainError> {
-    let settings = &scene.settings;
-    settings.check()?;
-    scene.objects.check_instances().map_err(RenderError::from)?;
-    let primitives = scene.objects.primitive_count();
-    if primitives > MAX_PRIMITIVES {
-        return Err(RenderError::TooManyPrimitives(primitives).into());
+    Explainer::new(scene)?.explain(&scene.camera, pixel, sample)
+}
+
+/// A scene's world and caustic map, built once as [`super::render`] builds
+/// them, to explain many pixels without building them again (the live
+/// preview of `whitted serve` keeps one while the scene, its structure
+/// and its settings stay the same). The camera is not part of the world:
+/// each explanation names its own.
+pub struct Explainer<'s> {
+    scene: &'s Scene,
+    world: World<'s>,
+    caustics: Option<CausticMap>,
+}
+
+impl<'s> Explainer<'s> {
+    /// Checks `scene`'s settings and builds its world and caustic map.
+    pub fn new(scene: &'s Scene) -> Result<Self, ExplainError> {
+        let settings = &scene.settings;
+        settings.check()?;
+        scene.objects.check_instances().map_err(RenderError::from)?;
+        let primitives = scene.objects.primitive_count();
+        if primitives > MAX_PRIMITIVES {
+            return Err(RenderError::TooManyPrimitives(primitives).into());
+        }
+        // As `render` builds them.
+        let world = super::build_world(scene);
+        let caustics = on_deep_stack(settings.max_depth, || {
+            super::photon_pass::build(&world, &shading_of(scene), settings)
+                .map_err(RenderError::from)
+        })??;
+        Ok(Self {
+            scene,
+            world,
+            caustics: caustics.map(|(map, _)| map),
+        })
     }
-    let (width, height) = (settings.width, settings.height);
-    if x >= width || y >= height {
-        return Err(ExplainError::PixelOutside {
+
+    /// Explains sample `sample` of pixel (`x`, `y`) seen through `camera`
+    /// (the scene's own, or one the viewer moved). The recursion runs on a
+    /// thread with the renderer's stack size for the scene's depth.
+    pub fn explain(
+        &self,
+        camera: &Camera,
+        (x, y): (u32, u32),
+        sample: u32,
+    ) -> Result<PixelExplanation, ExplainError> {
+        let settings = &self.scene.settings;
+        let (width, height) = (settings.width, settings.height);
+        if x >= width || y >= height {
+            return Err(ExplainError::PixelOutside {
+                x,
+                y,
+                width,
+                height,
+            });
+        }
+        let samples = settings.samples_per_pixel;
+        if settings.aa == AntiAliasing::Stratified && sample >= samples {
+            return Err(ExplainError::SampleOutside { sample, samples });
+        }
+        on_deep_stack(settings.max_depth, || {
+            self.trace_pixel(camera, (x, y), sample)
+        })?
+    }
+
+    /// [`Self::explain`] once the arguments are checked, on the thread
+    /// that recurses.
+    fn trace_pixel(
+        &self,
+        camera: &Camera,
+        (x, y): (u32, u32),
+        sample: u32,
+    ) -> Result<PixelExplanation, ExplainError> {
+        let (scene, world) = (self.scene, &self.world);
+        let settings = &scene.settings;
+        let shading = shading_of(scene);
+        let limits = limits_of(settings);
+        let integrator = Integrator::new(settings.integrator, world, shading, limits)
+            .with_caustics(self.caustics.as_ref());
+        let mut counts = RayCounts::default();
+        let (pixel, samples) = match settings.aa {
+            AntiAliasing::Stratified => {
+                stratified_samples(scene, camera, &integrator, (x, y), &mut counts)
+            }
+            AntiAliasing::Adaptive(adaptive) => {
+                let pixels =
+                    AdaptivePixels::new(&integrator, camera, settings, scene.color_space, adaptive);
+                let mut cost = Cost {
+                    rays: &mut counts,
+                    cuts: &mut HashMap::new(),
+                };
+                pixels.pixel_alone(x, y, &mut cost)
+            }
+        };
+        let count = samples.len() as u32;
+        let Some(&(position, _)) = samples.get(sample as usize) else {
+            return Err(ExplainError::SampleOutside {
+                sample,
+                samples: count,
+            });
+        };
+        // The sample's own ray and differential again, watched: the same
+        // ray through the same integrator, so the root's colour is the
+        // sample's bit for bit.
+        let ray = position_ray(camera, settings, position);
+        let differential = match settings.aa {
+            AntiAliasing::Stratified => {
+                sample_differential(camera, settings, (x, y), pixel_pattern(x, y), sample)
+            }
+            AntiAliasing::Adaptive(_) => position_differential(camera, settings, position, 1.0),
+        };
+        let mut recorder = RayTreeRecorder::new(world, shading, limits);
+        integrator.trace_primary_observed(&ray, differential, &mut counts, &mut recorder);
+        let tree = recorder.finish().ok_or(ExplainError::SampleOutside {
+            sample,
+            samples: count,
+        })?;
+        Ok(PixelExplanation {
             x,
             y,
-            width,
-            height,
-        });
+            sample,
+            samples: count,
+            position,
+            aa: settings.aa,
+            accel: settings.accel,
+            limits,
+            tree,
+            sample_colors: samples.into_iter().map(|(_, color)| color).collect(),
+            pixel: pixel.to_f32(),
+        })
     }
-    let samples = settings.samples_per_pixel;
-    if settings.aa == AntiAliasing::Stratified && sample >= samples {
-        return Err(ExplainError::SampleOutside { sample, samples });
+}
+
+/// The shading inputs of `scene`, as `render` gives them.
+fn shading_of(scene: &Scene) -> Shading<'_> {
+    Shading {
+        materials: &scene.materials,
+        lights: &scene.lights,
+        background: scene.background,
+        ambient: scene.ambient,
     }
-    let stack = super::worker_stack_bytes(settings.max_depth);
+}
+
+/// The recursion limits of `settings`, as `render` gives them.
+fn limits_of(settings: &RenderSettings) -> RecursionLimits {
+    RecursionLimits {
+        max_depth: settings.max_depth,
+        min_weight: settings.min_weight,
+        ray_budget: SECONDARY_RAY_BUDGET,
+    }
+}
+
+/// Runs `work` on a thread with the renderer's stack size for
+/// `max_depth`.
+fn on_deep_stack<T: Send>(
+    max_depth: u32,
+    work: impl FnOnce() -> T + Send,
+) -> Result<T, RenderError> {
+    let stack = super::worker_stack_bytes(max_depth);
     std::thread::scope(|scope| {
-        std::thread::Builder::new()
+        Ok(std::thread::Builder::new()
             .stack_size(stack)
-            .spawn_scoped(scope, || trace_pixel(scene, (x, y), sample))
+            .spawn_scoped(scope, work)
             .map_err(|e| RenderError::Threads {
                 threads: 1,
                 message: e.to_string(),
             })?
             .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
-    })
-}
-
-/// [`explain_pixel`] once the arguments are checked, on the thread that
-/// recurses.
-fn trace_pixel(
-    scene: &Scene,
-    (x, y): (u32, u32),
-    sample: u32,
-) -> Result<PixelExplanation, ExplainError> {
-    let settings = &scene.settings;
-    // As `render` builds them.
-    let world = super::build_world(scene);
-    let shading = Shading {
-        materials: &scene.materials,
-        lights: &scene.lights,
-        background: scene.background,
-        ambient: scene.ambient,
-    };
-    let limits = RecursionLimits {
-        max_depth: settings.max_depth,
-        min_weight: settings.min_weight,
-        ray_budget: SECONDARY_RAY_BUDGET,
-    };
-    let caustics =
-        super::photon_pass::build(&world, &shading, settings).map_err(RenderError::from)?;
-    let integrator = Integrator::new(settings.integrator, &world, shading, limits)
-        .with_caustics(caustics.as_ref().map(|(map, _)| map));
-    let mut counts = RayCounts::default();
-    let (pixel, samples) = match settings.aa {
-        AntiAliasing::Stratified => stratified_samples(scene, &integrator, (x, y), &mut counts),
-        AntiAliasing::Adaptive(adaptive) => {
-            let pixels = AdaptivePixels::new(
-                &integrator,
-                &scene.camera,
-                settings,
-                scene.color_space,
-                adaptive,
-            );
-            let mut cost = Cost {
-                rays: &mut counts,
-                cuts: &mut HashMap::new(),
-            };
-            pixels.pixel_alone(x, y, &mut cost)
-        }
-    };
-    let count = samples.len() as u32;
-    let Some(&(position, _)) = samples.get(sample as usize) else {
-        return Err(ExplainError::SampleOutside {
-            sample,
-            samples: count,
-        });
-    };
-    // The sample's own ray and differential again, watched: the same ray
-    // through the same integrator, so the root's colour is the sample's
-    // bit for bit.
-    let ray = position_ray(&scene.camera, settings, position);
-    let differential = match settings.aa {
-        AntiAliasing::Stratified => {
-            sample_differential(&scene.camera, settings, (x, y), pixel_pattern(x, y), sample)
-        }
-        AntiAliasing::Adaptive(_) => position_differential(&scene.camera, settings, position, 1.0),
-    };
-    let mut recorder = RayTreeRecorder::new(&world, shading, limits);
-    integrator.trace_primary_observed(&ray, differential, &mut counts, &mut recorder);
-    let tree = recorder.finish().ok_or(ExplainError::SampleOutside {
-        sample,
-        samples: count,
-    })?;
-    Ok(PixelExplanation {
-        x,
-        y,
-        sample,
-        samples: count,
-        position,
-        aa: settings.aa,
-        accel: settings.accel,
-        limits,
-        tree,
-        sample_colors: samples.into_iter().map(|(_, color)| color).collect(),
-        pixel: pixel.to_f32(),
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
     })
 }
 
@@ -219,6 +276,7 @@ fn trace_pixel(
 /// the image and its colour, and their mean summed in the renderer's order.
 fn stratified_samples(
     scene: &Scene,
+    camera: &Camera,
     integrator: &Integrator<'_>,
     (x, y): (u32, u32),
     counts: &mut RayCounts,
@@ -229,8 +287,8 @@ fn stratified_samples(
     let mut sum = Color::ZERO;
     let mut samples = Vec::with_capacity(spp as usize);
     for s in 0..spp {
-        let ray = sample_ray(&scene.camera, settings, (x, y), pattern, s);
-        let differential = sample_differential(&scene.camera, settings, (x, y), pattern, s);
+        let ray = sample_ray(camera, settings, (x, y), pattern, s);
+        let differential = sample_differential(camera, settings, (x, y), pattern, s);
         let color = integrator
             .trace_primary_observed(&ray, differential, counts, &mut Unobserved)
             .color;

@@ -21,7 +21,7 @@ pub use adaptive::{
     Adaptive, AdaptiveError, AntiAliasing, DEFAULT_AA_DEPTH, DEFAULT_AA_THRESHOLD, MAX_AA_DEPTH,
 };
 pub use camera::{Camera, CameraError};
-pub use explain::{ExplainError, PixelExplanation, explain_pixel};
+pub use explain::{ExplainError, Explainer, PixelExplanation, explain_pixel};
 pub use gradient_note::GradientExceeded;
 pub use merge::{MergeError, Merged, merge_parts};
 pub use part::{

@@ -9,7 +9,9 @@ const page = (window.whitted = {
   frame: null, // the newest frame's description (without its picture)
   frames: 0, // frames shown
   lastTree: null, // the last ray tree shown (explain --json's)
-  timings: {}, // ms from navigation start: first frame, first full frame
+  // ms from navigation start: this script running, the event stream
+  // open, the first frame shown, the first full frame shown
+  timings: { script: performance.now() },
   error: null, // the error shown, if any
 });
 
@@ -33,6 +35,9 @@ function fillSelect(select, names, chosen) {
 }
 
 const events = new EventSource("/events");
+events.addEventListener("open", () => {
+  if (page.timings.events === undefined) page.timings.events = performance.now();
+});
 events.addEventListener("frame", (e) => {
   const frame = JSON.parse(e.data);
   const picture = $("picture");
@@ -194,24 +199,44 @@ function explainAt(e) {
   explain(x, y);
 }
 
-function explain(x, y) {
+function explain(x, y, sample = 0) {
   const request = page.frame.request;
-  fetch(`/api/explain?x=${x}&y=${y}`)
+  const query = `x=${x}&y=${y}&sample=${sample}`;
+  fetch(`/api/explain?${query}`)
     .then((r) => (r.ok ? r.json() : r.text().then((t) => Promise.reject(t))))
     .then((tree) => {
       page.lastTree = tree;
-      page.explained = { x, y, request };
+      page.explained = { x, y, sample, request };
       const root = document.createElement("ul");
       root.appendChild(treeNode(tree.tree));
       const title = document.createElement("p");
-      title.textContent = `pixel ${x},${y}: ${rgbText(tree.pixel.value)} (sample ${tree.sample.index} of ${tree.sample.count})`;
+      title.textContent = `pixel ${x},${y}: ${rgbText(tree.pixel.value)}; `;
+      title.append(sampleChooser(x, y, tree.sample, tree.anti_aliasing.method));
       $("tree").replaceChildren(title, root);
       const rays = $("rays");
       rays.onload = () => { rays.hidden = false; };
-      rays.src = `/api/explain.svg?x=${x}&y=${y}&request=${request}`;
+      rays.src = `/api/explain.svg?${query}&request=${request}`;
       rays.style.width = page.frame.full_width + "px";
     })
     .catch((t) => showError(String(t)));
+}
+
+// The sample shown, and a choice of the pixel's others when it has some
+// (its samples, or the corners its adaptive subdivision traced).
+function sampleChooser(x, y, sample, method) {
+  const what = method === "adaptive" ? "corner" : "sample";
+  const span = document.createElement("span");
+  if (sample.count < 2) {
+    span.textContent = `its only ${what}`;
+    return span;
+  }
+  const select = document.createElement("select");
+  select.id = "sample";
+  for (let k = 0; k < sample.count; k++) select.add(new Option(`${what} ${k}`, k));
+  select.value = sample.index;
+  select.onchange = () => explain(x, y, +select.value);
+  span.append(select, ` of ${sample.count} (${rgbText(sample.color)})`);
+  return span;
 }
 
 function hideRays() {
@@ -244,6 +269,7 @@ function treeNode(n) {
   const where = o.line ? ` (line ${o.line})` : "";
   li.append(` — hit ${o.label || o.kind || "primitive " + o.primitive}${where} at t = ${h.t.toPrecision(5)}`);
   const list = document.createElement("ul");
+  list.appendChild(termsItem(h.terms));
   for (const light of h.lights) {
     const item = document.createElement("li");
     item.className = "kind-shadow";
@@ -252,7 +278,13 @@ function treeNode(n) {
       `, diffuse ${rgbText(light.diffuse)}, specular ${rgbText(light.specular)}`;
     list.appendChild(item);
   }
-  for (const child of h.children) list.appendChild(treeNode(child));
+  for (const child of h.children) {
+    const item = treeNode(child);
+    const symbol = child.kind === "reflected" ? "kr" : "kt";
+    item.prepend(`${symbol} ${rgbText(child.coefficient)} × `);
+    item.insertBefore(document.createTextNode(` = ${rgbText(child.contribution)}`), item.querySelector("ul"));
+    list.appendChild(item);
+  }
   for (const stop of h.stops) {
     const item = document.createElement("li");
     item.className = "stop";
@@ -261,4 +293,18 @@ function treeNode(n) {
   }
   li.appendChild(list);
   return li;
+}
+
+// The local terms of the shading formula at a hit: the emission, the
+// ambient term, the caustic map's light (when there is one) and the
+// opacity that weighs them (when not 1); each light's follow.
+function termsItem(t) {
+  const item = document.createElement("li");
+  item.className = "terms";
+  const zero = (c) => c.every((v) => v === 0);
+  let text = `terms: emission ${rgbText(t.emission)}, ambient ${rgbText(t.ambient)}`;
+  if (t.caustic && !zero(t.caustic)) text += `, caustic ${rgbText(t.caustic)}`;
+  if (!t.opacity.every((v) => v === 1)) text += `; opacity ${rgbText(t.opacity)} weighs them`;
+  item.textContent = text;
+  return item;
 }
