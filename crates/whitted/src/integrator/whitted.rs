@@ -34,7 +34,7 @@ use crate::shading::{
     Color, Crossing, Light, Lobes, Material, MediumStack, Weights, direct_samples, phong,
     shading_normal,
 };
-use crate::world::{MaterialId, Surface, World};
+use crate::world::{Hit, MaterialId, Surface, World};
 
 /// Longest chain of transmissive surfaces one shadow ray passes through.
 const MAX_SHADOW_CROSSINGS: usize = 64;
@@ -75,6 +75,8 @@ pub struct Whitted<'a> {
     limits: RecursionLimits,
     any_transmissive: bool,
     caustics: Option<&'a CausticMap>,
+    /// Per material, whether shading reads (u, v) ([`Material::reads_uv`]).
+    reads_uv: Vec<bool>,
 }
 
 impl<'a> Whitted<'a> {
@@ -90,6 +92,7 @@ impl<'a> Whitted<'a> {
             limits,
             any_transmissive: shading.materials.iter().any(Material::is_transmissive),
             caustics: None,
+            reads_uv: shading.materials.iter().map(Material::reads_uv).collect(),
         }
     }
 
@@ -130,7 +133,7 @@ impl<'a> Whitted<'a> {
                 }
             }
             Some(hit) => {
-                let surface = self.world.surface(ray, &hit);
+                let surface = self.surface::<O>(ray, &hit);
                 observer.ray_hit(ray, Some((&hit, &surface)));
                 let mut tally = SampleTally {
                     counts,
@@ -149,6 +152,13 @@ impl<'a> Whitted<'a> {
         }
     }
 
+    /// The surface at `hit`, with (u, v) and tangents only where the
+    /// material or the observer reads them.
+    fn surface<O: RayObserver>(&self, ray: &Ray, hit: &Hit) -> Surface {
+        let reads_uv: &[bool] = if O::READS_UV { &[] } else { &self.reads_uv };
+        self.world.surface_for(ray, hit, reads_uv)
+    }
+
     /// The colour seen along a secondary ray (unit direction).
     fn trace<O: RayObserver>(
         &self,
@@ -164,7 +174,7 @@ impl<'a> Whitted<'a> {
                 self.shading.background
             }
             Some(hit) => {
-                let surface = self.world.surface(ray, &hit);
+                let surface = self.surface::<O>(ray, &hit);
                 tally.observer.ray_hit(ray, Some((&hit, &surface)));
                 self.shade(ray, &surface, depth, weight, media, tally)
             }
@@ -352,7 +362,7 @@ impl<'a> Whitted<'a> {
                 tally.observer.shadow_ray(&ray, step);
                 return through;
             };
-            let blocker = self.world.surface(&ray, &hit);
+            let blocker = self.surface::<O>(&ray, &hit);
             let step = ShadowStep::Closest {
                 blocker: Some((&hit, &blocker)),
             };
