@@ -27,6 +27,7 @@
 
 use crate::integrator::observer::{RayObserver, ShadowStep, Unobserved};
 use crate::integrator::photon_map::{self, CausticMap};
+use crate::integrator::shadow_cache;
 use crate::integrator::{PrimarySample, RayCounts, RayKind, RecursionLimits, Shading};
 use crate::math::{Ray, Vec3, offset_ray_origin};
 use crate::shading::optics::reflect;
@@ -218,7 +219,8 @@ impl<'a> Whitted<'a> {
                     tally.observer.light(index, Some(&sample), None);
                     continue;
                 }
-                let shadow = self.transmittance(s, light, sample.to_light, sample.distance, tally);
+                let shadow =
+                    self.transmittance(s, (index, light), sample.to_light, sample.distance, tally);
                 tally.observer.light(index, Some(&sample), Some(shadow));
                 if shadow == Color::ZERO {
                     continue;
@@ -324,14 +326,14 @@ impl<'a> Whitted<'a> {
         color
     }
 
-    /// How much of `light` reaches `s` along `to_light` (unit) over
+    /// How much of `light` (number `index`) reaches `s` along `to_light` (unit) over
     /// `distance`: 0 behind an opaque surface, the product of what every
     /// transmissive or dissolved surface crossed lets through otherwise
     /// ([`Material::pass_through`]).
     fn transmittance<O: RayObserver>(
         &self,
         s: &Surface,
-        light: &Light,
+        (index, light): (usize, &Light),
         to_light: Vec3,
         distance: f64,
         tally: &mut SampleTally<'_, O>,
@@ -349,7 +351,7 @@ impl<'a> Whitted<'a> {
         };
         let mut ray = segment(origin);
         if !self.any_transmissive {
-            let blocked = self.world.occluded(&ray);
+            let blocked = shadow_cache::occluded(self.world, &ray, index);
             tally
                 .observer
                 .shadow_ray(&ray, ShadowStep::AnyHit { blocked });

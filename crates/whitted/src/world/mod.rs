@@ -33,6 +33,7 @@ mod hit;
 mod instance;
 mod objects;
 mod packet;
+mod shadow_hint;
 
 pub use hit::{Hit, Surface};
 pub use objects::{
@@ -40,6 +41,7 @@ pub use objects::{
     Objects, Primitive, PrimitiveId, TransformId,
 };
 pub use packet::{PACKET_SIZE, PacketHits, RayPacket};
+pub use shadow_hint::ShadowHint;
 
 use crate::accel::{
     AccelKind, AccelerationStructure, Accelerator, Clipper, KdTree, KdTreeBuildParams, QueryContext,
@@ -669,12 +671,14 @@ impl<'a> World<'a> {
                 leaf_occludes(&self.entries, range, &query, self.wide_triangles, |e| {
                     self.shape_occludes(e.number, &query)
                 })
+                .is_some()
             });
         }
         let occluded = self.accel.occluded_in_leaf_order(ray, ctx, |range| {
             leaf_occludes(&self.entries, range, &query, self.wide_triangles, |e| {
                 self.other_occludes(definitions, e, &query, &mut inner)
             })
+            .is_some()
         });
         ctx.counters += inner.counters;
         occluded
