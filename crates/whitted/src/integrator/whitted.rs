@@ -142,7 +142,7 @@ impl<'a> Whitted<'a> {
                     rays_left: self.limits.ray_budget,
                     cut_at: None,
                 };
-                let color = self.shade(ray, &surface, 0, 1.0, MediumStack::default(), &mut tally);
+                let color = self.shade(ray, &surface, 0, 1.0, &MediumStack::default(), &mut tally);
                 tally.observer.ray_end(color);
                 PrimarySample {
                     color,
@@ -166,7 +166,7 @@ impl<'a> Whitted<'a> {
         ray: &Ray,
         depth: u32,
         weight: f64,
-        media: MediumStack,
+        media: &MediumStack,
         tally: &mut SampleTally<'_, O>,
     ) -> Color {
         match self.world.intersect(ray) {
@@ -190,7 +190,7 @@ impl<'a> Whitted<'a> {
         s: &Surface,
         depth: u32,
         weight: f64,
-        media: MediumStack,
+        media: &MediumStack,
         tally: &mut SampleTally<'_, O>,
     ) -> Color {
         let m = &self.shading.materials[s.material.0 as usize];
@@ -313,7 +313,7 @@ impl<'a> Whitted<'a> {
                 tally
                     .observer
                     .ray_start(kind, &refracted, transmitted_weight, child);
-                let c = self.trace(&refracted, depth + 1, child, inside_after, tally);
+                let c = self.trace(&refracted, depth + 1, child, &inside_after, tally);
                 tally.observer.ray_end(c);
                 color += transmitted_weight * c;
             } else {
