@@ -38,7 +38,8 @@ pub struct ExplainArgs {
     pixel: (u32, u32),
 
     /// Which of the pixel's samples (from 0; the pixel is the mean of its
-    /// samples).
+    /// samples). With --aa adaptive, which of the corners the pixel's
+    /// subdivision traces, row by row (the pixel is their area average).
     #[arg(long, value_name = "K", default_value = "0", value_parser = sample_index, allow_negative_numbers = true)]
     sample: u32,
 

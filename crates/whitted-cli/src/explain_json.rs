@@ -10,7 +10,7 @@ use serde_json::{Value, json};
 use whitted::accel::TraversalCounters;
 use whitted::integrator::{HitNode, LightTerm, LightVerdict, RayNode, Stop};
 use whitted::math::Vec3;
-use whitted::render::{PixelExplanation, Scene};
+use whitted::render::{AntiAliasing, PixelExplanation, Scene};
 use whitted::shading::Color;
 use whitted::world::PrimitiveId;
 
@@ -51,6 +51,20 @@ fn object(scene: &Scene, file: Option<&Path>, id: PrimitiveId) -> Value {
     })
 }
 
+/// How the pixel was sampled: the method's name, and the adaptive
+/// parameters.
+fn anti_aliasing(aa: AntiAliasing) -> Value {
+    match aa {
+        AntiAliasing::Stratified => json!({ "method": aa.name() }),
+        AntiAliasing::Adaptive(a) => json!({
+            "method": aa.name(),
+            "threshold": a.threshold,
+            "depth": a.depth,
+            "min_depth": a.min_depth,
+        }),
+    }
+}
+
 /// The whole explanation.
 pub fn explanation_json(scene: &Scene, file: Option<&Path>, e: &PixelExplanation) -> Value {
     let settings = &scene.settings;
@@ -66,6 +80,7 @@ pub fn explanation_json(scene: &Scene, file: Option<&Path>, e: &PixelExplanation
             "color": rgb(e.tree.color),
         },
         "sample_colors": e.sample_colors.iter().map(|&c| rgb(c)).collect::<Vec<_>>(),
+        "anti_aliasing": anti_aliasing(e.aa),
         "accel": e.accel.name(),
         "limits": {
             "max_depth": e.limits.max_depth,

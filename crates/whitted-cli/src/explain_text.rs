@@ -8,7 +8,7 @@ use std::path::Path;
 use whitted::accel::TraversalCounters;
 use whitted::integrator::{HitNode, LightVerdict, RayKind, RayNode, Stop};
 use whitted::math::Vec3;
-use whitted::render::{PixelExplanation, Scene};
+use whitted::render::{AntiAliasing, PixelExplanation, Scene};
 use whitted::shading::Color;
 use whitted::world::PrimitiveId;
 
@@ -79,13 +79,27 @@ pub fn explanation_text(scene: &Scene, file: Option<&Path>, e: &PixelExplanation
     );
     let [r, g, b] = e.pixel;
     let _ = writeln!(out, "pixel as rendered: ({r:.4}, {g:.4}, {b:.4})");
-    if e.samples > 1 {
-        let _ = writeln!(
-            out,
-            "  the mean of its {} samples; this sample's colour: {}",
-            e.samples,
-            color(e.tree.color)
-        );
+    match e.aa {
+        AntiAliasing::Adaptive(adaptive) => {
+            let _ = writeln!(
+                out,
+                "  {adaptive}: the area average of its squares, each the mean of its four \
+                 corners; {} corners traced, on a grid 1/{} of a pixel wide (the samples, row by \
+                 row); this corner's colour: {}",
+                e.samples,
+                1u32 << adaptive.depth,
+                color(e.tree.color)
+            );
+        }
+        AntiAliasing::Stratified if e.samples > 1 => {
+            let _ = writeln!(
+                out,
+                "  the mean of its {} samples; this sample's colour: {}",
+                e.samples,
+                color(e.tree.color)
+            );
+        }
+        AntiAliasing::Stratified => {}
     }
     out.push('\n');
     node_text(&mut out, scene, file, &e.tree, "");

@@ -3,6 +3,7 @@
 //! It prints only through [`report`], which never panics.
 #![deny(clippy::print_stdout, clippy::print_stderr, clippy::dbg_macro)]
 
+mod anti_aliasing;
 mod arguments;
 mod bench_command;
 mod explain_command;
@@ -16,6 +17,7 @@ mod render_command;
 mod render_stats;
 mod report;
 mod scene_arguments;
+mod serve;
 #[cfg(unix)]
 mod signals;
 mod split;
@@ -45,6 +47,7 @@ enum Command {
     Bench(bench_command::BenchArgs),
     Merge(merge_command::MergeArgs),
     Explain(explain_command::ExplainArgs),
+    Serve(serve::ServeArgs),
 }
 
 fn main() -> ExitCode {
@@ -58,6 +61,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench_command::run(&args),
         Command::Merge(args) => merge_command::run(&args),
         Command::Explain(args) => explain_command::run(&args),
+        Command::Serve(args) => serve::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

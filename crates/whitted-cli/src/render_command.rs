@@ -216,12 +216,12 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             .collect::<Vec<_>>()
             .join(", ");
         note!(
-            "{}: {}x{}, {} spp in {:.3} s (world built in {:.3} s); rays: {by_kind}; \
+            "{}: {}x{}, {} in {:.3} s (world built in {:.3} s); rays: {by_kind}; \
              {:.2} Mrays/s",
             args.output.display(),
             scene.settings.width,
             scene.settings.height,
-            scene.settings.samples_per_pixel,
+            crate::anti_aliasing::sampling(&scene.settings),
             elapsed,
             output.build_seconds,
             rays.total() as f64 / elapsed / 1e6,

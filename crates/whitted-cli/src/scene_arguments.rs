@@ -1,7 +1,7 @@
 //! The arguments that say which scene and how it is seen, shared by the
 //! commands that render it (`render`, `explain`): the scene file, the
-//! image size and samples, the depth, the acceleration structures, the
-//! photons, the camera and the memory budget.
+//! image size, the samples and anti-aliasing, the depth, the acceleration
+//! structures, the photons, the camera and the memory budget.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -12,7 +12,9 @@ use whitted::limits::MemoryBudget;
 use whitted::math::Vec3;
 use whitted::render::{Scene, check_image_size};
 use whitted::scene::{CameraOverride, LoadOptions, load_any_with};
+use whitted::shading::TextureFilter;
 
+use crate::anti_aliasing::AaArgs;
 use crate::arguments;
 use crate::report::note;
 
@@ -62,6 +64,16 @@ pub struct SceneArgs {
     #[arg(long, value_name = "N", value_parser = arguments::photons, allow_negative_numbers = true)]
     photons: Option<u64>,
 
+    #[command(flatten)]
+    aa: Box<AaArgs>,
+
+    /// Filter textures over each pixel's footprint (overrides the scene's
+    /// `texture_filter`): `mipmap` carries ray differentials and samples
+    /// images from mipmaps and checkers box-filtered; `none` (the default)
+    /// looks them up at the hit point.
+    #[arg(long, value_name = "NAME", value_parser = parse_texture_filter)]
+    texture_filter: Option<TextureFilter>,
+
     /// Put the camera's eye here (replaces the scene's).
     #[arg(long, value_name = "X,Y,Z", value_parser = arguments::vec3, allow_hyphen_values = true)]
     eye: Option<Vec3>,
@@ -89,6 +101,13 @@ pub struct SceneArgs {
 fn parse_accel(name: &str) -> Result<AccelKind, String> {
     AccelKind::from_name(name).ok_or_else(|| {
         let names: Vec<&str> = AccelKind::ALL.iter().map(AccelKind::name).collect();
+        format!("expected one of: {}", names.join(", "))
+    })
+}
+
+fn parse_texture_filter(name: &str) -> Result<TextureFilter, String> {
+    TextureFilter::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = TextureFilter::ALL.iter().map(|f| f.name()).collect();
         format!("expected one of: {}", names.join(", "))
     })
 }
@@ -164,6 +183,8 @@ impl SceneArgs {
         settings.accel_top = self.accel_top.or(settings.accel_top);
         settings.accel_bottom = self.accel_bottom.or(settings.accel_bottom);
         settings.photons.count = self.photons.unwrap_or(settings.photons.count);
+        settings.aa = self.aa.apply(settings.aa)?;
+        settings.texture_filter = self.texture_filter.unwrap_or(settings.texture_filter);
         Ok(scene)
     }
 }

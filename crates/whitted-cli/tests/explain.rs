@@ -72,13 +72,26 @@ fn rgb(value: &serde_json::Value) -> [f64; 3] {
 }
 
 #[test]
-fn the_json_root_is_the_pixel_render_writes_for_one_and_several_samples() {
+fn the_json_root_is_the_pixel_render_writes_for_one_and_several_samples_and_adaptive() {
     let folder = tempfile::tempdir().unwrap();
     let dir = folder.path();
     let whitted_toml = scene("whitted.toml");
-    for spp in ["1", "3"] {
-        let size = ["--width", "40", "--height", "30", "--spp", spp];
-        let out = dir.join(format!("spp{spp}.pfm"));
+    let samplings: [&[&str]; 3] = [
+        &["--spp", "1"],
+        &["--spp", "3"],
+        &[
+            "--aa",
+            "adaptive",
+            "--aa-threshold",
+            "0.1",
+            "--aa-depth",
+            "2",
+        ],
+    ];
+    for (i, sampling) in samplings.into_iter().enumerate() {
+        let mut size = vec!["--width", "40", "--height", "30"];
+        size.extend(sampling);
+        let out = dir.join(format!("sampling{i}.pfm"));
         let mut args = vec![
             "render",
             whitted_toml.as_str(),
@@ -86,7 +99,7 @@ fn the_json_root_is_the_pixel_render_writes_for_one_and_several_samples() {
             "-o",
             out.to_str().unwrap(),
         ];
-        args.extend(size);
+        args.extend(&size);
         assert!(whitted(&args, dir).status.success());
         let (width, pixels) = read_pfm(&out);
         for (x, y) in [(20, 14), (5, 25), (33, 8), (24, 17)] {
@@ -99,13 +112,13 @@ fn the_json_root_is_the_pixel_render_writes_for_one_and_several_samples() {
                 "--json",
                 "-q",
             ];
-            args.extend(size);
+            args.extend(&size);
             let explained = json(&whitted(&args, dir));
             let value: Vec<f32> = rgb(&explained["pixel"]["value"]).map(|c| c as f32).to_vec();
             assert_eq!(
                 value,
                 pixels[y * width + x].to_vec(),
-                "pixel {pixel}, {spp} spp"
+                "pixel {pixel}, {sampling:?}"
             );
             let root = rgb(&explained["tree"]["color"]);
             let samples: Vec<[f64; 3]> = explained["sample_colors"]
@@ -115,11 +128,60 @@ fn the_json_root_is_the_pixel_render_writes_for_one_and_several_samples() {
                 .map(rgb)
                 .collect();
             assert_eq!(root, samples[0]);
-            if spp == "1" {
+            if i == 0 {
                 assert_eq!(root.map(|c| c as f32).to_vec(), value);
             }
+            let method = &explained["anti_aliasing"]["method"];
+            assert_eq!(method, if i == 2 { "adaptive" } else { "stratified" });
         }
     }
+}
+
+#[test]
+fn the_text_of_an_adaptive_pixel_says_it_is_the_area_average_of_its_corners() {
+    let folder = tempfile::tempdir().unwrap();
+    let args = [
+        "explain",
+        &scene("whitted.toml"),
+        "--pixel",
+        "20,14",
+        "--width",
+        "40",
+        "--height",
+        "30",
+        "--aa",
+        "adaptive",
+        "--aa-min-depth",
+        "1",
+        "--sample",
+        "8",
+        "-q",
+    ];
+    let output = whitted(&args, folder.path());
+    assert!(output.status.success(), "{output:?}");
+    let text = String::from_utf8_lossy(&output.stdout);
+    assert!(text.contains("sample 8 of "), "{text}");
+    assert!(
+        text.contains(
+            "adaptive anti-aliasing (threshold 0.3, depth 1 to 3): the area average of its squares"
+        ),
+        "{text}"
+    );
+    assert!(text.contains("on a grid 1/8 of a pixel wide"), "{text}");
+    // The corner lies on the pixel, on the grid of eighths.
+    let header = text.lines().next().unwrap();
+    let at = header.rsplit_once(" at (").unwrap().1.trim_end_matches(')');
+    let (px, py) = at.split_once(", ").unwrap();
+    let (px, py): (f64, f64) = (px.parse().unwrap(), py.parse().unwrap());
+    assert!(
+        (20.0..=21.0).contains(&px) && (14.0..=15.0).contains(&py),
+        "{header}"
+    );
+    assert_eq!(
+        ((px * 8.0).fract(), (py * 8.0).fract()),
+        (0.0, 0.0),
+        "{header}"
+    );
 }
 
 #[test]

@@ -1,16 +1,19 @@
 //! `whitted explain`'s promise: the colour at the root of a pixel's ray
 //! tree is the rendered pixel, exactly. Checked on every example scene in
 //! `scenes/`, for seeded random pixels, with one sample per pixel (the
-//! root is the pixel) and with several (each sample's root is that
-//! sample's colour, and their mean is the pixel).
+//! root is the pixel), with several (each sample's root is that
+//! sample's colour, and their mean is the pixel) and with adaptive
+//! anti-aliasing (each corner's root is its colour, and their area
+//! average is the pixel).
 
 use std::path::{Path, PathBuf};
 
 use whitted::accel::AccelKind;
 use whitted::integrator::RayNode;
 use whitted::math::random::hash64;
-use whitted::render::{Scene, explain_pixel, render};
+use whitted::render::{Adaptive, AntiAliasing, Scene, explain_pixel, render};
 use whitted::scene::load_any;
+use whitted::shading::TextureFilter;
 
 /// The example scenes of every format, sorted by name.
 fn example_scenes() -> Vec<PathBuf> {
@@ -99,6 +102,92 @@ fn each_sample_s_root_is_its_colour_and_their_mean_the_rendered_pixel() {
                     "{name} pixel {x},{y} sample {k}"
                 );
                 assert_eq!(explained.pixel, first.pixel);
+            }
+        }
+    }
+}
+
+#[test]
+fn adaptive_corners_roots_are_their_colours_and_their_area_average_the_rendered_pixel() {
+    let resolution = (12, 9);
+    let aa = AntiAliasing::Adaptive(Adaptive {
+        threshold: 0.1,
+        depth: 2,
+        min_depth: 0,
+    });
+    let (mut explained_pixels, mut corners) = (0, 0);
+    for path in example_scenes() {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let mut scene = small(&path, resolution, 1);
+        scene.settings.aa = aa;
+        let film = render(&scene, &|_| {}).unwrap().image;
+        for (x, y) in pixels(&name, resolution, 3) {
+            let first = explain_pixel(&scene, (x, y), 0).unwrap();
+            assert_eq!(first.pixel, film.pixel(x, y), "{name} pixel {x},{y}");
+            assert_eq!(first.aa, aa);
+            let count = first.samples;
+            assert!((4..=25).contains(&count), "{name} pixel {x},{y}: {count}");
+            assert_eq!(first.sample_colors.len(), count as usize);
+            explained_pixels += 1;
+            corners += count;
+            let mut positions = Vec::new();
+            for k in [0, count / 2, count - 1] {
+                let explained = explain_pixel(&scene, (x, y), k).unwrap();
+                assert_eq!(
+                    explained.tree.color, first.sample_colors[k as usize],
+                    "{name} pixel {x},{y} corner {k}"
+                );
+                assert_eq!(explained.pixel, first.pixel);
+                let p = explained.position;
+                let on_the_pixel = (f64::from(x)..=f64::from(x + 1)).contains(&p.x)
+                    && (f64::from(y)..=f64::from(y + 1)).contains(&p.y);
+                assert!(on_the_pixel, "{name} pixel {x},{y} corner {k} at {p:?}");
+                positions.push((p.y, p.x));
+            }
+            // Row by row: the first corner is the top left, the last the
+            // bottom right.
+            assert_eq!(positions[0], (f64::from(y), f64::from(x)));
+            assert_eq!(positions[2], (f64::from(y + 1), f64::from(x + 1)));
+            let error = explain_pixel(&scene, (x, y), count).unwrap_err();
+            assert_eq!(
+                error.to_string(),
+                format!(
+                    "sample {count} does not exist: the pixel has {count} (0 to {})",
+                    count - 1
+                )
+            );
+        }
+    }
+    // Some pixel was subdivided, so the corners inside a pixel are covered.
+    assert!(corners > 4 * explained_pixels, "{corners} corners");
+}
+
+#[test]
+fn with_filtered_textures_the_explained_pixel_is_the_rendered_pixel() {
+    // The samples' and the corners' ray differentials must be the
+    // renderer's, or a filtered texture gives another colour.
+    let resolution = (12, 9);
+    let adaptive = AntiAliasing::Adaptive(Adaptive {
+        threshold: 0.1,
+        depth: 2,
+        min_depth: 1,
+    });
+    for path in example_scenes() {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        for (aa, spp) in [(AntiAliasing::Stratified, 2), (adaptive, 1)] {
+            let mut scene = small(&path, resolution, spp);
+            scene.settings.texture_filter = TextureFilter::Mipmap;
+            scene.settings.aa = aa;
+            let film = render(&scene, &|_| {}).unwrap().image;
+            for (x, y) in pixels(&name, resolution, 2) {
+                let first = explain_pixel(&scene, (x, y), 0).unwrap();
+                assert_eq!(first.pixel, film.pixel(x, y), "{name} {aa:?} pixel {x},{y}");
+                let last = first.samples - 1;
+                let explained = explain_pixel(&scene, (x, y), last).unwrap();
+                assert_eq!(
+                    explained.tree.color, first.sample_colors[last as usize],
+                    "{name} {aa:?} pixel {x},{y} sample {last}"
+                );
             }
         }
     }

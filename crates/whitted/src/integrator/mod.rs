@@ -25,7 +25,7 @@ pub use whitted::Whitted;
 
 use crate::accel::{QueryContext, TraversalCounters};
 use crate::math::Ray;
-use crate::shading::{Color, Light, Material};
+use crate::shading::{Color, Light, Material, RayDifferential};
 use crate::world::{Hit, MaterialId, Surface, World};
 
 /// The most secondary rays (reflected and refracted) one camera sample
@@ -137,16 +137,33 @@ impl<'a> Integrator<'a> {
         }
     }
 
-    /// [`Integrator::trace_primary`], telling `observer` every step (see
-    /// [`RayObserver`]).
+    /// [`Integrator::trace_primary`] with the camera ray's differential,
+    /// if textures are filtered (see [`crate::shading::differential`]).
+    #[inline]
+    pub fn trace_camera_ray(
+        &self,
+        ray: &Ray,
+        differential: Option<RayDifferential>,
+        counts: &mut RayCounts,
+    ) -> PrimarySample {
+        match self {
+            Integrator::Whitted(w) => {
+                w.trace_primary_observed(ray, differential, counts, &mut Unobserved)
+            }
+        }
+    }
+
+    /// [`Integrator::trace_camera_ray`], telling `observer` every step
+    /// (see [`RayObserver`]).
     pub fn trace_primary_observed<O: RayObserver>(
         &self,
         ray: &Ray,
+        differential: Option<RayDifferential>,
         counts: &mut RayCounts,
         observer: &mut O,
     ) -> PrimarySample {
         match self {
-            Integrator::Whitted(w) => w.trace_primary_observed(ray, counts, observer),
+            Integrator::Whitted(w) => w.trace_primary_observed(ray, differential, counts, observer),
         }
     }
 

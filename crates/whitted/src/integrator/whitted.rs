@@ -30,10 +30,11 @@ use crate::integrator::photon_map::{self, CausticMap};
 use crate::integrator::shadow_cache;
 use crate::integrator::{PrimarySample, RayCounts, RayKind, RecursionLimits, Shading};
 use crate::math::{Ray, Vec3, offset_ray_origin};
+use crate::shading::differential::Bend;
 use crate::shading::optics::reflect;
 use crate::shading::{
-    Color, Crossing, Light, Lobes, Material, MediumStack, Weights, direct_samples, phong,
-    shading_normal,
+    Color, Crossing, Light, Lobes, Material, MediumStack, RayDifferential, Weights, direct_samples,
+    phong, shading_normal,
 };
 use crate::world::{Hit, MaterialId, Surface, World};
 
@@ -111,13 +112,15 @@ impl<'a> Whitted<'a> {
 
     /// The colour seen along a camera ray (unit direction), and its first hit.
     pub fn trace_primary(&self, ray: &Ray, counts: &mut RayCounts) -> PrimarySample {
-        self.trace_primary_observed(ray, counts, &mut Unobserved)
+        self.trace_primary_observed(ray, None, counts, &mut Unobserved)
     }
 
-    /// [`Whitted::trace_primary`], telling `observer` every step.
+    /// [`Whitted::trace_primary`] with the ray's differential, if textures
+    /// are filtered, telling `observer` every step.
     pub fn trace_primary_observed<O: RayObserver>(
         &self,
         ray: &Ray,
+        differential: Option<RayDifferential>,
         counts: &mut RayCounts,
         observer: &mut O,
     ) -> PrimarySample {
@@ -142,7 +145,9 @@ impl<'a> Whitted<'a> {
                     rays_left: self.limits.ray_budget,
                     cut_at: None,
                 };
-                let color = self.shade(ray, &surface, 0, 1.0, &MediumStack::default(), &mut tally);
+                let differential = differential.as_ref();
+                let media = &MediumStack::default();
+                let color = self.shade(ray, differential, &surface, 0, 1.0, media, &mut tally);
                 tally.observer.ray_end(color);
                 PrimarySample {
                     color,
@@ -164,6 +169,7 @@ impl<'a> Whitted<'a> {
     fn trace<O: RayObserver>(
         &self,
         ray: &Ray,
+        differential: Option<&RayDifferential>,
         depth: u32,
         weight: f64,
         media: &MediumStack,
@@ -177,16 +183,18 @@ impl<'a> Whitted<'a> {
             Some(hit) => {
                 let surface = self.surface::<O>(ray, &hit);
                 tally.observer.ray_hit(ray, Some((&hit, &surface)));
-                self.shade(ray, &surface, depth, weight, media, tally)
+                self.shade(ray, differential, &surface, depth, weight, media, tally)
             }
         }
     }
 
     /// The colour leaving `s` back along `ray`. `weight` is the largest
     /// factor by which this colour reaches the pixel.
+    #[allow(clippy::too_many_arguments)]
     fn shade<O: RayObserver>(
         &self,
         ray: &Ray,
+        differential: Option<&RayDifferential>,
         s: &Surface,
         depth: u32,
         weight: f64,
@@ -207,11 +215,14 @@ impl<'a> Whitted<'a> {
 
         // The opacity weighs the surface's own light and mirror; the
         // dissolved rest joins the transmitted ray.
-        let alpha = m.opacity.at(s.uv);
-        let mut local = m.emission.at(s.uv) + m.ambient.at(s.uv) * self.shading.ambient;
+        let at_hit = differential.and_then(|d| d.at_hit(ray, s));
+        let footprint = at_hit.as_ref().map(|h| &h.footprint);
+        let alpha = m.opacity.filtered(s.uv, footprint);
+        let ambient = m.ambient.filtered(s.uv, footprint);
+        let mut local = m.emission.filtered(s.uv, footprint) + ambient * self.shading.ambient;
 
-        let diffuse = m.diffuse.at(s.uv);
-        let specular = m.specular.at(s.uv);
+        let diffuse = m.diffuse.filtered(s.uv, footprint);
+        let specular = m.specular.filtered(s.uv, footprint);
         if alpha != Color::ZERO && (diffuse != Color::ZERO || specular != Color::ZERO) {
             for (index, light, sample) in direct_samples(self.shading.lights, s.point) {
                 let n_dot_l = n.dot(sample.to_light);
@@ -241,8 +252,8 @@ impl<'a> Whitted<'a> {
             tally.observer.depth_limit();
             return color;
         }
-        let kr = m.reflection.at(s.uv);
-        let kt = m.transmission.at(s.uv);
+        let kr = m.reflection.filtered(s.uv, footprint);
+        let kt = m.transmission.filtered(s.uv, footprint);
         if kr == Color::ZERO && kt == Color::ZERO && alpha == Color::ONE {
             return color;
         }
@@ -282,6 +293,9 @@ impl<'a> Whitted<'a> {
             ..
         } = lobes;
 
+        let bend = differential
+            .zip(at_hit)
+            .map(|(d, h)| Bend::new(self.world, ray, d, h, s, facing, n));
         let branches = reflected_weight != Color::ZERO && refracted.is_some();
         let child = weight * reflected_weight.max_element();
         if child >= self.limits.min_weight
@@ -296,7 +310,9 @@ impl<'a> Whitted<'a> {
             tally
                 .observer
                 .ray_start(kind, &reflected, reflected_weight, child);
-            let c = self.trace(&reflected, depth + 1, child, media, tally);
+            let differential = bend.map(|b| b.reflected());
+            let differential = differential.as_ref();
+            let c = self.trace(&reflected, differential, depth + 1, child, media, tally);
             tally.observer.ray_end(c);
             color += reflected_weight * c;
         } else if reflected_weight != Color::ZERO {
@@ -313,7 +329,10 @@ impl<'a> Whitted<'a> {
                 tally
                     .observer
                     .ray_start(kind, &refracted, transmitted_weight, child);
-                let c = self.trace(&refracted, depth + 1, child, &inside_after, tally);
+                let differential = bend.map(|b| b.refracted(dir, n_from / n_to));
+                let differential = differential.as_ref();
+                let media = &inside_after;
+                let c = self.trace(&refracted, differential, depth + 1, child, media, tally);
                 tally.observer.ray_end(c);
                 color += transmitted_weight * c;
             } else {

@@ -8,6 +8,7 @@
 
 use crate::math::magnitude::{self, MagnitudeError};
 use crate::math::{Aabb, DVec2, Ray, Vec3, unit};
+use crate::shading::RayDifferential;
 
 /// Why a camera could not be built.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -157,6 +158,26 @@ impl Camera {
         Ray::new(self.eye, dir)
     }
 
+    /// The ray differential of [`Camera::ray`] at `(x, y)`: how its
+    /// direction changes per pixel step in x and y (its origin does not).
+    pub fn ray_differential(&self, width: u32, height: u32, x: f64, y: f64) -> RayDifferential {
+        let aspect = f64::from(width) / f64::from(height);
+        let sx = (2.0 * x / f64::from(width) - 1.0) * aspect * self.tan_half_fov;
+        let sy = (1.0 - 2.0 * y / f64::from(height)) * self.tan_half_fov;
+        let v = self.forward + sx * self.right + sy * self.true_up;
+        let (length, d) = (v.length(), v.normalize());
+        // ∂(v/|v|) = (∂v − (d·∂v) d) / |v|.
+        let unit = |dv: Vec3| (dv - d.dot(dv) * d) / length;
+        let dvdx = self.right * (2.0 * aspect * self.tan_half_fov / f64::from(width));
+        let dvdy = self.true_up * (-2.0 * self.tan_half_fov / f64::from(height));
+        RayDifferential {
+            dox: Vec3::ZERO,
+            ddx: unit(dvdx),
+            doy: Vec3::ZERO,
+            ddy: unit(dvdy),
+        }
+    }
+
     /// Where `point` appears on a `width` × `height` image (pixel units
     /// from the top-left corner, the inverse of [`Camera::ray`]), and its
     /// depth along the view direction; the position means something only
@@ -191,6 +212,30 @@ mod tests {
         }
         let behind = c.project(200, 100, c.ray(200, 100, 10.0, 10.0).at(-1.0)).1;
         assert!(behind < 0.0);
+    }
+
+    #[test]
+    fn the_ray_differential_matches_neighbouring_pixel_rays() {
+        let c = Camera::new(Vec3::new(1.0, 2.0, 5.0), Vec3::ZERO, Vec3::Y, 50.0).unwrap();
+        let (w, h) = (320, 200);
+        for (x, y) in [(0.5, 0.5), (160.0, 100.0), (300.25, 17.5), (3.0, 190.0)] {
+            let d = c.ray_differential(w, h, x, y);
+            let e = 1e-4;
+            let fx = (c.ray(w, h, x + e, y).dir - c.ray(w, h, x - e, y).dir) / (2.0 * e);
+            let fy = (c.ray(w, h, x, y + e).dir - c.ray(w, h, x, y - e).dir) / (2.0 * e);
+            assert!(
+                (d.ddx - fx).length() < 1e-8 * fx.length().max(1e-3),
+                "{d:?} {fx}"
+            );
+            assert!(
+                (d.ddy - fy).length() < 1e-8 * fy.length().max(1e-3),
+                "{d:?} {fy}"
+            );
+            // A whole pixel step agrees to first order.
+            let step = c.ray(w, h, x + 1.0, y).dir - c.ray(w, h, x, y).dir;
+            assert!((d.ddx - step).length() < 0.01 * step.length());
+            assert_eq!((d.dox, d.doy), (Vec3::ZERO, Vec3::ZERO));
+        }
     }
 
     fn camera() -> Camera {

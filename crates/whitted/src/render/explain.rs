@@ -7,6 +7,11 @@
 //! the pixel is the mean of its samples' colours summed in the renderer's
 //! order: so the tree's root colour is the sample's radiance, bit for bit,
 //! and [`PixelExplanation::pixel`] is the rendered pixel, bit for bit.
+//! With adaptive anti-aliasing the samples are the corners the pixel's
+//! subdivision traces ([`super::adaptive`], the renderer's own pass run
+//! on that pixel alone) and the pixel is their area average.
+
+use std::collections::HashMap;
 
 use crate::accel::AccelKind;
 use crate::integrator::{
@@ -14,8 +19,11 @@ use crate::integrator::{
     Shading, Unobserved,
 };
 use crate::math::DVec2;
-use crate::render::sample_ray::{pixel_pattern, sample_ray};
-use crate::render::{RenderError, Scene};
+use crate::render::adaptive::{AdaptivePixels, Cost};
+use crate::render::sample_ray::{
+    pixel_pattern, position_differential, position_ray, sample_differential, sample_ray,
+};
+use crate::render::{AntiAliasing, RenderError, Scene};
 use crate::shading::Color;
 use crate::world::MAX_PRIMITIVES;
 
@@ -26,13 +34,19 @@ pub struct PixelExplanation {
     pub x: u32,
     /// The pixel's row (0 at the top).
     pub y: u32,
-    /// Which of the pixel's samples is explained.
+    /// Which of the pixel's samples is explained: with adaptive
+    /// anti-aliasing, which of the corners its subdivision traced, in
+    /// reading order.
     pub sample: u32,
-    /// The pixel's number of samples.
+    /// The pixel's number of samples (of corners, with adaptive
+    /// anti-aliasing).
     pub samples: u32,
     /// Where the sample lies on the image, in pixels from the top left
     /// corner.
     pub position: DVec2,
+    /// How the pixel was sampled: with adaptive anti-aliasing, the pixel
+    /// is the area average of its squares, each the mean of its corners.
+    pub aa: AntiAliasing,
     /// The structure the rays were traced through (the costs are its).
     pub accel: AccelKind,
     /// The recursion limits the tree was traced with.
@@ -41,8 +55,8 @@ pub struct PixelExplanation {
     pub tree: RayNode,
     /// Every sample's colour, in order.
     pub sample_colors: Vec<Color>,
-    /// The pixel as the renderer stores it: the mean of the samples'
-    /// colours, in 32-bit floats.
+    /// The pixel as the renderer stores it, in 32-bit floats: the mean of
+    /// the samples' colours, or the area average of the adaptive squares.
     pub pixel: [f32; 3],
 }
 
@@ -103,7 +117,7 @@ pub fn explain_pixel(
         });
     }
     let samples = settings.samples_per_pixel;
-    if sample >= samples {
+    if settings.aa == AntiAliasing::Stratified && sample >= samples {
         return Err(ExplainError::SampleOutside { sample, samples });
     }
     let stack = super::worker_stack_bytes(settings.max_depth);
@@ -145,42 +159,87 @@ fn trace_pixel(
         super::photon_pass::build(&world, &shading, settings).map_err(RenderError::from)?;
     let integrator = Integrator::new(settings.integrator, &world, shading, limits)
         .with_caustics(caustics.as_ref().map(|(map, _)| map));
-    let pattern = pixel_pattern(x, y);
     let mut counts = RayCounts::default();
-    let mut sum = Color::ZERO;
-    let mut sample_colors = Vec::with_capacity(settings.samples_per_pixel as usize);
-    let mut tree = None;
-    for s in 0..settings.samples_per_pixel {
-        let ray = sample_ray(&scene.camera, settings, (x, y), pattern, s);
-        let color = if s == sample {
-            let mut recorder = RayTreeRecorder::new(&world, shading, limits);
-            let traced = integrator.trace_primary_observed(&ray, &mut counts, &mut recorder);
-            tree = recorder.finish();
-            traced.color
-        } else {
-            integrator
-                .trace_primary_observed(&ray, &mut counts, &mut Unobserved)
-                .color
-        };
-        sample_colors.push(color);
-        sum += color;
-    }
-    let pixel = (sum / f64::from(settings.samples_per_pixel)).to_f32();
-    let tree = tree.ok_or(ExplainError::SampleOutside {
+    let (pixel, samples) = match settings.aa {
+        AntiAliasing::Stratified => stratified_samples(scene, &integrator, (x, y), &mut counts),
+        AntiAliasing::Adaptive(adaptive) => {
+            let pixels = AdaptivePixels::new(
+                &integrator,
+                &scene.camera,
+                settings,
+                scene.color_space,
+                adaptive,
+            );
+            let mut cost = Cost {
+                rays: &mut counts,
+                cuts: &mut HashMap::new(),
+            };
+            pixels.pixel_alone(x, y, &mut cost)
+        }
+    };
+    let count = samples.len() as u32;
+    let Some(&(position, _)) = samples.get(sample as usize) else {
+        return Err(ExplainError::SampleOutside {
+            sample,
+            samples: count,
+        });
+    };
+    // The sample's own ray and differential again, watched: the same ray
+    // through the same integrator, so the root's colour is the sample's
+    // bit for bit.
+    let ray = position_ray(&scene.camera, settings, position);
+    let differential = match settings.aa {
+        AntiAliasing::Stratified => {
+            sample_differential(&scene.camera, settings, (x, y), pixel_pattern(x, y), sample)
+        }
+        AntiAliasing::Adaptive(_) => position_differential(&scene.camera, settings, position, 1.0),
+    };
+    let mut recorder = RayTreeRecorder::new(&world, shading, limits);
+    integrator.trace_primary_observed(&ray, differential, &mut counts, &mut recorder);
+    let tree = recorder.finish().ok_or(ExplainError::SampleOutside {
         sample,
-        samples: settings.samples_per_pixel,
+        samples: count,
     })?;
-    let offset = crate::math::sampling::pixel_sample(sample, settings.samples_per_pixel, pattern);
     Ok(PixelExplanation {
         x,
         y,
         sample,
-        samples: settings.samples_per_pixel,
-        position: DVec2::new(f64::from(x) + offset.x, f64::from(y) + offset.y),
+        samples: count,
+        position,
+        aa: settings.aa,
         accel: settings.accel,
         limits,
         tree,
-        sample_colors,
-        pixel,
+        sample_colors: samples.into_iter().map(|(_, color)| color).collect(),
+        pixel: pixel.to_f32(),
     })
+}
+
+/// The stratified samples of pixel (`x`, `y`), each with its position on
+/// the image and its colour, and their mean summed in the renderer's order.
+fn stratified_samples(
+    scene: &Scene,
+    integrator: &Integrator<'_>,
+    (x, y): (u32, u32),
+    counts: &mut RayCounts,
+) -> (Color, Vec<(DVec2, Color)>) {
+    let settings = &scene.settings;
+    let spp = settings.samples_per_pixel;
+    let pattern = pixel_pattern(x, y);
+    let mut sum = Color::ZERO;
+    let mut samples = Vec::with_capacity(spp as usize);
+    for s in 0..spp {
+        let ray = sample_ray(&scene.camera, settings, (x, y), pattern, s);
+        let differential = sample_differential(&scene.camera, settings, (x, y), pattern, s);
+        let color = integrator
+            .trace_primary_observed(&ray, differential, counts, &mut Unobserved)
+            .color;
+        let offset = crate::math::sampling::pixel_sample(s, spp, pattern);
+        samples.push((
+            DVec2::new(f64::from(x) + offset.x, f64::from(y) + offset.y),
+            color,
+        ));
+        sum += color;
+    }
+    (sum / f64::from(spp), samples)
 }

@@ -2,6 +2,7 @@
 //! samples placed by a pattern seeded from the pixel's position, so the
 //! picture is identical bit for bit whatever the number of threads.
 
+mod adaptive;
 mod camera;
 mod explain;
 mod gradient_note;
@@ -16,6 +17,9 @@ mod settings;
 mod sources;
 mod trace_timing;
 
+pub use adaptive::{
+    Adaptive, AdaptiveError, AntiAliasing, DEFAULT_AA_DEPTH, DEFAULT_AA_THRESHOLD, MAX_AA_DEPTH,
+};
 pub use camera::{Camera, CameraError};
 pub use explain::{ExplainError, PixelExplanation, explain_pixel};
 pub use gradient_note::GradientExceeded;
@@ -34,19 +38,21 @@ pub use sources::{LineIndex, ObjectSource, ObjectSources, PrimitiveDescription, 
 pub use trace_timing::TraceTiming;
 
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Mutex, PoisonError};
 
 use rayon::prelude::*;
 
-use crate::image::Film;
+use crate::image::{ColorSpace, Film};
 use crate::integrator::{
     Integrator, RayCounts, RayKind, RecursionLimits, SECONDARY_RAY_BUDGET, Shading,
 };
 use crate::limits::{MemoryBudget, MemoryError};
+use crate::math::Ray;
 use crate::shading::Color;
-use crate::world::{MAX_PRIMITIVES, MaterialId, World};
-use sample_ray::{pixel_pattern, sample_ray};
+use crate::world::{Hit, MAX_PRIMITIVES, MaterialId, Surface, World};
+use adaptive::{AdaptivePixels, Cost};
+use sample_ray::{pixel_pattern, sample_differential, sample_ray};
 
 /// Side of the square tiles the image is cut into, in pixels.
 const TILE_SIZE: u32 = 16;
@@ -170,9 +176,15 @@ pub enum RenderError {
         /// The first one's row.
         y: u32,
     },
+    /// The adaptive anti-aliasing parameters are out of range.
+    #[error(transparent)]
+    AntiAliasing(#[from] AdaptiveError),
     /// The pixels asked for are not in the image.
     #[error(transparent)]
     Selection(#[from] SelectionError),
+    /// The render was cancelled ([`render_cancellable`]) before it ended.
+    #[error("the render was cancelled")]
+    Cancelled,
     /// The thread pool could not be created.
     #[error("could not start {threads} worker threads: {message}")]
     Threads {
@@ -244,6 +256,20 @@ pub fn render(
     render_selected(scene, &whole, progress)
 }
 
+/// Renders `scene` as [`render`] does, but stops early with
+/// [`RenderError::Cancelled`] once `cancel` is set: each tile checks it
+/// before it starts, so a cancelled render ends within a tile's time per
+/// thread (the live preview of `whitted serve` cancels a render when a
+/// newer one is asked for).
+pub fn render_cancellable(
+    scene: &Scene,
+    cancel: &AtomicBool,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<RenderOutput, RenderError> {
+    let whole = PixelSelection::whole(scene.settings.width, scene.settings.height);
+    render_pixels(scene, &whole, Some(cancel), progress)
+}
+
 /// Renders the pixels of `scene` that `selection` holds, as [`render`]
 /// does (each bit for bit as a whole render has it), and leaves the others
 /// black. Progress counts the selected pixels.
@@ -252,6 +278,17 @@ pub fn render_selected(
     selection: &PixelSelection,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<RenderOutput, RenderError> {
+    render_pixels(scene, selection, None, progress)
+}
+
+/// [`render_selected`], stopping early when `cancel` is given and set.
+fn render_pixels(
+    scene: &Scene,
+    selection: &PixelSelection,
+    cancel: Option<&AtomicBool>,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<RenderOutput, RenderError> {
+    let cancelled = || cancel.is_some_and(|c| c.load(Ordering::Relaxed));
     let settings = &scene.settings;
     let (width, height) = (settings.width, settings.height);
     settings.check()?;
@@ -311,10 +348,14 @@ pub fn render_selected(
     let clock = trace_timing::TraceClock::start();
     pool.install(|| {
         tiles.into_par_iter().for_each(|index| {
+            if cancelled() {
+                return;
+            }
             let tile = clock.tile(|| {
                 render_tile(
                     &integrator,
                     &scene.camera,
+                    scene.color_space,
                     settings,
                     selection,
                     index % tiles_x,
@@ -331,9 +372,12 @@ pub fn render_selected(
         });
     });
     let trace = clock.finish(pool.current_num_threads());
+    if cancelled() {
+        return Err(RenderError::Cancelled);
+    }
     let films = films.into_inner().unwrap_or_else(PoisonError::into_inner);
     check_finite(&films.image)?;
-    let ray_budget_cut = budget_cut(scene, &films.cuts);
+    let ray_budget_cut = budget_cut(scene, &films.cuts, films.rays[RayKind::Primary]);
     Ok(RenderOutput {
         image: films.image,
         aovs: films.aovs,
@@ -350,17 +394,27 @@ pub fn render_selected(
 
 /// The report of the samples the ray budget cut short, by the material
 /// they were cut at: the material with the most (the lowest id among
-/// equals, so the report does not depend on the threads).
-fn budget_cut(scene: &Scene, cuts: &HashMap<MaterialId, u64>) -> Option<RayBudgetCut> {
+/// equals, so the report does not depend on the threads). `camera_rays` is
+/// the total when the pixels were sampled adaptively.
+fn budget_cut(
+    scene: &Scene,
+    cuts: &HashMap<MaterialId, u64>,
+    camera_rays: u64,
+) -> Option<RayBudgetCut> {
     let (&material, _) = cuts
         .iter()
         .max_by_key(|&(material, &samples)| (samples, std::cmp::Reverse(material.0)))?;
     let settings = &scene.settings;
     Some(RayBudgetCut {
         samples: cuts.values().sum(),
-        total: u64::from(settings.width)
-            * u64::from(settings.height)
-            * u64::from(settings.samples_per_pixel),
+        total: match settings.aa {
+            AntiAliasing::Stratified => {
+                u64::from(settings.width)
+                    * u64::from(settings.height)
+                    * u64::from(settings.samples_per_pixel)
+            }
+            AntiAliasing::Adaptive(_) => camera_rays,
+        },
         material,
         material_name: scene.material_name(material),
         max_depth: settings.max_depth,
@@ -399,6 +453,7 @@ fn tile_is_selected(selection: &PixelSelection, tile_x: u32, tile_y: u32) -> boo
 fn render_tile(
     integrator: &Integrator,
     camera: &Camera,
+    color_space: ColorSpace,
     settings: &RenderSettings,
     selection: &PixelSelection,
     tile_x: u32,
@@ -425,6 +480,16 @@ fn render_tile(
         selected: 0,
     };
     let spp = settings.samples_per_pixel;
+    let mut adaptive = match settings.aa {
+        AntiAliasing::Stratified => None,
+        AntiAliasing::Adaptive(a) => Some(AdaptivePixels::new(
+            integrator,
+            camera,
+            settings,
+            color_space,
+            a,
+        )),
+    };
     for y in y0..y0 + height {
         for x in x0..x0 + width {
             if !selection.contains(x, y) {
@@ -435,12 +500,23 @@ fn render_tile(
                 continue;
             }
             tile.selected += 1;
+            if let Some(adaptive) = &mut adaptive {
+                let mut cost = Cost {
+                    rays: &mut tile.rays,
+                    cuts: &mut tile.cuts,
+                };
+                let color = adaptive.pixel(x, y, &mut cost);
+                tile.color.extend_from_slice(&color.to_f32());
+                push_aovs(integrator, camera, settings, x, y, None, &mut tile.aovs);
+                continue;
+            }
             let pattern = pixel_pattern(x, y);
             let mut sum = Color::ZERO;
             let mut centre = None;
             for s in 0..spp {
                 let ray = sample_ray(camera, settings, (x, y), pattern, s);
-                let sample = integrator.trace_primary(&ray, &mut tile.rays);
+                let differential = sample_differential(camera, settings, (x, y), pattern, s);
+                let sample = integrator.trace_camera_ray(&ray, differential, &mut tile.rays);
                 if let Some(material) = sample.cut_at {
                     *tile.cuts.entry(material).or_default() += 1;
                 }
@@ -451,55 +527,69 @@ fn render_tile(
             }
             let color = sum / f64::from(spp);
             tile.color.extend_from_slice(&color.to_f32());
-            if settings.aovs.is_empty() {
-                continue;
-            }
-            let (ray, first_hit) = centre.unwrap_or_else(|| {
-                let ray = camera.ray(
-                    settings.width,
-                    settings.height,
-                    f64::from(x) + 0.5,
-                    f64::from(y) + 0.5,
-                );
-                let hit = integrator.first_hit(&ray);
-                (ray, hit)
-            });
-            for (aov, data) in settings.aovs.iter().zip(&mut tile.aovs) {
-                match (aov, &first_hit) {
-                    (Aov::Depth, Some((hit, _))) => data.push(hit.t() as f32),
-                    (Aov::Depth, None) => data.push(f32::INFINITY),
-                    (Aov::Normal, Some((_, surface))) => {
-                        let n = if ray.dir.dot(surface.normal) < 0.0 {
-                            surface.normal
-                        } else {
-                            -surface.normal
-                        };
-                        data.extend_from_slice(&[n.x as f32, n.y as f32, n.z as f32]);
-                    }
-                    (Aov::Normal, None) => data.extend_from_slice(&[0.0; 3]),
-                    (Aov::Id, Some((hit, _))) => data.push(
-                        integrator
-                            .world()
-                            .placement(hit.primitive)
-                            .map_or(hit.primitive.0, |(_, p)| p) as f32,
-                    ),
-                    (Aov::Instance, Some((hit, _))) => data.push(
-                        integrator
-                            .world()
-                            .placement(hit.primitive)
-                            .map_or(-1.0, |(k, _)| k as f32),
-                    ),
-                    (Aov::Instance, None) => data.push(-1.0),
-                    (Aov::Id, None) => data.push(-1.0),
-                    (Aov::Cost, _) => {
-                        let counters = integrator.traversal_cost(&ray);
-                        data.push((counters.nodes + counters.primitives) as f32);
-                    }
-                }
-            }
+            push_aovs(integrator, camera, settings, x, y, centre, &mut tile.aovs);
         }
     }
     tile
+}
+
+/// Appends the AOVs of pixel (`x`, `y`): those of the ray through its
+/// centre, given as `centre` with its first hit when it was traced.
+fn push_aovs(
+    integrator: &Integrator,
+    camera: &Camera,
+    settings: &RenderSettings,
+    x: u32,
+    y: u32,
+    centre: Option<(Ray, Option<(Hit, Surface)>)>,
+    aovs: &mut [Vec<f32>],
+) {
+    if settings.aovs.is_empty() {
+        return;
+    }
+    let (ray, first_hit) = centre.unwrap_or_else(|| {
+        let ray = camera.ray(
+            settings.width,
+            settings.height,
+            f64::from(x) + 0.5,
+            f64::from(y) + 0.5,
+        );
+        let hit = integrator.first_hit(&ray);
+        (ray, hit)
+    });
+    for (aov, data) in settings.aovs.iter().zip(aovs.iter_mut()) {
+        match (aov, &first_hit) {
+            (Aov::Depth, Some((hit, _))) => data.push(hit.t() as f32),
+            (Aov::Depth, None) => data.push(f32::INFINITY),
+            (Aov::Normal, Some((_, surface))) => {
+                let n = if ray.dir.dot(surface.normal) < 0.0 {
+                    surface.normal
+                } else {
+                    -surface.normal
+                };
+                data.extend_from_slice(&[n.x as f32, n.y as f32, n.z as f32]);
+            }
+            (Aov::Normal, None) => data.extend_from_slice(&[0.0; 3]),
+            (Aov::Id, Some((hit, _))) => data.push(
+                integrator
+                    .world()
+                    .placement(hit.primitive)
+                    .map_or(hit.primitive.0, |(_, p)| p) as f32,
+            ),
+            (Aov::Instance, Some((hit, _))) => data.push(
+                integrator
+                    .world()
+                    .placement(hit.primitive)
+                    .map_or(-1.0, |(k, _)| k as f32),
+            ),
+            (Aov::Instance, None) => data.push(-1.0),
+            (Aov::Id, None) => data.push(-1.0),
+            (Aov::Cost, _) => {
+                let counters = integrator.traversal_cost(&ray);
+                data.push((counters.nodes + counters.primitives) as f32);
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -560,6 +650,26 @@ mod tests {
         assert_eq!(clamp.tiles, 4);
         assert!(clamp.used <= clamp.tiles, "{clamp:?}");
         assert_eq!(clamped.image, output.image);
+    }
+
+    #[test]
+    fn a_cancelled_render_stops_and_an_uncancelled_one_is_the_plain_render() {
+        let mut scene = crate::scene::default_scene();
+        scene.settings.width = 64;
+        scene.settings.height = 48;
+        scene.settings.threads = Some(1);
+        let cancel = AtomicBool::new(false);
+        let plain = render(&scene, &|_| {}).unwrap();
+        let kept = render_cancellable(&scene, &cancel, &|_| {}).unwrap();
+        assert_eq!(kept.image, plain.image);
+        let tiles = std::sync::atomic::AtomicU64::new(0);
+        let stopped = render_cancellable(&scene, &cancel, &|_| {
+            if tiles.fetch_add(1, Ordering::Relaxed) == 2 {
+                cancel.store(true, Ordering::Relaxed);
+            }
+        });
+        assert!(matches!(stopped, Err(RenderError::Cancelled)));
+        assert_eq!(tiles.load(Ordering::Relaxed), 3, "tiles rendered of 12");
     }
 
     #[test]

@@ -1,10 +1,11 @@
 //! The camera ray of one sample of one pixel: where the renderer and
 //! `whitted explain` agree on which ray a sample is.
 
-use crate::math::Ray;
 use crate::math::random::hash64;
 use crate::math::sampling::pixel_sample;
+use crate::math::{DVec2, Ray};
 use crate::render::{Camera, RenderSettings};
+use crate::shading::{RayDifferential, TextureFilter};
 
 /// The seed of pixel (`x`, `y`)'s sample pattern: a hash of its position,
 /// so the picture does not depend on the order pixels are rendered in.
@@ -24,10 +25,54 @@ pub(crate) fn sample_ray(
     s: u32,
 ) -> Ray {
     let offset = pixel_sample(s, settings.samples_per_pixel, pattern);
-    camera.ray(
-        settings.width,
-        settings.height,
-        f64::from(x) + offset.x,
-        f64::from(y) + offset.y,
+    position_ray(
+        camera,
+        settings,
+        DVec2::new(f64::from(x) + offset.x, f64::from(y) + offset.y),
     )
+}
+
+/// The camera ray through `position` on the image, in pixels from its
+/// top-left corner.
+#[inline]
+pub(crate) fn position_ray(camera: &Camera, settings: &RenderSettings, position: DVec2) -> Ray {
+    camera.ray(settings.width, settings.height, position.x, position.y)
+}
+
+/// The ray differential of sample `s` of pixel (`x`, `y`) (see
+/// [`sample_ray`]) when the settings filter textures, else `None`: one
+/// pixel's step, scaled by `1/√spp` for several samples per pixel (the
+/// spacing of their grid).
+#[inline]
+pub(crate) fn sample_differential(
+    camera: &Camera,
+    settings: &RenderSettings,
+    (x, y): (u32, u32),
+    pattern: u32,
+    s: u32,
+) -> Option<RayDifferential> {
+    let spp = settings.samples_per_pixel;
+    let offset = pixel_sample(s, spp, pattern);
+    let position = DVec2::new(f64::from(x) + offset.x, f64::from(y) + offset.y);
+    position_differential(camera, settings, position, 1.0 / f64::from(spp).sqrt())
+}
+
+/// The ray differential of the camera ray through `position` on the image
+/// (in pixels) when the settings filter textures, else `None`: one pixel's
+/// step times `scale`. Adaptive anti-aliasing gives its corners a whole
+/// pixel's step: a corner stands for the pixel around it, however finely
+/// the pixel is later subdivided.
+#[inline]
+pub(crate) fn position_differential(
+    camera: &Camera,
+    settings: &RenderSettings,
+    position: DVec2,
+    scale: f64,
+) -> Option<RayDifferential> {
+    if settings.texture_filter == TextureFilter::None {
+        return None;
+    }
+    let differential =
+        camera.ray_differential(settings.width, settings.height, position.x, position.y);
+    Some(differential.scaled(scale))
 }

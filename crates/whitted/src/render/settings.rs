@@ -2,9 +2,10 @@
 //! part (size, samples, depth, structure), the command line may replace any
 //! of it and adds the rest (threads, per-pixel data).
 
-use super::RenderError;
+use super::{AntiAliasing, RenderError};
 use crate::accel::AccelKind;
 use crate::integrator::{IntegratorKind, PhotonSettings};
+use crate::shading::TextureFilter;
 
 /// The deepest recursion a render accepts. Each level takes a few
 /// kilobytes of a worker's stack, which is sized for it.
@@ -97,8 +98,11 @@ pub struct RenderSettings {
     pub width: u32,
     /// Image height in pixels.
     pub height: u32,
-    /// Samples per pixel (1 means exactly the pixel centre).
+    /// Samples per pixel (1 means exactly the pixel centre), when `aa` is
+    /// stratified.
     pub samples_per_pixel: u32,
+    /// How the camera samples each pixel.
+    pub aa: AntiAliasing,
     /// Deepest reflection/refraction recursion; 0 traces primary rays only.
     pub max_depth: u32,
     /// A branch whose weight on the pixel falls below this stops early
@@ -115,6 +119,9 @@ pub struct RenderSettings {
     pub integrator: IntegratorKind,
     /// Photon-mapped caustics: off unless photons are asked for.
     pub photons: PhotonSettings,
+    /// How textures are filtered: off (a point lookup, as always) unless
+    /// asked for.
+    pub texture_filter: TextureFilter,
     /// Worker threads; `None` uses every core. The picture is the same for
     /// any count.
     pub threads: Option<usize>,
@@ -137,6 +144,7 @@ impl RenderSettings {
             return Err(RenderError::DepthTooLarge(self.max_depth));
         }
         self.photons.check()?;
+        self.aa.check()?;
         Ok(())
     }
 }
@@ -147,6 +155,7 @@ impl Default for RenderSettings {
             width: 640,
             height: 480,
             samples_per_pixel: 1,
+            aa: AntiAliasing::Stratified,
             max_depth: 8,
             min_weight: 1e-3,
             accel: AccelKind::default(),
@@ -154,6 +163,7 @@ impl Default for RenderSettings {
             accel_bottom: None,
             integrator: IntegratorKind::default(),
             photons: PhotonSettings::default(),
+            texture_filter: TextureFilter::None,
             threads: None,
             aovs: Vec::new(),
         }

@@ -8,6 +8,7 @@
 pub mod area_light;
 pub mod bump;
 mod color;
+pub mod differential;
 pub mod emission;
 pub mod factor;
 pub mod light;
@@ -21,6 +22,7 @@ pub mod texture;
 pub use area_light::{AreaLight, Emitter};
 pub use bump::{Bump, shading_normal};
 pub use color::Color;
+pub use differential::{Footprint, RayDifferential, TextureFilter};
 pub use emission::EmittedRay;
 pub use light::{Attenuation, Light, LightSample, direct_samples};
 pub use material::Material;

@@ -34,6 +34,7 @@
 //! out of range, unknown names, and shapes, transforms or cameras their
 //! constructors refuse.
 
+mod anti_aliasing;
 mod area_light;
 mod csg;
 mod definition;
@@ -44,6 +45,7 @@ mod patches;
 mod photons;
 mod reader;
 mod shapes;
+mod texture_filter;
 
 use crate::accel::AccelKind;
 use std::path::Path;
@@ -212,6 +214,11 @@ const RENDER_KEYS: &[&str] = &[
     photons::PHOTON_KEYS[0],
     photons::PHOTON_KEYS[1],
     photons::PHOTON_KEYS[2],
+    anti_aliasing::AA_KEYS[0],
+    anti_aliasing::AA_KEYS[1],
+    anti_aliasing::AA_KEYS[2],
+    anti_aliasing::AA_KEYS[3],
+    texture_filter::TEXTURE_FILTER_KEY,
 ];
 
 fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
@@ -245,6 +252,8 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
     let accel_bottom = r.optional(&f, "accel_bottom", read_accel);
     let color_space = r.or_default(&f, "colours", ColorSpace::Linear, read_color_space);
     let photons = photons::read_photons(r, &f);
+    let aa = anti_aliasing::read_anti_aliasing(r, &f);
+    let texture_filter = texture_filter::read_texture_filter(r, &f);
     keys?;
     let (width, height) = size?;
     Ok(Render {
@@ -256,8 +265,10 @@ fn read_render(r: &mut Reader<'_>, value: &Value<'_>) -> Parsed<Render> {
             min_weight: min_weight?,
             accel: accel?,
             photons: photons?,
+            texture_filter: texture_filter?,
             accel_top: accel_top?,
             accel_bottom: accel_bottom?,
+            aa: aa?,
             ..d
         },
         background: background?,
@@ -409,7 +420,7 @@ pub(super) mod tests {
                 "`ambient` must not be negative, got -1",
                 "unknown key `size` in [render]; expected one of: width, height, samples, \
                  max_depth, min_weight, background, ambient, accel, accel_top, accel_bottom, colours, \
-                 photons, gather, radius",
+                 photons, gather, radius, aa, aa_threshold, aa_depth, aa_min_depth, texture_filter",
                 "unknown acceleration structure `octree`; expected one of: bvh, kdtree, grid, linear",
                 "unknown colour convention `srgb` for `colours`; expected one of: linear, display",
             ]

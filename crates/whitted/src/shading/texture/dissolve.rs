@@ -31,7 +31,17 @@ impl DissolveMap {
 
     /// The opacity, or the light let through, at texture coordinates `uv`.
     pub fn at(&self, uv: DVec2) -> Color {
-        let opacity = self.opacity_at(uv);
+        self.value_for_opacity(self.opacity_at(uv))
+    }
+
+    /// The opacity, or the light let through, where the image's colour
+    /// (filtered or not) is `image`.
+    pub(super) fn value_for_image(&self, image: Color) -> Color {
+        self.value_for_opacity((self.dissolve * luminance(image)).clamp(0.0, 1.0))
+    }
+
+    /// The texture's value where the opacity is `opacity`.
+    fn value_for_opacity(&self, opacity: f64) -> Color {
         match self.filter {
             None => Color::splat(opacity),
             Some(filter) => filter * (1.0 - opacity),

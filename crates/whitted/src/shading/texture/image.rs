@@ -7,20 +7,31 @@
 //! `u = (x + 0.5) / width`, `v = 1 - (y + 0.5) / height`.
 
 use std::fmt;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
+
+use super::mipmap::Mipmap;
 
 use crate::shading::Color;
 
 use crate::math::DVec2;
 
 /// Decoded texels in linear RGB, row 0 at the top of the image.
-#[derive(Clone, PartialEq)]
+#[derive(Clone)]
 pub struct ImageData {
     width: usize,
     height: usize,
     texels: Vec<[f32; 3]>,
     max_component: f64,
     mean: Color,
+    /// Its mipmap, built by the first filtered lookup.
+    mipmap: OnceLock<Mipmap>,
+}
+
+impl PartialEq for ImageData {
+    /// The same texels (whether the mipmap is built yet does not count).
+    fn eq(&self, other: &Self) -> bool {
+        (self.width, self.height) == (other.width, other.height) && self.texels == other.texels
+    }
 }
 
 impl fmt::Debug for ImageData {
@@ -50,7 +61,14 @@ impl ImageData {
             texels,
             max_component,
             mean,
+            mipmap: OnceLock::new(),
         })
+    }
+
+    /// Its mipmap pyramid, built once on first use.
+    pub fn mipmap(&self) -> &Mipmap {
+        self.mipmap
+            .get_or_init(|| Mipmap::build(self.width, self.height, &self.texels))
     }
 
     /// The mean of all texels.
@@ -89,7 +107,7 @@ pub enum Wrap {
 
 impl Wrap {
     /// The texel index in `0..n` for any integer index `i`.
-    fn index(self, i: i64, n: usize) -> usize {
+    pub(super) fn index(self, i: i64, n: usize) -> usize {
         let n = n as i64;
         let wrapped = match self {
             Wrap::Repeat => i.rem_euclid(n),

@@ -11,7 +11,9 @@
 mod checker;
 mod decode;
 mod dissolve;
+mod filtered;
 mod image;
+pub mod mipmap;
 
 pub use self::checker::Checker;
 #[cfg(test)]

@@ -1,0 +1,245 @@
+//! `whitted serve`: a live preview in the browser. A small HTTP server on
+//! the standard library's sockets, one thread per connection; the page
+//! (embedded in the binary) gets its frames as server-sent events and
+//! asks for views, ray trees and saves with plain requests. See
+//! docs/serve.md; ARCHITECTURE.md says why this stack.
+
+mod http;
+mod picture;
+mod routes;
+mod session;
+
+use std::io::{BufReader, Write};
+use std::net::{IpAddr, Ipv4Addr, SocketAddr, TcpListener, TcpStream};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Duration;
+
+use clap::Args;
+
+use crate::report::{note, results};
+use crate::scene_arguments::SceneArgs;
+use http::{Refusal, Request, Response, read_request};
+use session::Session;
+
+/// The most connections served at once (each event stream holds one).
+const MAX_CONNECTIONS: usize = 64;
+
+/// How long a connection may wait to read or write.
+const IO_TIMEOUT: Duration = Duration::from_secs(20);
+
+/// How often an idle event stream sends a comment, to find closed pages.
+const KEEP_ALIVE: Duration = Duration::from_secs(10);
+
+/// Show a scene live in the browser: a progressive render that follows
+/// the scene file, a camera moved with the mouse, the AOVs and
+/// structures, each pixel's ray tree, and saves.
+#[derive(Debug, Args)]
+#[command(after_long_help = "Examples:
+  whitted serve scenes/whitted.toml
+  whitted serve ../shared/scenes/spd/balls3.nff --port 8080 --width 320 --height 240")]
+pub struct ServeArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+
+    /// The port to listen on (0: any free port, printed at the start).
+    #[arg(long, value_name = "P", default_value_t = 7878)]
+    port: u16,
+
+    /// The address to listen on: 127.0.0.1 (the default) lets only this
+    /// machine connect; 0.0.0.0 lets any.
+    #[arg(long, value_name = "ADDR", default_value_t = IpAddr::V4(Ipv4Addr::LOCALHOST))]
+    bind: IpAddr,
+}
+
+/// Runs the command: serves until stopped.
+pub fn run(args: ServeArgs) -> Result<(), String> {
+    args.scene.check()?;
+    let listener = TcpListener::bind((args.bind, args.port))
+        .map_err(|e| format!("cannot listen on {}:{}: {e}", args.bind, args.port))?;
+    let address = listener.local_addr().map_err(|e| e.to_string())?;
+    let who = if address.ip().is_loopback() {
+        "only this machine can connect"
+    } else {
+        "other machines can connect"
+    };
+    results(&format!(
+        "whitted serve: http://{address}/ ({who}; Ctrl-C stops)\n"
+    ))?;
+    let session = Session::new(args.scene);
+    let connections = AtomicUsize::new(0);
+    std::thread::scope(|scope| {
+        scope.spawn(|| session.render_loop());
+        if let Some(path) = session.file() {
+            let path = path.to_path_buf();
+            let session = &session;
+            scope.spawn(move || session.watch_file(path));
+        }
+        for stream in listener.incoming() {
+            let Ok(stream) = stream else { continue };
+            let (session, connections) = (&session, &connections);
+            if connections.fetch_add(1, Ordering::SeqCst) >= MAX_CONNECTIONS {
+                let refusal = Refusal::new(503, "too many connections");
+                let _ = Response::refused(&refusal).write(&mut &stream);
+                connections.fetch_sub(1, Ordering::SeqCst);
+                continue;
+            }
+            scope.spawn(move || {
+                serve_connection(session, stream, address);
+                connections.fetch_sub(1, Ordering::SeqCst);
+            });
+        }
+    });
+    Ok(())
+}
+
+/// Reads one request from `stream` and answers it.
+fn serve_connection(session: &Session, stream: TcpStream, address: SocketAddr) {
+    let _ = stream.set_read_timeout(Some(IO_TIMEOUT));
+    let _ = stream.set_write_timeout(Some(IO_TIMEOUT));
+    let mut reader = BufReader::new(&stream);
+    let request = match read_request(&mut reader) {
+        Ok(Some(request)) => request,
+        Ok(None) => return,
+        Err(refusal) => {
+            let _ = Response::refused(&refusal).write(&mut &stream);
+            return;
+        }
+    };
+    let peer = stream.peer_addr().ok();
+    if let Err(refusal) = check_origin(&request, address, peer) {
+        let _ = Response::refused(&refusal).write(&mut &stream);
+        return;
+    }
+    if request.path == "/events" && request.method == "GET" {
+        stream_events(session, &stream);
+        return;
+    }
+    let response = routes::answer(session, &request).unwrap_or_else(|r| Response::refused(&r));
+    if response.status >= 500 {
+        note!("{} {}: {}", request.method, request.path, response.status);
+    }
+    let _ = response.write(&mut &stream);
+}
+
+/// Refuses, on a server bound to the loopback address, requests from
+/// another machine, requests that name another host (a page of another
+/// site reaching this server through a name it controls), and posts from
+/// another site's page.
+fn check_origin(
+    request: &Request,
+    address: SocketAddr,
+    peer: Option<SocketAddr>,
+) -> Result<(), Refusal> {
+    if !address.ip().is_loopback() {
+        return Ok(());
+    }
+    if peer.is_some_and(|p| !p.ip().is_loopback()) {
+        return Err(Refusal::new(
+            403,
+            "requests from other machines are refused",
+        ));
+    }
+    let port = address.port();
+    let hosts = [
+        format!("127.0.0.1:{port}"),
+        format!("localhost:{port}"),
+        format!("[::1]:{port}"),
+    ];
+    let host = request.header("host").unwrap_or("");
+    if !hosts.iter().any(|h| h == host) {
+        return Err(Refusal::new(
+            403,
+            format!("requests for host `{host}` are refused: this server is {address}"),
+        ));
+    }
+    if let Some(origin) = request.header("origin")
+        && request.method != "GET"
+        && origin != format!("http://{host}")
+    {
+        return Err(Refusal::new(
+            403,
+            format!("posts from `{origin}` are refused"),
+        ));
+    }
+    Ok(())
+}
+
+/// Sends the session's newest frame or error, then each newer one (those
+/// still kept), until the page goes away.
+fn stream_events(session: &Session, stream: &TcpStream) {
+    let mut out = stream;
+    if http::start_events(&mut out).is_err() {
+        return;
+    }
+    let mut seen = 0;
+    loop {
+        let (now, events) = session.next_events(seen, KEEP_ALIVE);
+        let sent = if events.is_empty() {
+            out.write_all(b": still here\n\n")
+                .and_then(|()| out.flush())
+        } else {
+            events
+                .iter()
+                .try_for_each(|e| http::send_event(&mut out, e.name, &e.data))
+        };
+        if sent.is_err() {
+            return;
+        }
+        seen = now;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn with_headers(method: &str, headers: &[(&str, &str)]) -> Request {
+        Request {
+            method: method.to_string(),
+            path: "/".to_string(),
+            query: Vec::new(),
+            headers: headers
+                .iter()
+                .map(|(n, v)| (n.to_string(), v.to_string()))
+                .collect(),
+            body: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn other_hosts_and_sites_are_refused() {
+        let address: SocketAddr = "127.0.0.1:7878".parse().unwrap();
+        let local: SocketAddr = "127.0.0.1:50000".parse().unwrap();
+        let check = |r: &Request, peer| check_origin(r, address, Some(peer)).map_err(|e| e.status);
+        let ok = with_headers("GET", &[("host", "127.0.0.1:7878")]);
+        assert_eq!(check(&ok, local), Ok(()));
+        let named = with_headers("GET", &[("host", "localhost:7878")]);
+        assert_eq!(check(&named, local), Ok(()));
+        let far: SocketAddr = "10.0.0.2:50000".parse().unwrap();
+        assert_eq!(check(&ok, far), Err(403));
+        let rebound = with_headers("GET", &[("host", "evil.example:7878")]);
+        assert_eq!(check(&rebound, local), Err(403));
+        assert_eq!(check(&with_headers("GET", &[]), local), Err(403));
+        let posted = with_headers(
+            "POST",
+            &[
+                ("host", "127.0.0.1:7878"),
+                ("origin", "http://evil.example"),
+            ],
+        );
+        assert_eq!(check(&posted, local), Err(403));
+        let own = with_headers(
+            "POST",
+            &[
+                ("host", "127.0.0.1:7878"),
+                ("origin", "http://127.0.0.1:7878"),
+            ],
+        );
+        assert_eq!(check(&own, local), Ok(()));
+        let open: SocketAddr = "0.0.0.0:7878".parse().unwrap();
+        assert_eq!(
+            check_origin(&rebound, open, Some(far)).map_err(|e| e.status),
+            Ok(())
+        );
+    }
+}

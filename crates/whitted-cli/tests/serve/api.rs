@@ -1,0 +1,185 @@
+//! `whitted serve` over HTTP: the page, the progressive frames, the ray
+//! tree of a pixel against the picture and `explain --json`, edits of the
+//! scene file (a bad one shown, the server alive), the camera and its
+//! flags, the views, and bad requests.
+
+use crate::support::{Server, read_pfm, scene_text, whitted};
+
+const SIZE: [&str; 4] = ["--width", "64", "--height", "48"];
+
+#[test]
+fn the_page_is_served_and_frames_come_coarse_first_then_full() {
+    let server = Server::start(&scene_text(), &SIZE);
+    let (status, page) = server.get("/");
+    assert_eq!(status, 200);
+    let page = String::from_utf8(page).unwrap();
+    assert!(page.contains("<script src=\"/page.js\">"), "{page}");
+    assert_eq!(server.get("/page.js").0, 200);
+    assert_eq!(server.get("/page.css").0, 200);
+    let mut events = server.events();
+    let first = events.full_frame();
+    assert_eq!(
+        (&first["width"], &first["height"]),
+        (&64.into(), &48.into())
+    );
+    assert!(
+        first["png"]
+            .as_str()
+            .unwrap()
+            .starts_with("data:image/png;base64,iVBOR")
+    );
+    assert!(first["rays_per_second"].as_f64().unwrap() > 0.0);
+    assert!(first["build_seconds"].as_f64().unwrap() >= 0.0);
+    // A new request: every pass of it is seen, the coarse one first.
+    let (status, _) = server.view("accel=kdtree");
+    assert_eq!(status, 200);
+    let passes: Vec<_> = events
+        .until(|_, data| data["pass"] == "full" && data["accel"] == "kdtree")
+        .into_iter()
+        .filter(|(_, data)| data["accel"] == "kdtree")
+        .map(|(_, data)| (data["pass"].clone(), data["width"].clone()))
+        .collect();
+    assert_eq!(
+        passes,
+        [
+            ("coarse".into(), 8.into()),
+            ("refining".into(), 32.into()),
+            ("full".into(), 64.into())
+        ]
+    );
+}
+
+#[test]
+fn a_pixels_ray_tree_is_explain_json_and_its_root_is_the_rendered_pixel() {
+    let server = Server::start(&scene_text(), &SIZE);
+    server.events().full_frame();
+    let (status, pfm) = server.get("/api/save.pfm");
+    assert_eq!(status, 200);
+    let (width, pixels) = read_pfm(&pfm);
+    assert_eq!((width, pixels.len()), (64, 64 * 48));
+    for (x, y) in [(0, 0), (20, 30), (40, 12), (63, 47)] {
+        let tree = server.get_json(&format!("/api/explain?x={x}&y={y}"));
+        let value: Vec<f32> = tree["pixel"]["value"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap() as f32)
+            .collect();
+        assert_eq!(value, pixels[y * 64 + x], "pixel {x},{y}");
+        let root: Vec<f32> = tree["tree"]["color"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap() as f32)
+            .collect();
+        assert_eq!(root, value, "one sample per pixel: the root is the pixel");
+        let pixel = format!("{x},{y}");
+        let mut args = vec!["explain", "scene.toml", "--pixel", &pixel, "--json"];
+        args.extend(SIZE);
+        let printed: serde_json::Value =
+            serde_json::from_slice(&whitted(&args, server.dir.path())).unwrap();
+        assert_eq!(tree, printed, "the page's tree is explain --json's");
+    }
+    let (status, svg) = server.get("/api/explain.svg?x=20&y=30");
+    assert_eq!(status, 200);
+    assert!(String::from_utf8(svg).unwrap().starts_with("<svg"));
+    assert_eq!(server.get("/api/explain?x=64&y=0").0, 400);
+    assert_eq!(server.get("/api/explain?x=a&y=0").0, 400);
+}
+
+#[test]
+fn a_bad_edit_is_shown_located_and_a_good_one_renders_again() {
+    let mut server = Server::start(&scene_text(), &SIZE);
+    let mut events = server.events();
+    events.full_frame();
+    let (_, before) = server.get("/api/save.pfm");
+    let text = scene_text();
+    std::fs::write(server.scene(), text.replace("fov = 45", "fov = \"wide\"")).unwrap();
+    let error = events.until(|name, _| name == "error").pop().unwrap().1;
+    let message = error["message"].as_str().unwrap();
+    assert!(message.contains("scene.toml:"), "{message}");
+    assert!(message.contains(":17:"), "the line of the error: {message}");
+    assert!(server.alive());
+    assert_eq!(server.get("/").0, 200);
+    assert_eq!(server.get("/api/explain?x=1&y=1").0, 409);
+    std::fs::write(
+        server.scene(),
+        text.replace("[0.25, 0.45, 0.85]", "[0.85, 0.45, 0.25]"),
+    )
+    .unwrap();
+    events.full_frame();
+    let (_, after) = server.get("/api/save.pfm");
+    let (before, after) = (read_pfm(&before).1, read_pfm(&after).1);
+    assert_ne!(before[0], after[0], "the sky's colour changed");
+}
+
+#[test]
+fn a_moved_camera_gives_flags_that_render_the_same_picture() {
+    let server = Server::start(&scene_text(), &SIZE);
+    let mut events = server.events();
+    events.full_frame();
+    let (status, state) = server.view("eye=1.5,2,-4.5&fov=50");
+    assert_eq!(status, 200, "{state}");
+    let state: serde_json::Value = serde_json::from_str(&state).unwrap();
+    let flags = state["flags"].as_str().unwrap().to_string();
+    assert_eq!(
+        flags,
+        "--eye 1.5,2,-4.5 --look-at 0.2,0.9,0.5 --up 0,1,0 --fov 50"
+    );
+    events.until(|name, data| {
+        name == "frame" && data["pass"] == "full" && data["state"]["flags"] == flags.as_str()
+    });
+    let (_, served) = server.get("/api/save.pfm");
+    let mut args = vec!["render", "scene.toml", "-o", "flags.pfm", "--quiet"];
+    args.extend(SIZE);
+    args.extend(flags.split(' '));
+    whitted(&args, server.dir.path());
+    let rendered = std::fs::read(server.dir.path().join("flags.pfm")).unwrap();
+    assert!(served == rendered, "the flags render the picture shown");
+    // Back to the scene's camera.
+    let (_, state) = server.view("camera=scene");
+    assert!(state.contains("--eye 0,1.8,-5.5 "), "{state}");
+    assert_eq!(server.view("eye=0.2,0.9,0.5").0, 400, "eye at look_at");
+}
+
+#[test]
+fn views_switch_between_aovs_and_saves_use_the_writers() {
+    let server = Server::start(&scene_text(), &SIZE);
+    let mut events = server.events();
+    events.full_frame();
+    for aov in ["depth", "normal", "id", "cost"] {
+        assert_eq!(server.view(&format!("aov={aov}")).0, 200);
+        events.until(|_, data| data["pass"] == "full" && data["aov"] == aov);
+        let (status, png) = server.get("/api/save.png");
+        assert_eq!(status, 200);
+        assert!(png.starts_with(b"\x89PNG"), "{aov}");
+    }
+    let (status, exr) = server.get("/api/save.exr");
+    assert_eq!(status, 200);
+    assert!(
+        exr.starts_with(&[0x76, 0x2f, 0x31, 0x01]),
+        "an OpenEXR file"
+    );
+    assert_eq!(server.view("aov=color").0, 200);
+}
+
+#[test]
+fn bad_and_foreign_requests_are_refused_and_the_server_stays_up() {
+    let mut server = Server::start(&scene_text(), &SIZE);
+    let port = server.port;
+    assert_eq!(server.raw("GARBAGE", b"").0, 400);
+    assert_eq!(
+        server.raw("GET / HTTP/1.1\r\nHost: evil.example", b"").0,
+        403
+    );
+    assert_eq!(server.get("/../scene.toml").0, 404);
+    assert_eq!(server.get("/scene.toml").0, 404);
+    assert_eq!(server.get("/%2e%2e/etc/passwd").0, 404);
+    let foreign =
+        format!("POST /api/view HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nOrigin: http://evil.example");
+    assert_eq!(server.raw(&foreign, b"aov=depth").0, 403);
+    assert_eq!(server.view("aov=nothing").0, 400);
+    assert_eq!(server.view("fov=0").0, 400);
+    assert!(server.alive());
+    assert_eq!(server.get("/").0, 200);
+}
