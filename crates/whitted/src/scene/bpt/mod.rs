@@ -85,16 +85,18 @@ pub fn parse_bpt(source: &str, path: &Path) -> Result<LoadedScene, SceneError> {
     scene.ambient = Color::splat(AMBIENT);
     scene.lights = vec![headlight(&scene.camera)];
     let material = scene.add_material(Material::default());
-    for (index, patch) in patches.into_iter().enumerate() {
-        scene.add_primitive(
-            Shape::BezierPatch(patch),
-            material,
-            crate::math::Transform::IDENTITY,
-        );
-        scene.sources.primitives.push(crate::render::ObjectSource {
-            label: format!("patch {}", index + 1),
-            location: None,
-        });
+    for (index, patch) in patches.iter().enumerate() {
+        for piece in patch.pieces() {
+            scene.add_primitive(
+                Shape::BezierPatch(piece),
+                material,
+                crate::math::Transform::IDENTITY,
+            );
+            scene.sources.primitives.push(crate::render::ObjectSource {
+                label: format!("patch {}", index + 1),
+                location: None,
+            });
+        }
     }
     Ok(LoadedScene {
         scene,

@@ -1,6 +1,7 @@
-//! `shape = "patches"`: every Bézier patch of a `.bpt` file, each its own
-//! primitive with the object's material and transform, so the patches
-//! share the scene's acceleration structure like a mesh's triangles.
+//! `shape = "patches"`: every Bézier patch of a `.bpt` file, each piece of
+//! each patch ([`BezierPatch::pieces`]) its own primitive with the object's
+//! material and transform, so the patches share the scene's acceleration
+//! structure like a mesh's triangles.
 //!
 //! ```toml
 //! [[objects]]
@@ -15,7 +16,7 @@
 
 use super::reader::{Fields, Parsed, Reader};
 use crate::scene::{SceneError, load_bpt_patches};
-use crate::shape::Shape;
+use crate::shape::{BezierPatch, Shape};
 
 /// The value of `shape` that reads a file of patches.
 pub(super) const KIND: &str = "patches";
@@ -37,5 +38,9 @@ pub(super) fn read(r: &mut Reader<'_>, f: &Fields<'_, '_>) -> Parsed<Vec<Shape>>
         };
         r.error(span, message)
     })?;
-    Ok(patches.into_iter().map(Shape::BezierPatch).collect())
+    Ok(patches
+        .iter()
+        .flat_map(BezierPatch::pieces)
+        .map(Shape::BezierPatch)
+        .collect())
 }

@@ -18,7 +18,8 @@ pub(crate) struct Evaluated {
 }
 
 /// The cubic Bernstein polynomials at `t` and their derivatives.
-fn basis(t: f64) -> ([f64; 4], [f64; 4]) {
+#[inline]
+pub(super) fn basis(t: f64) -> ([f64; 4], [f64; 4]) {
     let s = 1.0 - t;
     (
         [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t],

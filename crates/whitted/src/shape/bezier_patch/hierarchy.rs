@@ -31,6 +31,9 @@ pub(super) struct Node {
     pub(super) high: [f64; 2],
     /// The index of the first of the four children, or 0 for a leaf.
     pub(super) children: u32,
+    /// For a leaf, the index of its piece's control net in
+    /// [`Hierarchy::nets`].
+    pub(super) net: u32,
 }
 
 impl Node {
@@ -45,14 +48,52 @@ impl Node {
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct Hierarchy {
     pub(super) nodes: Vec<Node>,
+    /// The control net of each leaf's piece, over the leaf's own (s, t) in
+    /// [0, 1]²: u = low[0] + s (high[0] - low[0]), and v likewise.
+    pub(super) nets: Vec<ControlNet>,
 }
 
 impl Hierarchy {
     /// The hierarchy of `net`, whose boxes are widened by `margin`.
     pub(super) fn build(net: &ControlNet, margin: f64) -> Self {
-        let mut nodes = vec![node(net, [0.0, 0.0], [1.0, 1.0], margin)];
-        split(&mut nodes, 0, net, 0, margin);
-        Self { nodes }
+        let mut tree = Self {
+            nodes: vec![node(net, [0.0, 0.0], [1.0, 1.0], margin)],
+            nets: Vec::new(),
+        };
+        tree.split(0, net, 0, margin);
+        tree
+    }
+
+    /// Splits node `index` (whose piece is `net`) and its children, as
+    /// deep as the rules in the module's documentation ask; keeps the nets
+    /// of the leaves.
+    fn split(&mut self, index: usize, net: &ControlNet, depth: u32, margin: f64) {
+        if depth >= MAX_DEPTH || (depth >= MIN_DEPTH && is_flat(net)) {
+            self.nodes[index].net = self.nets.len() as u32;
+            self.nets.push(*net);
+            return;
+        }
+        let (low, high) = (self.nodes[index].low, self.nodes[index].high);
+        let mid = [0.5 * (low[0] + high[0]), 0.5 * (low[1] + high[1])];
+        let first = self.nodes.len();
+        self.nodes[index].children = first as u32;
+        let parts = quarters(net);
+        for (k, part) in parts.iter().enumerate() {
+            let (u0, u1) = if k / 2 == 0 {
+                (low[0], mid[0])
+            } else {
+                (mid[0], high[0])
+            };
+            let (v0, v1) = if k % 2 == 0 {
+                (low[1], mid[1])
+            } else {
+                (mid[1], high[1])
+            };
+            self.nodes.push(node(part, [u0, v0], [u1, v1], margin));
+        }
+        for (k, part) in parts.iter().enumerate() {
+            self.split(first + k, part, depth + 1, margin);
+        }
     }
 
     /// The number of leaves.
@@ -68,35 +109,7 @@ fn node(net: &ControlNet, low: [f64; 2], high: [f64; 2], margin: f64) -> Node {
         low,
         high,
         children: 0,
-    }
-}
-
-/// Splits node `index` (whose piece is `net`) and its children, as deep as
-/// the rules in the module's documentation ask.
-fn split(nodes: &mut Vec<Node>, index: usize, net: &ControlNet, depth: u32, margin: f64) {
-    if depth >= MAX_DEPTH || (depth >= MIN_DEPTH && is_flat(net)) {
-        return;
-    }
-    let (low, high) = (nodes[index].low, nodes[index].high);
-    let mid = [0.5 * (low[0] + high[0]), 0.5 * (low[1] + high[1])];
-    let first = nodes.len();
-    nodes[index].children = first as u32;
-    let parts = quarters(net);
-    for (k, part) in parts.iter().enumerate() {
-        let (u0, u1) = if k / 2 == 0 {
-            (low[0], mid[0])
-        } else {
-            (mid[0], high[0])
-        };
-        let (v0, v1) = if k % 2 == 0 {
-            (low[1], mid[1])
-        } else {
-            (mid[1], high[1])
-        };
-        nodes.push(node(part, [u0, v0], [u1, v1], margin));
-    }
-    for (k, part) in parts.iter().enumerate() {
-        split(nodes, first + k, part, depth + 1, margin);
+        net: 0,
     }
 }
 

@@ -419,3 +419,41 @@ fn degenerate_patches_are_refused() {
         Err(ShapeError::OutOfRange { .. })
     ));
 }
+
+#[test]
+fn the_pieces_of_a_patch_are_the_patch() {
+    for patch in [wavy(), collapsed(), saddle()] {
+        let pieces: Vec<BezierPatch> = patch.pieces().collect();
+        assert!(pieces.len() >= 16);
+        let whole = patch.bounds().expanded(1e-6);
+        for piece in &pieces {
+            let b = piece.bounds();
+            assert!(b.min.cmpge(whole.min).all() && b.max.cmple(whole.max).all());
+            assert_eq!(piece.pieces().count(), 1);
+        }
+        let centre = patch.bounds().centroid();
+        let mut rng = Rng::new(23);
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let origin = centre + 4.0 * rng.unit_vector();
+            let target = rng.point_in(patch.bounds().min, patch.bounds().max);
+            let ray = Ray::new(origin, target - origin);
+            let nearest = pieces
+                .iter()
+                .filter_map(|piece| piece.intersect(&ray))
+                .min_by(|a, b| a.t.total_cmp(&b.t));
+            match (patch.intersect(&ray), nearest) {
+                (Some(a), Some(b)) => {
+                    hits += 1;
+                    assert!((a.t - b.t).abs() < 1e-9 * a.t, "{a:?} {b:?}");
+                    assert!((a.u - b.u).abs() < 1e-6 && (a.v - b.v).abs() < 1e-6);
+                    let (sa, sb) = (patch.surface(&ray, &a), pieces[0].surface(&ray, &b));
+                    assert!((sa.normal - sb.normal).length() < 1e-6);
+                }
+                (None, None) => {}
+                (a, b) => panic!("{a:?} vs {b:?} for {ray:?}"),
+            }
+        }
+        assert!(hits > 200, "{hits}");
+    }
+}
