@@ -12,6 +12,7 @@ mod observer;
 pub mod photon_map;
 mod ray_counts;
 mod ray_tree;
+mod shadow_cache;
 mod whitted;
 
 pub use observer::{RayObserver, ShadowStep, Unobserved};

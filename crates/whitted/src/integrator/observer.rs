@@ -45,6 +45,11 @@ pub enum ShadowStep<'s> {
 /// does nothing unless implemented; see the module documentation for the
 /// order of the calls.
 pub trait RayObserver {
+    /// Whether it reads the (u, v) and tangents of the surfaces it is
+    /// shown: when not, the integrator leaves them out for materials that
+    /// do not read them either.
+    const READS_UV: bool = true;
+
     /// A ray of `kind` starts; the parent multiplies its colour by
     /// `coefficient` (one for the camera ray), and `weight` is the largest
     /// factor by which it reaches the pixel.
@@ -110,4 +115,6 @@ pub trait RayObserver {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Unobserved;
 
-impl RayObserver for Unobserved {}
+impl RayObserver for Unobserved {
+    const READS_UV: bool = false;
+}

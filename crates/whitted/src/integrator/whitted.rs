@@ -27,6 +27,7 @@
 
 use crate::integrator::observer::{RayObserver, ShadowStep, Unobserved};
 use crate::integrator::photon_map::{self, CausticMap};
+use crate::integrator::shadow_cache;
 use crate::integrator::{PrimarySample, RayCounts, RayKind, RecursionLimits, Shading};
 use crate::math::{Ray, Vec3, offset_ray_origin};
 use crate::shading::differential::Bend;
@@ -35,7 +36,7 @@ use crate::shading::{
     Color, Crossing, Light, Lobes, Material, MediumStack, RayDifferential, Weights, direct_samples,
     phong, shading_normal,
 };
-use crate::world::{MaterialId, Surface, World};
+use crate::world::{Hit, MaterialId, Surface, World};
 
 /// Longest chain of transmissive surfaces one shadow ray passes through.
 const MAX_SHADOW_CROSSINGS: usize = 64;
@@ -76,6 +77,8 @@ pub struct Whitted<'a> {
     limits: RecursionLimits,
     any_transmissive: bool,
     caustics: Option<&'a CausticMap>,
+    /// Per material, whether shading reads (u, v) ([`Material::reads_uv`]).
+    reads_uv: Vec<bool>,
 }
 
 impl<'a> Whitted<'a> {
@@ -91,6 +94,7 @@ impl<'a> Whitted<'a> {
             limits,
             any_transmissive: shading.materials.iter().any(Material::is_transmissive),
             caustics: None,
+            reads_uv: shading.materials.iter().map(Material::reads_uv).collect(),
         }
     }
 
@@ -133,7 +137,7 @@ impl<'a> Whitted<'a> {
                 }
             }
             Some(hit) => {
-                let surface = self.world.surface(ray, &hit);
+                let surface = self.surface::<O>(ray, &hit);
                 observer.ray_hit(ray, Some((&hit, &surface)));
                 let mut tally = SampleTally {
                     counts,
@@ -142,7 +146,7 @@ impl<'a> Whitted<'a> {
                     cut_at: None,
                 };
                 let differential = differential.as_ref();
-                let media = MediumStack::default();
+                let media = &MediumStack::default();
                 let color = self.shade(ray, differential, &surface, 0, 1.0, media, &mut tally);
                 tally.observer.ray_end(color);
                 PrimarySample {
@@ -154,6 +158,13 @@ impl<'a> Whitted<'a> {
         }
     }
 
+    /// The surface at `hit`, with (u, v) and tangents only where the
+    /// material or the observer reads them.
+    fn surface<O: RayObserver>(&self, ray: &Ray, hit: &Hit) -> Surface {
+        let reads_uv: &[bool] = if O::READS_UV { &[] } else { &self.reads_uv };
+        self.world.surface_for(ray, hit, reads_uv)
+    }
+
     /// The colour seen along a secondary ray (unit direction).
     fn trace<O: RayObserver>(
         &self,
@@ -161,7 +172,7 @@ impl<'a> Whitted<'a> {
         differential: Option<&RayDifferential>,
         depth: u32,
         weight: f64,
-        media: MediumStack,
+        media: &MediumStack,
         tally: &mut SampleTally<'_, O>,
     ) -> Color {
         match self.world.intersect(ray) {
@@ -170,7 +181,7 @@ impl<'a> Whitted<'a> {
                 self.shading.background
             }
             Some(hit) => {
-                let surface = self.world.surface(ray, &hit);
+                let surface = self.surface::<O>(ray, &hit);
                 tally.observer.ray_hit(ray, Some((&hit, &surface)));
                 self.shade(ray, differential, &surface, depth, weight, media, tally)
             }
@@ -187,7 +198,7 @@ impl<'a> Whitted<'a> {
         s: &Surface,
         depth: u32,
         weight: f64,
-        media: MediumStack,
+        media: &MediumStack,
         tally: &mut SampleTally<'_, O>,
     ) -> Color {
         let m = &self.shading.materials[s.material.0 as usize];
@@ -219,7 +230,8 @@ impl<'a> Whitted<'a> {
                     tally.observer.light(index, Some(&sample), None);
                     continue;
                 }
-                let shadow = self.transmittance(s, light, sample.to_light, sample.distance, tally);
+                let shadow =
+                    self.transmittance(s, (index, light), sample.to_light, sample.distance, tally);
                 tally.observer.light(index, Some(&sample), Some(shadow));
                 if shadow == Color::ZERO {
                     continue;
@@ -321,7 +333,7 @@ impl<'a> Whitted<'a> {
                     .ray_start(kind, &refracted, transmitted_weight, child);
                 let differential = bend.map(|b| b.refracted(dir, n_from / n_to));
                 let differential = differential.as_ref();
-                let media = inside_after;
+                let media = &inside_after;
                 let c = self.trace(&refracted, differential, depth + 1, child, media, tally);
                 tally.observer.ray_end(c);
                 color += transmitted_weight * c;
@@ -335,14 +347,14 @@ impl<'a> Whitted<'a> {
         color
     }
 
-    /// How much of `light` reaches `s` along `to_light` (unit) over
+    /// How much of `light` (number `index`) reaches `s` along `to_light` (unit) over
     /// `distance`: 0 behind an opaque surface, the product of what every
     /// transmissive or dissolved surface crossed lets through otherwise
     /// ([`Material::pass_through`]).
     fn transmittance<O: RayObserver>(
         &self,
         s: &Surface,
-        light: &Light,
+        (index, light): (usize, &Light),
         to_light: Vec3,
         distance: f64,
         tally: &mut SampleTally<'_, O>,
@@ -360,7 +372,7 @@ impl<'a> Whitted<'a> {
         };
         let mut ray = segment(origin);
         if !self.any_transmissive {
-            let blocked = self.world.occluded(&ray);
+            let blocked = shadow_cache::occluded(self.world, &ray, index);
             tally
                 .observer
                 .shadow_ray(&ray, ShadowStep::AnyHit { blocked });
@@ -373,7 +385,7 @@ impl<'a> Whitted<'a> {
                 tally.observer.shadow_ray(&ray, step);
                 return through;
             };
-            let blocker = self.world.surface(&ray, &hit);
+            let blocker = self.surface::<O>(&ray, &hit);
             let step = ShadowStep::Closest {
                 blocker: Some((&hit, &blocker)),
             };

@@ -199,30 +199,65 @@ impl Light {
 /// square), each carrying its share of the estimate. The pattern is chosen
 /// by a hash of `p`'s coordinates, a function of the pixel sample alone,
 /// so the picture is the same for any number of threads.
-pub fn direct_samples(
-    lights: &[Light],
+pub fn direct_samples(lights: &[Light], p: Vec3) -> DirectSamples<'_> {
+    DirectSamples {
+        lights,
+        p,
+        light: 0,
+        index: 0,
+        count: 0,
+        pattern: 0,
+    }
+}
+
+/// The iterator [`direct_samples`] returns: a loop over the lights and
+/// each light's samples written out, which costs less per shaded point
+/// than the nested iterator adapters it replaced (docs/performance.md).
+#[derive(Clone, Debug)]
+pub struct DirectSamples<'l> {
+    lights: &'l [Light],
     p: Vec3,
-) -> impl Iterator<Item = (usize, &Light, LightSample)> {
-    lights
-        .iter()
-        .enumerate()
-        .flat_map(move |(light_index, light)| {
-            let count = light.sample_count();
-            let pattern = match light {
-                Light::Area(_) => point_hash(p),
-                _ => 0,
-            };
-            (0..count).filter_map(move |index| {
-                let sample = match light {
-                    Light::Area(area) => {
-                        let u = pixel_sample(index, count, pattern);
-                        area.sample(p, [u.x, u.y], count)
+    /// The light whose samples come next.
+    light: usize,
+    /// The next sample of that light, of `count` (0 before its first).
+    index: u32,
+    count: u32,
+    /// The area light's sample pattern.
+    pattern: u32,
+}
+
+impl<'l> Iterator for DirectSamples<'l> {
+    type Item = (usize, &'l Light, LightSample);
+
+    fn next(&mut self) -> Option<Self::Item> {
+        while let Some(light) = self.lights.get(self.light) {
+            let light_index = self.light;
+            let sample = match light {
+                Light::Area(area) => {
+                    if self.index == 0 {
+                        self.count = light.sample_count();
+                        self.pattern = point_hash(self.p);
                     }
-                    _ => light.sample(p),
-                };
-                sample.map(|sample| (light_index, light, sample))
-            })
-        })
+                    let index = self.index;
+                    self.index += 1;
+                    if self.index >= self.count {
+                        self.light += 1;
+                        self.index = 0;
+                    }
+                    let u = pixel_sample(index, self.count, self.pattern);
+                    area.sample(self.p, [u.x, u.y], self.count)
+                }
+                _ => {
+                    self.light += 1;
+                    light.sample(self.p)
+                }
+            };
+            if let Some(sample) = sample {
+                return Some((light_index, light, sample));
+            }
+        }
+        None
+    }
 }
 
 /// A 32-bit hash of a point's coordinates, to pick a sample pattern.
@@ -240,6 +275,54 @@ fn direction_to(position: Vec3, p: Vec3) -> Option<(Vec3, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::shading::{AreaLight, Emitter};
+
+    #[test]
+    fn direct_samples_are_each_light_s_samples_in_order() {
+        let point = |y: f64| Light::Point {
+            position: Vec3::new(0.3, y, 0.0),
+            intensity: Color::ONE,
+            attenuation: Attenuation::default(),
+        };
+        let area = |samples: u32| {
+            Light::Area(AreaLight {
+                emitter: Emitter::Disk {
+                    center: Vec3::new(0.0, 2.0, 0.0),
+                    normal: -Vec3::Y,
+                    radius: 1.0,
+                },
+                radiance: Color::splat(2.0),
+                samples,
+            })
+        };
+        // The second point light sits on the point: it has no sample.
+        let lights = [
+            point(2.0),
+            area(4),
+            point(0.0),
+            area(1),
+            area(9),
+            point(-3.0),
+        ];
+        let p = Vec3::new(0.3, 0.0, 0.0);
+        let mut expected = Vec::new();
+        for (i, light) in lights.iter().enumerate() {
+            let count = light.sample_count();
+            for k in 0..count {
+                let sample = match light {
+                    Light::Area(a) => {
+                        let u = pixel_sample(k, count, point_hash(p));
+                        a.sample(p, [u.x, u.y], count)
+                    }
+                    _ => light.sample(p),
+                };
+                expected.extend(sample.map(|s| (i, light, s)));
+            }
+        }
+        let got: Vec<_> = direct_samples(&lights, p).collect();
+        assert_eq!(expected.len(), 1 + 4 + 1 + 9 + 1);
+        assert_eq!(got, expected);
+    }
 
     #[test]
     fn point_light_attenuates_with_distance() {

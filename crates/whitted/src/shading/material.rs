@@ -83,6 +83,23 @@ impl Material {
         !self.transmission.is_black() || !self.opacity.is_white()
     }
 
+    /// True when shading this material reads the surface's (u, v) or
+    /// tangents: a texture that is not one colour, or a bump or normal map.
+    pub fn reads_uv(&self) -> bool {
+        self.bump.is_some()
+            || [
+                &self.ambient,
+                &self.diffuse,
+                &self.specular,
+                &self.reflection,
+                &self.transmission,
+                &self.emission,
+                &self.opacity,
+            ]
+            .into_iter()
+            .any(|t| !matches!(t, Texture::Constant(_)))
+    }
+
     /// How much light passes through the surface at `uv` (a shadow ray's
     /// factor): `α kt + 1 - α`.
     pub fn pass_through(&self, uv: DVec2) -> Color {
@@ -112,6 +129,7 @@ mod tests {
         let opaque = Material::default();
         assert_eq!(opaque.pass_through(uv), Color::ZERO);
         assert!(!opaque.is_transmissive());
+        assert!(!opaque.reads_uv());
         let clear = Material {
             opacity: Color::ZERO.into(),
             ..opaque

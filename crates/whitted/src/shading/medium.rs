@@ -75,7 +75,7 @@ pub struct Crossing {
 impl MediumStack {
     /// Crossing the surface of an object of `material` (index `ior`),
     /// `entering` it or leaving it.
-    pub fn cross(self, material: MaterialId, ior: f64, entering: bool) -> Crossing {
+    pub fn cross(&self, material: MaterialId, ior: f64, entering: bool) -> Crossing {
         if entering {
             return Crossing {
                 n_from: self.ior(),

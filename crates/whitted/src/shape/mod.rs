@@ -306,6 +306,19 @@ impl Shape {
         dispatch!(self, s => s.surface(ray, hit))
     }
 
+    /// The surface at a hit for a material that reads no (u, v): the same
+    /// point, error bound and normal as [`Shape::surface`], with (u, v) and
+    /// the tangents left zero where skipping them saves work (spheres and
+    /// quadrics, whose (u, v) take an `atan2` and an `acos`), computed
+    /// otherwise.
+    pub fn surface_geometry(&self, ray: &Ray, hit: &ShapeHit) -> LocalSurface {
+        match self {
+            Shape::Sphere(s) => s.surface_geometry(ray, hit),
+            Shape::Quadric(s) => s.surface_geometry(ray, hit),
+            _ => self.surface(ray, hit),
+        }
+    }
+
     /// The object-space bounds ([`Aabb::INFINITE`] for the plane).
     pub fn bounds(&self) -> Aabb {
         dispatch!(self, s => s.bounds())

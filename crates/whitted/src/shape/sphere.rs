@@ -115,16 +115,7 @@ impl Sphere {
 
     /// The surface at a hit.
     pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> LocalSurface {
-        let mut local = ray.at(hit.t) - self.center;
-        let length = local.length();
-        if length > 0.0 {
-            local *= self.radius / length;
-        } else {
-            local = Vec3::new(0.0, 0.0, self.radius);
-        }
-        let point = self.center + local;
-        let point_error = gamma(8) * (self.center.abs() + local.abs());
-        let normal = local / self.radius;
+        let (mut surface, local) = self.placed(ray, hit);
         let mut phi = local.y.atan2(local.x);
         if phi < 0.0 {
             phi += TAU;
@@ -138,14 +129,38 @@ impl Sphere {
         } else {
             (0.0, 1.0)
         };
-        LocalSurface {
-            point,
-            point_error,
-            normal,
-            uv: DVec2::new(phi / TAU, 1.0 - theta / PI),
-            dpdu: Vec3::new(-TAU * local.y, TAU * local.x, 0.0),
-            dpdv: PI * Vec3::new(-local.z * cos_phi, -local.z * sin_phi, rho),
+        surface.uv = DVec2::new(phi / TAU, 1.0 - theta / PI);
+        surface.dpdu = Vec3::new(-TAU * local.y, TAU * local.x, 0.0);
+        surface.dpdv = PI * Vec3::new(-local.z * cos_phi, -local.z * sin_phi, rho);
+        surface
+    }
+
+    /// The surface at a hit without its parametric part: (u, v) and the
+    /// tangents are left zero (see [`crate::shape::Shape::surface_geometry`]).
+    pub fn surface_geometry(&self, ray: &Ray, hit: &ShapeHit) -> LocalSurface {
+        self.placed(ray, hit).0
+    }
+
+    /// The point, its error bound and the normal at a hit, with (u, v) and
+    /// the tangents zero; and the point relative to the centre.
+    #[inline]
+    fn placed(&self, ray: &Ray, hit: &ShapeHit) -> (LocalSurface, Vec3) {
+        let mut local = ray.at(hit.t) - self.center;
+        let length = local.length();
+        if length > 0.0 {
+            local *= self.radius / length;
+        } else {
+            local = Vec3::new(0.0, 0.0, self.radius);
         }
+        let surface = LocalSurface {
+            point: self.center + local,
+            point_error: gamma(8) * (self.center.abs() + local.abs()),
+            normal: local / self.radius,
+            uv: DVec2::ZERO,
+            dpdu: Vec3::ZERO,
+            dpdv: Vec3::ZERO,
+        };
+        (surface, local)
     }
 
     /// The bounding box.

@@ -141,6 +141,13 @@ pub(crate) fn assert_surface_is_sane(shape: &Shape, seed: u64) {
         let Some(hit) = hit else { continue };
         assert!(ray.contains(hit.t));
         let s = shape.surface(&ray, &hit);
+        let lean = shape.surface_geometry(&ray, &hit);
+        assert_eq!(
+            (lean.point, lean.point_error, lean.normal),
+            (s.point, s.point_error, s.normal),
+            "{}: the surface without (u, v) differs",
+            shape.kind()
+        );
         assert!(
             (s.normal.length() - 1.0).abs() < 1e-9,
             "{}: normal {:?}",

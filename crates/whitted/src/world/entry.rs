@@ -141,8 +141,9 @@ pub(super) fn leaf_hit(
     closest
 }
 
-/// True when an entry of `entries[range]` lies in the query's ray
-/// interval: triangles here, other entries when `other(entry)` says so.
+/// An entry of `entries[range]` that lies in the query's ray interval (the
+/// first one found), if any: triangles here, other entries when
+/// `other(entry)` says so.
 /// Where `wide` (the processor has AVX), runs of two to four triangles are
 /// tested at once, with the same answers as one by one.
 #[inline(always)]
@@ -152,13 +153,13 @@ pub(super) fn leaf_occludes(
     query: &Query,
     wide: bool,
     mut other: impl FnMut(&Entry) -> bool,
-) -> bool {
+) -> Option<u32> {
     let mut entry = range.start;
     while entry < range.end {
         #[cfg(target_arch = "x86_64")]
         if wide && let Some((run, hits)) = triangle_run(entries, entry, range.end, query) {
             if hits.mask != 0 {
-                return true;
+                return Some(entry + hits.mask.trailing_zeros());
             }
             entry += run;
             continue;
@@ -169,12 +170,12 @@ pub(super) fn leaf_occludes(
             None => other(e),
         };
         if occludes {
-            return true;
+            return Some(entry);
         }
         entry += 1;
     }
     let _ = wide;
-    false
+    None
 }
 
 /// The run of two to [`LANES`] triangles that starts at `entry` (and ends

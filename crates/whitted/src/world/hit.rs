@@ -34,7 +34,9 @@ pub struct Surface {
     /// Unit normal for shading: the geometric one, or the one interpolated
     /// from a mesh's vertex normals.
     pub shading_normal: Vec3,
-    /// Texture coordinates.
+    /// Texture coordinates. With the tangents below, zero where
+    /// [`crate::world::World::surface_for`] was told the material reads
+    /// none of them.
     pub uv: DVec2,
     /// Derivative of the point along u (a tangent; not normalised).
     pub dpdu: Vec3,

@@ -94,7 +94,7 @@ impl MeshStructure {
     pub(super) fn occluded(&self, ray: &Ray, wide: bool, ctx: &mut QueryContext) -> bool {
         let query = Query::new(ray, true);
         self.accel.occluded_in_leaf_order(ray, ctx, |range| {
-            leaf_occludes(&self.entries, range, &query, wide, |_| false)
+            leaf_occludes(&self.entries, range, &query, wide, |_| false).is_some()
         })
     }
 }

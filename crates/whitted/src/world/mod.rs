@@ -33,6 +33,7 @@ mod hit;
 mod instance;
 mod objects;
 mod packet;
+mod shadow_hint;
 
 pub use hit::{Hit, Surface};
 pub use objects::{
@@ -40,6 +41,7 @@ pub use objects::{
     Objects, Primitive, PrimitiveId, TransformId,
 };
 pub use packet::{PACKET_SIZE, PacketHits, RayPacket};
+pub use shadow_hint::ShadowHint;
 
 use crate::accel::{
     AccelKind, AccelerationStructure, Accelerator, Clipper, KdTree, KdTreeBuildParams, QueryContext,
@@ -669,12 +671,14 @@ impl<'a> World<'a> {
                 leaf_occludes(&self.entries, range, &query, self.wide_triangles, |e| {
                     self.shape_occludes(e.number, &query)
                 })
+                .is_some()
             });
         }
         let occluded = self.accel.occluded_in_leaf_order(ray, ctx, |range| {
             leaf_occludes(&self.entries, range, &query, self.wide_triangles, |e| {
                 self.other_occludes(definitions, e, &query, &mut inner)
             })
+            .is_some()
         });
         ctx.counters += inner.counters;
         occluded
@@ -703,12 +707,21 @@ impl<'a> World<'a> {
 
     /// The world-space surface at a hit returned for `ray`.
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> Surface {
+        self.surface_for(ray, hit, &[])
+    }
+
+    /// [`World::surface`] for a shader that reads the (u, v) and tangents
+    /// only of materials `reads_uv` marks: for a material marked false
+    /// they may be left zero ([`Shape::surface_geometry`]); materials
+    /// beyond the slice get them.
+    pub fn surface_for(&self, ray: &Ray, hit: &Hit, reads_uv: &[bool]) -> Surface {
         self.surface_in(
             &self.definitions,
             ray,
             hit.primitive.0,
             &hit.shape_hit,
             None,
+            reads_uv,
         )
     }
 
@@ -722,16 +735,22 @@ impl<'a> World<'a> {
         number: u32,
         shape_hit: &ShapeHit,
         material: Option<MaterialId>,
+        reads_uv: &[bool],
     ) -> Surface {
         let (local, shading_normal, own, own_medium, transform) = match self.primitive_ref(number) {
             PrimitiveRef::Shape(i) => {
                 let p = &self.objects.primitives[i as usize];
                 let transform = self.transform(p.transform);
                 let object_ray = transform.map_or(*ray, |t| t.ray_to_object(ray));
-                let s = p.shape.surface(&object_ray, shape_hit);
-                let material = p.shape.material(shape_hit).map_or(p.material, MaterialId);
+                let own = p.shape.material(shape_hit).map_or(p.material, MaterialId);
+                let shown = material.unwrap_or(own);
+                let s = if reads_uv.get(shown.0 as usize) == Some(&false) {
+                    p.shape.surface_geometry(&object_ray, shape_hit)
+                } else {
+                    p.shape.surface(&object_ray, shape_hit)
+                };
                 let medium = p.shape.medium().map_or(p.material, MaterialId);
-                (s, s.normal, material, medium, transform)
+                (s, s.normal, own, medium, transform)
             }
             PrimitiveRef::Triangle { instance, triangle } => {
                 let m = &self.objects.mesh_instances[instance as usize];
@@ -748,8 +767,14 @@ impl<'a> World<'a> {
                 let i = &self.objects.instances[instance as usize];
                 let (definition, local_ray) = self.placed_ray(definitions, instance, ray);
                 let material = material.or(i.material);
-                let s =
-                    definition.surface_in(definitions, &local_ray, primitive, shape_hit, material);
+                let s = definition.surface_in(
+                    definitions,
+                    &local_ray,
+                    primitive,
+                    shape_hit,
+                    material,
+                    reads_uv,
+                );
                 return self.transform(i.transform).map_or(s, |t| s.to_outer(t));
             }
         };
@@ -775,6 +800,25 @@ mod tests {
         let mut objects = Objects::default();
         objects.add_primitive(shape, MaterialId(0), transform);
         objects
+    }
+
+    #[test]
+    fn surface_for_leaves_out_uv_only_for_materials_that_do_not_read_it() {
+        let sphere = Shape::Sphere(Sphere::new(Vec3::ZERO, 1.0).unwrap());
+        let scene = scene_with(sphere, Transform::translate(Vec3::X).unwrap());
+        let world = World::new(&scene);
+        let ray = Ray::new(Vec3::new(1.3, 0.4, 5.0), -Vec3::Z);
+        let hit = world.intersect(&ray).unwrap();
+        let full = world.surface(&ray, &hit);
+        assert_ne!(full.uv, DVec2::ZERO);
+        assert_eq!(world.surface_for(&ray, &hit, &[true]), full);
+        let lean = world.surface_for(&ray, &hit, &[false]);
+        assert_eq!(
+            (lean.uv, lean.dpdu, lean.dpdv),
+            (DVec2::ZERO, Vec3::ZERO, Vec3::ZERO)
+        );
+        let geometry = |s: Surface| (s.point, s.point_error, s.normal, s.material, s.medium);
+        assert_eq!(geometry(lean), geometry(full));
     }
 
     #[test]

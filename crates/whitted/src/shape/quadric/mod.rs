@@ -210,6 +210,15 @@ impl Quadric {
     /// step along the gradient (and kept in the clipping box), the unit
     /// gradient as the normal, and the spherical (u, v) about the centre.
     pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> LocalSurface {
+        let mut surface = self.surface_geometry(ray, hit);
+        let local = surface.point - self.data.center;
+        (surface.uv, surface.dpdu, surface.dpdv) = spherical(local, surface.normal);
+        surface
+    }
+
+    /// The surface at a hit without its parametric part: (u, v) and the
+    /// tangents are left zero (see [`crate::shape::Shape::surface_geometry`]).
+    pub fn surface_geometry(&self, ray: &Ray, hit: &ShapeHit) -> LocalSurface {
         let form = &self.data.form;
         let hit_point = ray.at(hit.t);
         let gradient = form.gradient(hit_point);
@@ -227,17 +236,14 @@ impl Quadric {
         let normal = crate::math::unit(form.gradient(point))
             .or_else(|| crate::math::unit(-ray.dir))
             .unwrap_or(Vec3::Z);
-        let center = self.data.center;
-        let local = point - center;
         let point_error = gamma(8) * point.abs() + Vec3::splat(self.surface_error(point));
-        let (uv, dpdu, dpdv) = spherical(local, normal);
         LocalSurface {
             point,
             point_error,
             normal,
-            uv,
-            dpdu,
-            dpdv,
+            uv: DVec2::ZERO,
+            dpdu: Vec3::ZERO,
+            dpdv: Vec3::ZERO,
         }
     }
 

@@ -1,0 +1,67 @@
+//! The shadow cache (POV-Ray's idea): a shadow ray towards a light is
+//! likely blocked by what blocked the previous one towards the same light,
+//! so that entry is tested first, and the walk runs only when it does not
+//! block. The answer is the any-hit query's own: the hint's test is the one
+//! the walk would run on that entry, and a hint is only ever a guess to try
+//! (a wrong or stale one costs one test).
+
+use crate::accel::{AccelerationStructure, QueryContext};
+use crate::math::Ray;
+use crate::world::World;
+use crate::world::entry::{EntryKind, Query, intersect_triangle, leaf_occludes};
+
+/// The entry that blocked the last shadow ray of one thread towards one
+/// light, if it was one the hinted query can test alone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShadowHint(u32);
+
+impl ShadowHint {
+    /// No entry to try first.
+    pub const NONE: Self = Self(u32::MAX);
+}
+
+impl Default for ShadowHint {
+    fn default() -> Self {
+        Self::NONE
+    }
+}
+
+impl World<'_> {
+    /// [`World::occluded`], trying `hint`'s entry first and leaving in it
+    /// the entry that blocked `ray`. Worlds with instances take the plain
+    /// query (their hint stays empty).
+    pub fn occluded_hinted(&self, ray: &Ray, hint: &mut ShadowHint) -> bool {
+        if self.instance_count != 0 {
+            *hint = ShadowHint::NONE;
+            return self.occluded(ray);
+        }
+        let query = Query::new(ray, self.has_triangles);
+        if let Some(e) = self.entries.get(hint.0 as usize) {
+            let blocks = match e.corners() {
+                Some(corners) => intersect_triangle(corners, &query, ray.t_max).is_some(),
+                None => e.kind == EntryKind::Primitive && self.shape_occludes(e.number, &query),
+            };
+            if blocks {
+                return true;
+            }
+        }
+        *hint = ShadowHint::NONE;
+        if self
+            .unbounded
+            .iter()
+            .any(|e| self.shape_occludes(e.number, &query))
+        {
+            return true;
+        }
+        let mut ctx = QueryContext::default();
+        self.accel.occluded_in_leaf_order(ray, &mut ctx, |range| {
+            let blocker = leaf_occludes(&self.entries, range, &query, self.wide_triangles, |e| {
+                self.shape_occludes(e.number, &query)
+            });
+            if let Some(entry) = blocker {
+                *hint = ShadowHint(entry);
+            }
+            blocker.is_some()
+        })
+    }
+}

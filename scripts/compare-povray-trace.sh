@@ -1,0 +1,64 @@
+#!/bin/bash
+# Render time of whitted against POV-Ray 3.7's own "Trace Time" on the SPD
+# scenes at 1024x1024, two threads, one sample (the speed issue's bar 1):
+#   whitted render X.nff --width 1024 --height 1024 --threads 2
+#     (the time on its summary line: build + trace, not reading or writing)
+#   povray +IX.pov +W1024 +H1024 -A +WT2 -D   (its "Trace Time" line)
+# Best of N runs each, interleaved, printed as a Markdown table. With BEFORE
+# set to a second whitted binary, it is run in the same loop and gets a
+# column of its own (before/after figures measured side by side).
+# Run from the repository root after `cargo build --release`:
+#   N=3 scripts/compare-povray-trace.sh            (all 14 scenes)
+#   N=3 scripts/compare-povray-trace.sh balls mount
+# Environment: SHARED (default ../shared), WHITTED (default
+# target/release/whitted), BEFORE (unset), SIZE (default 1024), OUT
+# (default /tmp/pov_trace).
+set -euo pipefail
+N=${N:-3}
+SIZE=${SIZE:-1024}
+SHARED=$(cd "${SHARED:-../shared}" && pwd)
+WHITTED=$(realpath "${WHITTED:-target/release/whitted}")
+BEFORE=${BEFORE:+$(realpath "$BEFORE")}
+OUT=${OUT:-/tmp/pov_trace}
+mkdir -p "$OUT"
+scenes=("$@")
+if [ ${#scenes[@]} -eq 0 ]; then
+  scenes=(balls gears mount rings teapot tetra tree jacks lattice nurbtst sample shells sombrero teapot_sf6)
+fi
+# The seconds on whitted's summary line ("... 1 spp in 0.590 s (world ...").
+whitted_time() {
+  "$1" render "$SHARED/scenes/spd/$2.nff" -o "$OUT/$2.whitted.png" \
+    --width "$SIZE" --height "$SIZE" --threads 2 2>&1 |
+    sed -n 's/.* spp in \([0-9.]*\) s.*/\1/p'
+}
+# The seconds in POV-Ray's "Trace Time: ... (1.769 seconds)" line.
+povray_time() {
+  (cd "$SHARED/scenes/spd/pov" &&
+    povray "+I$1.pov" "+O$OUT/$1.pov.png" "+W$SIZE" "+H$SIZE" -A +WT2 -D 2>&1) |
+    sed -n 's/.*Trace Time:.*(\([0-9.]*\) seconds).*/\1/p'
+}
+min() { echo "if ($1 < $2) $1 else $2" | bc; }
+if [ -n "$BEFORE" ]; then
+  echo "| scene | POV-Ray trace | whitted before | whitted | ratio before | ratio |"
+  echo "|---|---|---|---|---|---|"
+else
+  echo "| scene | POV-Ray trace | whitted render | ratio |"
+  echo "|---|---|---|---|"
+fi
+for f in "${scenes[@]}"; do
+  bw=999; bp=999; bb=999
+  for _ in $(seq "$N"); do
+    bw=$(min "$(whitted_time "$WHITTED" "$f")" "$bw")
+    if [ -n "$BEFORE" ]; then
+      bb=$(min "$(whitted_time "$BEFORE" "$f")" "$bb")
+    fi
+    bp=$(min "$(povray_time "$f")" "$bp")
+  done
+  ratio=$(echo "scale=2; $bp / $bw" | bc)
+  if [ -n "$BEFORE" ]; then
+    printf "| %s | %.3f s | %.3f s | %.3f s | %.2fx | %.2fx |\n" "$f" "$bp" "$bb" "$bw" \
+      "$(echo "scale=2; $bp / $bb" | bc)" "$ratio"
+  else
+    printf "| %s | %.3f s | %.3f s | %.2fx |\n" "$f" "$bp" "$bw" "$ratio"
+  fi
+done
