@@ -1,8 +1,9 @@
 //! The state of a `whitted serve` session: the view the page asked for,
 //! the scene as last read, the newest frame or error, and the one worker
 //! thread that renders. A new request cancels the running render
-//! ([`whitted::render::render_cancellable`]); the worker then starts over
-//! with the newest view, so it never renders a view nobody waits for.
+//! ([`Prepared::render`]); the worker then starts over with the newest
+//! view, so it never renders a view nobody waits for. The world is built
+//! once per scene read and structure chosen, not per pass.
 //!
 //! Each request is rendered in passes: 1/8 of the size with one sample
 //! (there within a fraction of a second), 1/2, then the full picture; a
@@ -17,7 +18,7 @@ use std::time::{Duration, SystemTime};
 use serde_json::{Value, json};
 use whitted::accel::AccelKind;
 use whitted::math::Vec3;
-use whitted::render::{Aov, Camera, RenderError, RenderOutput, Scene, render_cancellable};
+use whitted::render::{Aov, Camera, Pass, Prepared, RenderError, RenderOutput, Scene};
 
 use crate::explain_svg::base64;
 use crate::scene_arguments::SceneArgs;
@@ -287,28 +288,32 @@ impl Session {
         }
     }
 
-    /// Renders what is asked, newest first, forever.
+    /// The newest request once there is one newer than `done` (which it
+    /// becomes): its view, and whether the file is to be read again.
+    fn next_request(&self, done: &mut u64) -> (View, bool) {
+        let mut inner = self.lock();
+        while inner.requested == *done {
+            inner = self
+                .changed
+                .wait(inner)
+                .unwrap_or_else(PoisonError::into_inner);
+        }
+        *done = inner.requested;
+        self.cancel.store(false, Ordering::Relaxed);
+        (inner.view.clone(), std::mem::take(&mut inner.reload))
+    }
+
+    /// Renders what is asked, newest first, forever. The world (and the
+    /// caustic map) of the scene with the chosen structure is built once
+    /// ([`Prepared`]) and kept while only the camera or the view moves.
     pub fn render_loop(&self) {
         let mut done = 0;
         let mut base: Option<Scene> = None;
-        // The scene with the structure chosen, and that choice.
-        let mut world: Option<(Option<AccelKind>, Arc<Scene>)> = None;
+        let mut next = None;
         loop {
-            let (view, reload) = {
-                let mut inner = self.lock();
-                while inner.requested == done {
-                    inner = self
-                        .changed
-                        .wait(inner)
-                        .unwrap_or_else(PoisonError::into_inner);
-                }
-                done = inner.requested;
-                self.cancel.store(false, Ordering::Relaxed);
-                (inner.view.clone(), std::mem::take(&mut inner.reload))
-            };
+            let (mut view, reload) = next.take().unwrap_or_else(|| self.next_request(&mut done));
             if reload {
                 base = None;
-                world = None;
                 match self.args.load(true) {
                     Ok(scene) => {
                         self.lock().scene_camera = Some(CameraView::of(&scene.camera));
@@ -318,16 +323,28 @@ impl Session {
                 }
             }
             let Some(base) = &base else { continue };
-            let world = match &world {
-                Some((accel, w)) if *accel == view.accel => w,
-                _ => {
-                    &world
-                        .insert((view.accel, Arc::new(with_accel(base, view.accel))))
-                        .1
+            // The scene with the structure chosen, and its world.
+            let world = Arc::new(with_accel(base, view.accel));
+            let prepared = match Prepared::new(&world) {
+                Ok(prepared) => prepared,
+                Err(e) => {
+                    self.publish_error(done, &e.to_string());
+                    continue;
                 }
             };
-            if let Err(message) = self.render_view(done, world, &view) {
-                self.publish_error(done, &message);
+            let mut build_seconds = prepared.build_seconds();
+            loop {
+                if let Err(message) =
+                    self.render_view(done, &prepared, &world, &view, &mut build_seconds)
+                {
+                    self.publish_error(done, &message);
+                }
+                let (newer, reload) = self.next_request(&mut done);
+                if reload || newer.accel != view.accel {
+                    next = Some((newer, reload));
+                    break;
+                }
+                view = newer;
             }
         }
     }
@@ -340,16 +357,24 @@ impl Session {
         self.publish("error", json!({ "request": request, "message": message }));
     }
 
-    /// Renders `view` of `world` (the scene with the view's structure) in
-    /// passes, publishing each frame, until the last or until a newer
-    /// request cancels it.
-    fn render_view(&self, request: u64, world: &Arc<Scene>, view: &View) -> Result<(), String> {
+    /// Renders `view` of `world` (the scene with the view's structure,
+    /// `prepared` its world) in passes, publishing each frame, until the
+    /// last or until a newer request cancels it. The first frame published
+    /// reports `build_seconds`, which then becomes 0.
+    fn render_view(
+        &self,
+        request: u64,
+        prepared: &Prepared<'_>,
+        world: &Arc<Scene>,
+        view: &View,
+        build_seconds: &mut f64,
+    ) -> Result<(), String> {
         let mut scene = Scene::clone(world);
         if let Some(camera) = &view.camera {
             scene.camera = camera.camera()?;
         }
         scene.settings.aovs = view.aov.into_iter().collect();
-        let full = Arc::new(scene.clone());
+        let full = Arc::new(scene);
         {
             let mut inner = self.lock();
             inner.scene = Some(Arc::clone(&full));
@@ -362,15 +387,18 @@ impl Session {
         };
         for &(pass, divisor) in passes {
             let (width, height) = (full.settings.width, full.settings.height);
-            scene.settings.width = width.div_ceil(divisor);
-            scene.settings.height = height.div_ceil(divisor);
-            scene.settings.samples_per_pixel = if divisor == 1 {
-                full.settings.samples_per_pixel
-            } else {
-                1
+            let frame = Pass {
+                width: width.div_ceil(divisor),
+                height: height.div_ceil(divisor),
+                samples_per_pixel: if divisor == 1 {
+                    full.settings.samples_per_pixel
+                } else {
+                    1
+                },
+                ..Pass::of(&full)
             };
             let start = std::time::Instant::now();
-            let output = match render_cancellable(&scene, &self.cancel, &|_| {}) {
+            let output = match prepared.render(&frame, &self.cancel, &|_| {}) {
                 Ok(output) => output,
                 Err(RenderError::Cancelled) => return Ok(()),
                 Err(e) => return Err(e.to_string()),
@@ -383,13 +411,13 @@ impl Session {
             let data = json!({
                 "request": request,
                 "pass": pass,
-                "width": scene.settings.width,
-                "height": scene.settings.height,
+                "width": frame.width,
+                "height": frame.height,
                 "full_width": width,
                 "full_height": height,
                 "aov": view.aov.map(|a| a.name()),
-                "accel": scene.settings.accel.name(),
-                "build_seconds": output.build_seconds,
+                "accel": full.settings.accel.name(),
+                "build_seconds": std::mem::take(build_seconds),
                 "render_seconds": seconds,
                 "rays": output.rays.total(),
                 "rays_per_second": output.rays.total() as f64 / trace,

@@ -50,6 +50,51 @@ fn the_page_is_served_and_frames_come_coarse_first_then_full() {
 }
 
 #[test]
+fn a_camera_move_renders_through_the_kept_world_and_a_new_structure_builds_one() {
+    let server = Server::start(&scene_text(), &SIZE);
+    let mut events = server.events();
+    let first = events.full_frame()["request"].as_u64().unwrap();
+    // Every frame of requests after `after`, up to the full one of the
+    // newest: (request, pass, build_seconds).
+    let frames_after = |events: &mut crate::support::Events, after: u64| {
+        events
+            .until(|_, data| data["pass"] == "full" && data["request"].as_u64() > Some(after))
+            .into_iter()
+            .filter(|(_, data)| data["request"].as_u64() > Some(after))
+            .map(|(name, data)| {
+                assert_eq!(name, "frame", "{data}");
+                (
+                    data["request"].as_u64().unwrap(),
+                    data["pass"].as_str().unwrap().to_string(),
+                    data["build_seconds"].as_f64().unwrap(),
+                )
+            })
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(server.view("eye=1.5,2,-4.5&fov=50").0, 200);
+    let moved = frames_after(&mut events, first);
+    assert!(!moved.is_empty());
+    for (_, pass, build) in &moved {
+        assert_eq!(
+            *build, 0.0,
+            "the {pass} pass after a camera move built the world"
+        );
+    }
+    let last = moved.last().unwrap().0;
+    assert_eq!(server.view("accel=kdtree").0, 200);
+    let rebuilt = frames_after(&mut events, last);
+    let (_, pass, build) = &rebuilt[0];
+    assert!(
+        *build > 0.0,
+        "the {pass} pass of a new structure reused the old world"
+    );
+    assert!(
+        rebuilt[1..].iter().all(|(_, _, build)| *build == 0.0),
+        "{rebuilt:?}"
+    );
+}
+
+#[test]
 fn a_pixels_ray_tree_is_explain_json_and_its_root_is_the_rendered_pixel() {
     let server = Server::start(&scene_text(), &SIZE);
     server.events().full_frame();

@@ -16,13 +16,14 @@ use std::collections::HashMap;
 use crate::accel::AccelKind;
 use crate::integrator::{
     CausticMap, Integrator, RayCounts, RayNode, RayTreeRecorder, RecursionLimits,
-    SECONDARY_RAY_BUDGET, Shading, Unobserved,
+    SECONDARY_RAY_BUDGET, Unobserved,
 };
 use crate::math::DVec2;
 use crate::render::adaptive::{AdaptivePixels, Cost};
 use crate::render::sample_ray::{
     pixel_pattern, position_differential, position_ray, sample_differential, sample_ray,
 };
+use crate::render::shading_of;
 use crate::render::{AntiAliasing, Camera, RenderError, RenderSettings, Scene};
 use crate::shading::Color;
 use crate::world::{MAX_PRIMITIVES, World};
@@ -230,16 +231,6 @@ impl<'s> Explainer<'s> {
             sample_colors: samples.into_iter().map(|(_, color)| color).collect(),
             pixel: pixel.to_f32(),
         })
-    }
-}
-
-/// The shading inputs of `scene`, as `render` gives them.
-fn shading_of(scene: &Scene) -> Shading<'_> {
-    Shading {
-        materials: &scene.materials,
-        lights: &scene.lights,
-        background: scene.background,
-        ambient: scene.ambient,
     }
 }
 

@@ -9,6 +9,7 @@ mod gradient_note;
 mod merge;
 mod part;
 mod photon_pass;
+mod prepared;
 mod resources;
 mod sample_ray;
 mod scene;
@@ -28,6 +29,7 @@ pub use part::{
     BUILT_IN_SCENE, Part, PartError, PartHeader, encode_part, parse_part, read_part, scene_sha256,
 };
 pub use photon_pass::PhotonReport;
+pub use prepared::{Pass, Prepared};
 pub use resources::{RayBudgetCut, ThreadClamp, memory_needed};
 pub use scene::Scene;
 pub use selection::{PixelSelection, SelectionError, Share, Window};
@@ -288,24 +290,33 @@ fn render_pixels(
     cancel: Option<&AtomicBool>,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<RenderOutput, RenderError> {
-    let cancelled = || cancel.is_some_and(|c| c.load(Ordering::Relaxed));
+    selection.check(scene.settings.width, scene.settings.height)?;
+    let prepared = Prepared::new(scene)?;
+    let build_seconds = prepared.build_seconds();
     let settings = &scene.settings;
-    let (width, height) = (settings.width, settings.height);
-    settings.check()?;
-    selection.check(width, height)?;
-    scene.objects.check_instances()?;
-    let primitives = scene.objects.primitive_count();
-    if primitives > MAX_PRIMITIVES {
-        return Err(RenderError::TooManyPrimitives(primitives));
-    }
-    resources::check_memory(settings, MemoryBudget::current())?;
-    let tiles_x = width.div_ceil(TILE_SIZE);
-    let tiles_y = height.div_ceil(TILE_SIZE);
-    let tiles: Vec<u32> = (0..tiles_x * tiles_y)
-        .filter(|&index| tile_is_selected(selection, index % tiles_x, index / tiles_x))
-        .collect();
+    trace_pixels(
+        &prepared,
+        &scene.camera,
+        settings,
+        selection,
+        cancel,
+        progress,
+        build_seconds,
+    )
+}
+
+/// How many tiles cover a `width` x `height` image.
+fn tile_count(width: u32, height: u32) -> usize {
+    (width.div_ceil(TILE_SIZE) * height.div_ceil(TILE_SIZE)) as usize
+}
+
+/// The worker threads for `tiles` tiles of a render with `settings`.
+fn worker_pool(
+    settings: &RenderSettings,
+    tiles: usize,
+) -> Result<(rayon::ThreadPool, Option<ThreadClamp>), RenderError> {
     let cores = std::thread::available_parallelism().map_or(1, usize::from);
-    let (threads, thread_clamp) = resources::useful_threads(settings.threads, tiles.len(), cores);
+    let (threads, thread_clamp) = resources::useful_threads(settings.threads, tiles, cores);
     let pool = rayon::ThreadPoolBuilder::new()
         .stack_size(worker_stack_bytes(settings.max_depth))
         .num_threads(threads)
@@ -314,25 +325,58 @@ fn render_pixels(
             threads,
             message: e.to_string(),
         })?;
+    Ok((pool, thread_clamp))
+}
 
-    gradient_note::forget(&scene.objects);
-    let build_start = std::time::Instant::now();
-    let world = build_world(scene);
-    let build_seconds = build_start.elapsed().as_secs_f64();
-    let shading = Shading {
+/// The shading inputs of `scene`.
+fn shading_of(scene: &Scene) -> Shading<'_> {
+    Shading {
         materials: &scene.materials,
         lights: &scene.lights,
         background: scene.background,
         ambient: scene.ambient,
-    };
+    }
+}
+
+/// Renders the pixels `selection` holds through the world of `prepared`,
+/// seen by `camera`, with `settings` (the prepared scene's, or those of a
+/// [`Pass`] of it): the tiles spread over the worker threads.
+fn trace_pixels(
+    prepared: &Prepared<'_>,
+    camera: &Camera,
+    settings: &RenderSettings,
+    selection: &PixelSelection,
+    cancel: Option<&AtomicBool>,
+    progress: &(dyn Fn(Progress) + Sync),
+    build_seconds: f64,
+) -> Result<RenderOutput, RenderError> {
+    let cancelled = || cancel.is_some_and(|c| c.load(Ordering::Relaxed));
+    let scene = prepared.scene;
+    let (width, height) = (settings.width, settings.height);
+    settings.check()?;
+    selection.check(width, height)?;
+    resources::check_memory(settings, MemoryBudget::current())?;
+    let tiles_x = width.div_ceil(TILE_SIZE);
+    let tiles_y = height.div_ceil(TILE_SIZE);
+    let tiles: Vec<u32> = (0..tiles_x * tiles_y)
+        .filter(|&index| tile_is_selected(selection, index % tiles_x, index / tiles_x))
+        .collect();
+    let (pool, thread_clamp) = worker_pool(settings, tiles.len())?;
+
+    gradient_note::forget(&scene.objects);
     let limits = RecursionLimits {
         max_depth: settings.max_depth,
         min_weight: settings.min_weight,
         ray_budget: SECONDARY_RAY_BUDGET,
     };
-    let caustics = pool.install(|| photon_pass::build(&world, &shading, settings))?;
-    let integrator = Integrator::new(settings.integrator, &world, shading, limits)
-        .with_caustics(caustics.as_ref().map(|(map, _)| map));
+    let caustics = prepared.caustics.as_ref();
+    let integrator = Integrator::new(
+        settings.integrator,
+        &prepared.world,
+        shading_of(scene),
+        limits,
+    )
+    .with_caustics(caustics.map(|(map, _)| map));
     let total = selection.pixel_count();
     let done = AtomicU64::new(0);
     let films = Mutex::new(Films {
@@ -354,7 +398,7 @@ fn render_pixels(
             let tile = clock.tile(|| {
                 render_tile(
                     &integrator,
-                    &scene.camera,
+                    camera,
                     scene.color_space,
                     settings,
                     selection,
@@ -377,7 +421,7 @@ fn render_pixels(
     }
     let films = films.into_inner().unwrap_or_else(PoisonError::into_inner);
     check_finite(&films.image)?;
-    let ray_budget_cut = budget_cut(scene, &films.cuts, films.rays[RayKind::Primary]);
+    let ray_budget_cut = budget_cut(scene, settings, &films.cuts, films.rays[RayKind::Primary]);
     Ok(RenderOutput {
         image: films.image,
         aovs: films.aovs,
@@ -388,7 +432,7 @@ fn render_pixels(
         thread_clamp,
         ray_budget_cut,
         gradient_exceeded: gradient_note::report(&scene.objects),
-        photons: caustics.map(|(_, report)| report),
+        photons: caustics.map(|&(_, report)| report),
     })
 }
 
@@ -398,13 +442,13 @@ fn render_pixels(
 /// the total when the pixels were sampled adaptively.
 fn budget_cut(
     scene: &Scene,
+    settings: &RenderSettings,
     cuts: &HashMap<MaterialId, u64>,
     camera_rays: u64,
 ) -> Option<RayBudgetCut> {
     let (&material, _) = cuts
         .iter()
         .max_by_key(|&(material, &samples)| (samples, std::cmp::Reverse(material.0)))?;
-    let settings = &scene.settings;
     Some(RayBudgetCut {
         samples: cuts.values().sum(),
         total: match settings.aa {
