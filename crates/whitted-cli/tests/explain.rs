@@ -5,6 +5,10 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+#[path = "common/pfm.rs"]
+mod pfm;
+use pfm::read_pfm;
+
 fn whitted(args: &[&str], dir: &Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_whitted"))
         .args(args)
@@ -18,38 +22,6 @@ fn scene(name: &str) -> String {
         .iter()
         .collect();
     path.to_string_lossy().into_owned()
-}
-
-/// The pixels of a PFM file written by `whitted render`, top row first.
-fn read_pfm(path: &Path) -> (usize, Vec<[f32; 3]>) {
-    let bytes = std::fs::read(path).unwrap();
-    let mut lines = 0;
-    let mut start = 0;
-    while lines < 3 {
-        if bytes[start] == b'\n' {
-            lines += 1;
-        }
-        start += 1;
-    }
-    let header = String::from_utf8_lossy(&bytes[..start]).into_owned();
-    let size: Vec<usize> = header
-        .lines()
-        .nth(1)
-        .unwrap()
-        .split_whitespace()
-        .map(|n| n.parse().unwrap())
-        .collect();
-    let (width, height) = (size[0], size[1]);
-    let floats: Vec<f32> = bytes[start..]
-        .chunks_exact(4)
-        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-        .collect();
-    let mut pixels = vec![[0.0; 3]; width * height];
-    for (i, rgb) in floats.chunks_exact(3).enumerate() {
-        let (x, row_from_bottom) = (i % width, i / width);
-        pixels[(height - 1 - row_from_bottom) * width + x] = [rgb[0], rgb[1], rgb[2]];
-    }
-    (width, pixels)
 }
 
 fn json(output: &Output) -> serde_json::Value {
@@ -101,7 +73,7 @@ fn the_json_root_is_the_pixel_render_writes_for_one_and_several_samples_and_adap
         ];
         args.extend(&size);
         assert!(whitted(&args, dir).status.success());
-        let (width, pixels) = read_pfm(&out);
+        let (width, pixels) = read_pfm(&std::fs::read(&out).unwrap());
         for (x, y) in [(20, 14), (5, 25), (33, 8), (24, 17)] {
             let pixel = format!("{x},{y}");
             let mut args = vec![

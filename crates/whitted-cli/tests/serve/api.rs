@@ -3,7 +3,8 @@
 //! scene file (a bad one shown, the server alive), the camera and its
 //! flags, the views, and bad requests.
 
-use crate::support::{Server, read_pfm, scene_text, whitted};
+use crate::pfm::read_pfm;
+use crate::support::{Server, scene_text, whitted};
 
 const SIZE: [&str; 4] = ["--width", "64", "--height", "48"];
 

@@ -3,4 +3,6 @@
 
 mod api;
 mod browser;
+#[path = "../common/pfm.rs"]
+mod pfm;
 mod support;

@@ -15,9 +15,9 @@
 use std::collections::HashMap;
 
 use super::solid::{Crossing, Crossings};
-use super::triangle::{RayShear, watertight};
+use super::triangle::{RayShear, barycentric_surface, watertight};
 use super::{LocalSurface, ShapeError, ShapeHit};
-use crate::math::{Aabb, DVec2, Ray, Vec3, gamma};
+use crate::math::{Aabb, Ray, Vec3};
 
 /// Where a mesh is not closed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -162,19 +162,8 @@ impl SmallMesh {
     /// The surface at a hit: the triangle's, (u, v) its barycentric
     /// coordinates.
     pub fn surface(&self, _ray: &Ray, hit: &ShapeHit) -> LocalSurface {
-        let [p0, p1, p2] = self.corners(hit.part as usize);
-        let (b1, b2) = (hit.u, hit.v);
-        let (w0, w1, w2) = ((1.0 - b1 - b2) * p0, b1 * p1, b2 * p2);
-        let (edge1, edge2) = (p1 - p0, p2 - p0);
-        LocalSurface {
-            point: w0 + w1 + w2,
-            point_error: gamma(7) * (w0.abs() + w1.abs() + w2.abs()),
-            // A zero-area triangle is never hit, so this normalises.
-            normal: edge1.cross(edge2).normalize(),
-            uv: DVec2::new(b1, b2),
-            dpdu: edge1,
-            dpdv: edge2,
-        }
+        // A zero-area triangle is never hit, so its normal normalises.
+        barycentric_surface(self.corners(hit.part as usize), hit.u, hit.v)
     }
 
     /// The bounding box of the vertices.

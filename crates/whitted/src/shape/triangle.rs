@@ -75,25 +75,32 @@ impl Triangle {
     /// coordinates, which lies on the triangle up to the bound
     /// `γ(7) (|b0 p0| + |b1 p1| + |b2 p2|)` (pbrt-v4 eq. 6.31).
     pub fn surface(&self, _ray: &Ray, hit: &ShapeHit) -> LocalSurface {
-        let (b1, b2) = (hit.u, hit.v);
-        let b0 = 1.0 - b1 - b2;
-        let (w0, w1, w2) = (b0 * self.p0, b1 * self.p1, b2 * self.p2);
-        let (edge1, edge2) = (self.p1 - self.p0, self.p2 - self.p0);
-        LocalSurface {
-            point: w0 + w1 + w2,
-            point_error: gamma(7) * (w0.abs() + w1.abs() + w2.abs()),
-            // Cannot fail: the constructor refused triangles whose cross
-            // product does not normalise.
-            normal: edge1.cross(edge2).normalize(),
-            uv: DVec2::new(b1, b2),
-            dpdu: edge1,
-            dpdv: edge2,
-        }
+        // Cannot fail to normalise: the constructor refused triangles whose
+        // cross product does not.
+        barycentric_surface([self.p0, self.p1, self.p2], hit.u, hit.v)
     }
 
     /// The bounding box of the vertices.
     pub fn bounds(&self) -> Aabb {
         Aabb::from_points([self.p0, self.p1, self.p2])
+    }
+}
+
+/// The surface of the triangle with `corners` at barycentric coordinates
+/// (`b1`, `b2`): the point rebuilt from them with its error bound, the
+/// geometric normal, (u, v) = (`b1`, `b2`) and the edges as tangents. The
+/// triangle must have a non-zero area (the normal is normalised).
+pub(crate) fn barycentric_surface(corners: [Vec3; 3], b1: f64, b2: f64) -> LocalSurface {
+    let [p0, p1, p2] = corners;
+    let (w0, w1, w2) = ((1.0 - b1 - b2) * p0, b1 * p1, b2 * p2);
+    let (edge1, edge2) = (p1 - p0, p2 - p0);
+    LocalSurface {
+        point: w0 + w1 + w2,
+        point_error: gamma(7) * (w0.abs() + w1.abs() + w2.abs()),
+        normal: edge1.cross(edge2).normalize(),
+        uv: DVec2::new(b1, b2),
+        dpdu: edge1,
+        dpdv: edge2,
     }
 }
 
