@@ -208,6 +208,7 @@ fn quadric_value(q: &super::Quadric, p: Vec3) -> f64 {
 mod tests {
     use super::*;
     use crate::math::random::Rng;
+    use crate::shape::testing::random_line_through;
     use crate::shape::{
         AxisBox, Cone, Cylinder, Disk, Expression, Implicit, Plane, Quadric, Sphere,
         Superellipsoid, Torus,
@@ -284,16 +285,9 @@ mod tests {
         let mut rng = Rng::new(21);
         for shape in closed_shapes() {
             let bounds = shape.bounds();
-            let size = bounds.extent().length();
-            let centre = bounds.centroid();
             let mut crossed = 0;
             for _ in 0..300 {
-                let origin = centre + 2.0 * size * rng.unit_vector();
-                let target = rng.point_in(bounds.min, bounds.max);
-                let dir = (target - origin) * rng.range(0.2, 3.0);
-                // The line's parameter is its own: start it anywhere.
-                let start = rng.range(-1.0, 1.0);
-                let ray = Ray::new(origin - start * dir, dir);
+                let (ray, start) = random_line_through(&mut rng, &bounds);
                 let mut crossings = Crossings::new();
                 shape.crossings(&ray, &mut crossings);
                 assert!(
@@ -303,7 +297,7 @@ mod tests {
                 );
                 crossed += usize::from(!crossings.is_empty());
                 let step = 4.0 / 400.0;
-                let near = 1e-7 * size / dir.length();
+                let near = 1e-7 * bounds.extent().length() / ray.dir.length();
                 for k in 0..400 {
                     let t = start + f64::from(k) * step - 0.5;
                     if crossings.iter().any(|c| (c.hit.t - t).abs() < near) {

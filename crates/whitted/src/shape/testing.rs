@@ -5,6 +5,21 @@ use super::Shape;
 use crate::math::random::Rng;
 use crate::math::{Aabb, DVec2, Ray, Vec3, offset_ray_origin};
 
+/// A random line through the box `bounds`: from a point twice the box's
+/// diagonal away from its centre towards a point inside it, with a random
+/// length of direction and the origin moved anywhere along the line, so
+/// tests of crossings along whole lines see every parametrisation. Also
+/// gives the line's parameter at that far point: the box lies between it
+/// and about 3 further on.
+pub(crate) fn random_line_through(rng: &mut Rng, bounds: &Aabb) -> (Ray, f64) {
+    let size = bounds.extent().length();
+    let origin = bounds.centroid() + 2.0 * size * rng.unit_vector();
+    let target = rng.point_in(bounds.min, bounds.max);
+    let dir = (target - origin) * rng.range(0.2, 3.0);
+    let start = rng.range(-1.0, 1.0);
+    (Ray::new(origin - start * dir, dir), start)
+}
+
 /// The region random rays aim at: the shape's bounds, or a box around the
 /// origin for unbounded shapes.
 fn region(shape: &Shape) -> Aabb {

@@ -5,6 +5,7 @@
 use super::*;
 use crate::math::random::Rng;
 use crate::shape::Shape;
+use crate::shape::testing::random_line_through;
 
 /// A torus of `n` by `m` quads around the y axis, each split in two.
 pub(crate) fn torus_mesh(major: f64, minor: f64, n: u32, m: u32) -> SmallMesh {
@@ -131,15 +132,9 @@ fn crossings_and_inside_test_agree_with_the_winding_number_on_random_lines() {
     let mut rng = Rng::new(31);
     for mesh in meshes() {
         let bounds = mesh.bounds();
-        let size = bounds.extent().length();
-        let centre = bounds.centroid();
         let mut crossed = 0;
         for _ in 0..200 {
-            let origin = centre + 2.0 * size * rng.unit_vector();
-            let target = rng.point_in(bounds.min, bounds.max);
-            let dir = (target - origin) * rng.range(0.2, 3.0);
-            let start = rng.range(-1.0, 1.0);
-            let ray = Ray::new(origin - start * dir, dir);
+            let (ray, start) = random_line_through(&mut rng, &bounds);
             let mut crossings = Crossings::new();
             mesh.crossings(&ray, &mut crossings);
             assert!(crossings.len().is_multiple_of(2), "{crossings:?}");
