@@ -43,8 +43,8 @@ pub fn lines(output: &RenderOutput, stages: StageSeconds) -> Vec<String> {
         "trace",
         trace.seconds,
         format!(
-            "{} tiles on {} thread{}, busy {:.1}% of the time; the last tile started {:.3} s \
-             before the end",
+            "{} tiles on {} thread{}, busy {:.1}% of the time; the first thread out of tiles \
+             waited {:.3} s for the others",
             trace.tiles,
             trace.threads,
             if trace.threads == 1 { "" } else { "s" },

@@ -40,10 +40,8 @@ pub use sources::{LineIndex, ObjectSource, ObjectSources, PrimitiveDescription, 
 pub use trace_timing::TraceTiming;
 
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Mutex, PoisonError};
-
-use rayon::prelude::*;
 
 use crate::image::{ColorSpace, Film};
 use crate::integrator::{
@@ -390,8 +388,14 @@ fn trace_pixels(
         cuts: HashMap::new(),
     });
     let clock = trace_timing::TraceClock::start();
-    pool.install(|| {
-        tiles.into_par_iter().for_each(|index| {
+    // Each worker takes the next tile from a shared counter until none is
+    // left: a thread that finishes early takes more, so both cores stay
+    // busy to the last tile. (Rayon's `for_each` over the list splits it
+    // into a few long runs up front: on mount one thread sat idle for a
+    // third of the render, see docs/performance.md.)
+    let next_tile = AtomicUsize::new(0);
+    pool.broadcast(|_| {
+        while let Some(&index) = tiles.get(next_tile.fetch_add(1, Ordering::Relaxed)) {
             if cancelled() {
                 return;
             }
@@ -413,7 +417,8 @@ fn trace_pixels(
                 .add(tile);
             let now = done.fetch_add(pixels, Ordering::Relaxed) + pixels;
             progress(Progress { done: now, total });
-        });
+        }
+        clock.out_of_work();
     });
     let trace = clock.finish(pool.current_num_threads());
     if cancelled() {

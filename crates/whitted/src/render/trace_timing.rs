@@ -16,8 +16,9 @@ pub struct TraceTiming {
     pub busy_seconds: f64,
     /// Worker threads that traced.
     pub threads: usize,
-    /// Seconds from the moment the last tile was started to the end: the
-    /// tail, when some threads had no more work while others finished.
+    /// Seconds from the moment the first thread found no tile left to the
+    /// end: the tail, when some threads had no more work while others
+    /// finished theirs.
     pub tail_seconds: f64,
     /// Tiles traced.
     pub tiles: usize,
@@ -40,7 +41,7 @@ impl TraceTiming {
 pub(super) struct TraceClock {
     start: Instant,
     busy_nanos: AtomicU64,
-    last_start_nanos: AtomicU64,
+    first_idle_nanos: AtomicU64,
     tiles: AtomicU64,
 }
 
@@ -50,7 +51,7 @@ impl TraceClock {
         Self {
             start: Instant::now(),
             busy_nanos: AtomicU64::new(0),
-            last_start_nanos: AtomicU64::new(0),
+            first_idle_nanos: AtomicU64::new(u64::MAX),
             tiles: AtomicU64::new(0),
         }
     }
@@ -58,8 +59,6 @@ impl TraceClock {
     /// Times `work`, one tile's, as part of the render.
     pub(super) fn tile<T>(&self, work: impl FnOnce() -> T) -> T {
         let started = self.start.elapsed();
-        self.last_start_nanos
-            .fetch_max(nanos(started), Ordering::Relaxed);
         let result = work();
         let spent = self.start.elapsed().saturating_sub(started);
         self.busy_nanos.fetch_add(nanos(spent), Ordering::Relaxed);
@@ -67,15 +66,24 @@ impl TraceClock {
         result
     }
 
+    /// Notes that the calling thread found no tile left to take.
+    pub(super) fn out_of_work(&self) {
+        self.first_idle_nanos
+            .fetch_min(nanos(self.start.elapsed()), Ordering::Relaxed);
+    }
+
     /// The timing so far, for `threads` worker threads.
     pub(super) fn finish(&self, threads: usize) -> TraceTiming {
         let seconds = self.start.elapsed().as_secs_f64();
-        let last_start = self.last_start_nanos.load(Ordering::Relaxed) as f64 * 1e-9;
+        let first_idle = match self.first_idle_nanos.load(Ordering::Relaxed) {
+            u64::MAX => seconds,
+            idle => idle as f64 * 1e-9,
+        };
         TraceTiming {
             seconds,
             busy_seconds: self.busy_nanos.load(Ordering::Relaxed) as f64 * 1e-9,
             threads,
-            tail_seconds: (seconds - last_start).max(0.0),
+            tail_seconds: (seconds - first_idle).max(0.0),
             tiles: self.tiles.load(Ordering::Relaxed) as usize,
         }
     }
@@ -90,18 +98,36 @@ mod tests {
     use super::*;
 
     #[test]
-    fn busy_time_adds_over_tiles_and_the_tail_runs_from_the_last_start() {
+    fn busy_time_adds_over_tiles_and_the_tail_runs_from_the_first_idle_thread() {
         let clock = TraceClock::start();
-        clock.tile(|| std::thread::sleep(Duration::from_millis(20)));
-        clock.tile(|| std::thread::sleep(Duration::from_millis(20)));
-        let timing = clock.finish(1);
-        assert_eq!(timing.tiles, 2);
-        assert!(timing.busy_seconds >= 0.04, "{timing:?}");
-        assert!(timing.seconds >= timing.busy_seconds, "{timing:?}");
-        // The last tile started after the first one's 20 ms and ran 20 ms.
-        assert!(timing.tail_seconds >= 0.02, "{timing:?}");
-        assert!(timing.tail_seconds < timing.seconds - 0.015, "{timing:?}");
+        std::thread::scope(|scope| {
+            // One thread with a short tile, one with two long ones.
+            scope.spawn(|| {
+                clock.tile(|| std::thread::sleep(Duration::from_millis(10)));
+                clock.out_of_work();
+            });
+            scope.spawn(|| {
+                clock.tile(|| std::thread::sleep(Duration::from_millis(30)));
+                clock.tile(|| std::thread::sleep(Duration::from_millis(30)));
+                clock.out_of_work();
+            });
+        });
+        let timing = clock.finish(2);
+        assert_eq!(timing.tiles, 3);
+        assert!(timing.busy_seconds >= 0.07, "{timing:?}");
+        assert!(timing.seconds >= 0.06, "{timing:?}");
+        // The first thread ran out of work after its 10 ms, the other
+        // went on for 50 ms more.
+        assert!(timing.tail_seconds >= 0.05, "{timing:?}");
+        assert!(timing.tail_seconds <= timing.seconds - 0.01, "{timing:?}");
         assert!(timing.utilisation() > 0.5 && timing.utilisation() <= 1.0);
+    }
+
+    #[test]
+    fn no_thread_out_of_work_means_no_tail() {
+        let clock = TraceClock::start();
+        clock.tile(|| std::thread::sleep(Duration::from_millis(5)));
+        assert_eq!(clock.finish(1).tail_seconds, 0.0);
     }
 
     #[test]
