@@ -6,7 +6,7 @@
 use std::cell::Cell;
 
 use crate::math::Ray;
-use crate::world::{ShadowHint, World};
+use crate::world::{OpaqueEntries, ShadowHint, ShadowPath, World};
 
 /// Lights with a hint of their own; shadow rays towards the others take the
 /// plain query.
@@ -28,6 +28,25 @@ pub(super) fn occluded(world: &World<'_>, ray: &Ray, light: usize) -> bool {
         let blocked = world.occluded_hinted(ray, &mut hint);
         hints[light].set(hint);
         blocked
+    })
+}
+
+/// What lies along `ray`, a shadow ray towards light number `light`, in a
+/// world where some surfaces let light through ([`World::shadow_path`]).
+pub(super) fn shadow_path(
+    world: &World<'_>,
+    ray: &Ray,
+    opaque: &OpaqueEntries,
+    light: usize,
+) -> ShadowPath {
+    if light >= CACHED_LIGHTS {
+        return world.shadow_path(ray, opaque, &mut ShadowHint::default());
+    }
+    HINTS.with(|hints| {
+        let mut hint = hints[light].get();
+        let path = world.shadow_path(ray, opaque, &mut hint);
+        hints[light].set(hint);
+        path
     })
 }
 

@@ -36,7 +36,7 @@ use crate::shading::{
     Color, Crossing, Light, Lobes, Material, MediumStack, RayDifferential, Weights, direct_samples,
     phong, shading_normal,
 };
-use crate::world::{Hit, MaterialId, Surface, World};
+use crate::world::{Hit, MaterialId, OpaqueEntries, ShadowPath, Surface, World};
 
 /// Longest chain of transmissive surfaces one shadow ray passes through.
 const MAX_SHADOW_CROSSINGS: usize = 64;
@@ -76,6 +76,11 @@ pub struct Whitted<'a> {
     shading: Shading<'a>,
     limits: RecursionLimits,
     any_transmissive: bool,
+    /// In a world with transmissive surfaces, which entries stop shadow
+    /// rays outright, so that most shadow rays need one any-hit walk
+    /// ([`World::shadow_path`]); `None` without such surfaces, or for a
+    /// world with instances.
+    opaque: Option<OpaqueEntries>,
     caustics: Option<&'a CausticMap>,
     /// Per material, whether shading reads (u, v) ([`Material::reads_uv`]).
     reads_uv: Vec<bool>,
@@ -88,11 +93,13 @@ impl<'a> Whitted<'a> {
     /// Prepares to trace in `world`, shading with `shading`, within
     /// `limits`.
     pub fn new(world: &'a World<'a>, shading: Shading<'a>, limits: RecursionLimits) -> Self {
+        let any_transmissive = shading.materials.iter().any(Material::is_transmissive);
         Self {
             world,
             shading,
             limits,
-            any_transmissive: shading.materials.iter().any(Material::is_transmissive),
+            any_transmissive,
+            opaque: opaque_entries(world, shading.materials, None),
             caustics: None,
             reads_uv: shading.materials.iter().map(Material::reads_uv).collect(),
         }
@@ -102,7 +109,11 @@ impl<'a> Whitted<'a> {
     /// and stops shadow rays at surfaces that bend light (the map carries
     /// that light); `None` leaves it as it was.
     pub fn with_caustics(self, caustics: Option<&'a CausticMap>) -> Self {
-        Self { caustics, ..self }
+        Self {
+            caustics,
+            opaque: opaque_entries(self.world, self.shading.materials, caustics),
+            ..self
+        }
     }
 
     /// The world it traces in.
@@ -378,6 +389,24 @@ impl<'a> Whitted<'a> {
                 .shadow_ray(&ray, ShadowStep::AnyHit { blocked });
             return if blocked { Color::ZERO } else { Color::ONE };
         }
+        // A shadow ray that leaves a surface letting light through on its
+        // inner side most often crosses it again (a closed glass solid): it
+        // goes straight to the surface-to-surface walk.
+        if let Some(opaque) = &self.opaque
+            && (to_light.dot(s.normal) > 0.0
+                || !self.shading.materials[s.material.0 as usize].is_transmissive())
+        {
+            match shadow_cache::shadow_path(self.world, &ray, opaque, index) {
+                ShadowPath::Crossed => {}
+                path => {
+                    let blocked = path == ShadowPath::Blocked;
+                    tally
+                        .observer
+                        .shadow_ray(&ray, ShadowStep::AnyHit { blocked });
+                    return if blocked { Color::ZERO } else { Color::ONE };
+                }
+            }
+        }
         let mut through = Color::ONE;
         for _ in 0..MAX_SHADOW_CROSSINGS {
             let Some(hit) = self.world.intersect(&ray) else {
@@ -405,4 +434,22 @@ impl<'a> Whitted<'a> {
         }
         Color::ZERO
     }
+}
+
+/// Which entries of `world` stop shadow rays outright, when some material
+/// lets light through: those of materials that let none through (with
+/// `caustics`, also those that bend light, whose light the map carries).
+/// `None` when no material lets light through (shadow rays then take the
+/// plain any-hit query) or for a world with instances.
+fn opaque_entries(
+    world: &World<'_>,
+    materials: &[Material],
+    caustics: Option<&CausticMap>,
+) -> Option<OpaqueEntries> {
+    if !materials.iter().any(Material::is_transmissive) {
+        return None;
+    }
+    let stops =
+        |m: &Material| !m.is_transmissive() || (caustics.is_some() && photon_map::bends_light(m));
+    world.opaque_entries(&materials.iter().map(stops).collect::<Vec<_>>())
 }

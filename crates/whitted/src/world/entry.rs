@@ -184,7 +184,12 @@ pub(super) fn leaf_occludes(
 /// Only called where the processor has AVX.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-fn triangle_run(entries: &[Entry], entry: u32, end: u32, query: &Query) -> Option<(u32, Hits4)> {
+pub(super) fn triangle_run(
+    entries: &[Entry],
+    entry: u32,
+    end: u32,
+    query: &Query,
+) -> Option<(u32, Hits4)> {
     let available = (end - entry).min(LANES as u32) as usize;
     let entries = &entries[entry as usize..entry as usize + available];
     let run = entries

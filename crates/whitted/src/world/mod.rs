@@ -34,6 +34,7 @@ mod instance;
 mod objects;
 mod packet;
 mod shadow_hint;
+mod shadow_path;
 
 pub use hit::{Hit, Surface};
 pub use objects::{
@@ -42,6 +43,7 @@ pub use objects::{
 };
 pub use packet::{PACKET_SIZE, PacketHits, RayPacket};
 pub use shadow_hint::ShadowHint;
+pub use shadow_path::{OpaqueEntries, ShadowPath};
 
 use crate::accel::{
     AccelKind, AccelerationStructure, Accelerator, Clipper, KdTree, KdTreeBuildParams, QueryContext,

@@ -13,7 +13,7 @@ use crate::world::entry::{EntryKind, Query, intersect_triangle, leaf_occludes};
 /// The entry that blocked the last shadow ray of one thread towards one
 /// light, if it was one the hinted query can test alone.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ShadowHint(u32);
+pub struct ShadowHint(pub(super) u32);
 
 impl ShadowHint {
     /// No entry to try first.
