@@ -118,3 +118,51 @@ pub struct Unobserved;
 impl RayObserver for Unobserved {
     const READS_UV: bool = false;
 }
+
+/// The observer that keeps the camera ray's first hit and its surface,
+/// for the per-pixel data (AOVs), and watches nothing else. It reads no
+/// (u, v), so the surfaces it is shown are the renderer's own.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FirstHit {
+    /// The camera ray's first hit and its surface, once it was traced
+    /// (`None` also when it hit nothing).
+    pub hit: Option<(Hit, Surface)>,
+    seen: bool,
+}
+
+impl RayObserver for FirstHit {
+    const READS_UV: bool = false;
+
+    #[inline(always)]
+    fn ray_hit(&mut self, _ray: &Ray, hit: Option<(&Hit, &Surface)>) {
+        if !self.seen {
+            self.seen = true;
+            self.hit = hit.map(|(h, s)| (*h, *s));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vec3;
+    use crate::scene::default_scene;
+    use crate::world::World;
+
+    #[test]
+    fn first_hit_keeps_the_camera_rays_hit_not_a_later_one() {
+        let scene = default_scene();
+        let world = World::new(&scene.objects);
+        let down = Ray::new(Vec3::new(0.0, 50.0, 0.0), -Vec3::Y);
+        let hit = world.intersect(&down).unwrap();
+        let surface = world.surface(&down, &hit);
+        let mut first = FirstHit::default();
+        first.ray_hit(&down, Some((&hit, &surface)));
+        first.ray_hit(&down, None);
+        assert_eq!(first.hit, Some((hit, surface)));
+        let mut missed = FirstHit::default();
+        missed.ray_hit(&down, None);
+        missed.ray_hit(&down, Some((&hit, &surface)));
+        assert_eq!(missed.hit, None);
+    }
+}

@@ -121,7 +121,7 @@ impl<'a> Whitted<'a> {
         self.world
     }
 
-    /// The colour seen along a camera ray (unit direction), and its first hit.
+    /// The colour seen along a camera ray (unit direction).
     pub fn trace_primary(&self, ray: &Ray, counts: &mut RayCounts) -> PrimarySample {
         self.trace_primary_observed(ray, None, counts, &mut Unobserved)
     }
@@ -143,7 +143,6 @@ impl<'a> Whitted<'a> {
                 observer.ray_end(self.shading.background);
                 PrimarySample {
                     color: self.shading.background,
-                    first_hit: None,
                     cut_at: None,
                 }
             }
@@ -162,7 +161,6 @@ impl<'a> Whitted<'a> {
                 tally.observer.ray_end(color);
                 PrimarySample {
                     color,
-                    first_hit: Some((hit, surface)),
                     cut_at: tally.cut_at.map(|(material, _)| material),
                 }
             }

@@ -45,7 +45,7 @@ use std::sync::{Mutex, PoisonError};
 
 use crate::image::{ColorSpace, Film};
 use crate::integrator::{
-    Integrator, RayCounts, RayKind, RecursionLimits, SECONDARY_RAY_BUDGET, Shading,
+    FirstHit, Integrator, RayCounts, RayKind, RecursionLimits, SECONDARY_RAY_BUDGET, Shading,
 };
 use crate::limits::{MemoryBudget, MemoryError};
 use crate::math::Ray;
@@ -565,12 +565,22 @@ fn render_tile(
             for s in 0..spp {
                 let ray = sample_ray(camera, settings, (x, y), pattern, s);
                 let differential = sample_differential(camera, settings, (x, y), pattern, s);
-                let sample = integrator.trace_camera_ray(&ray, differential, &mut tile.rays);
+                // With one sample, the AOVs are those of the ray just traced.
+                let sample = if spp == 1 && !settings.aovs.is_empty() {
+                    let mut first = FirstHit::default();
+                    let sample = integrator.trace_primary_observed(
+                        &ray,
+                        differential,
+                        &mut tile.rays,
+                        &mut first,
+                    );
+                    centre = Some((ray, first.hit));
+                    sample
+                } else {
+                    integrator.trace_camera_ray(&ray, differential, &mut tile.rays)
+                };
                 if let Some(material) = sample.cut_at {
                     *tile.cuts.entry(material).or_default() += 1;
-                }
-                if spp == 1 {
-                    centre = Some((ray, sample.first_hit));
                 }
                 sum += sample.color;
             }
