@@ -73,6 +73,14 @@ impl Sphere {
         })
     }
 
+    /// The sphere of `center` and `radius` taken from a sphere that
+    /// [`Sphere::new`] accepted (a world keeps them beside its other
+    /// entries and rebuilds the sphere to test it).
+    #[inline(always)]
+    pub(crate) fn from_accepted(center: Vec3, radius: f64) -> Self {
+        Self { center, radius }
+    }
+
     /// The centre.
     pub fn center(&self) -> Vec3 {
         self.center

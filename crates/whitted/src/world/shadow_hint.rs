@@ -8,7 +8,7 @@
 use crate::accel::{AccelerationStructure, QueryContext};
 use crate::math::Ray;
 use crate::world::World;
-use crate::world::entry::{EntryKind, Query, intersect_triangle, leaf_occludes};
+use crate::world::entry::{EntryKind, Query, leaf_occludes};
 
 /// The entry that blocked the last shadow ray of one thread towards one
 /// light, if it was one the hinted query can test alone.
@@ -37,8 +37,8 @@ impl World<'_> {
         }
         let query = Query::new(ray, self.has_triangles);
         if let Some(e) = self.entries.get(hint.0 as usize) {
-            let blocks = match e.corners() {
-                Some(corners) => intersect_triangle(corners, &query, ray.t_max).is_some(),
+            let blocks = match e.occludes_in_place(&query) {
+                Some(blocks) => blocks,
                 None => e.kind == EntryKind::Primitive && self.shape_occludes(e.number, &query),
             };
             if blocks {

@@ -11,7 +11,7 @@ use crate::math::Ray;
 use crate::shape::Shape;
 #[cfg(target_arch = "x86_64")]
 use crate::world::entry::triangle_run;
-use crate::world::entry::{Entry, EntryKind, Query, intersect_triangle};
+use crate::world::entry::{Entry, EntryKind, Query};
 use crate::world::{MaterialId, PrimitiveRef, ShadowHint, World};
 
 /// Which of a world's entries stop light: those every hit of which shows a
@@ -60,7 +60,10 @@ impl World<'_> {
 
     /// The one material every hit on entry `e` shows, if there is one.
     fn entry_material(&self, e: &Entry) -> Option<MaterialId> {
-        if !matches!(e.kind, EntryKind::Triangle | EntryKind::Primitive) {
+        if !matches!(
+            e.kind,
+            EntryKind::Triangle | EntryKind::Sphere | EntryKind::Primitive
+        ) {
             return None;
         }
         match self.primitive_ref(e.number) {
@@ -94,8 +97,8 @@ impl World<'_> {
         if let Some(e) = self.entries.get(hint.0 as usize)
             && opaque.entries[hint.0 as usize]
         {
-            let blocks = match e.corners() {
-                Some(corners) => intersect_triangle(corners, &query, ray.t_max).is_some(),
+            let blocks = match e.occludes_in_place(&query) {
+                Some(blocks) => blocks,
                 None => self.shape_occludes(e.number, &query),
             };
             if blocks {
@@ -134,8 +137,8 @@ impl World<'_> {
                     continue;
                 }
                 let e = &self.entries[entry as usize];
-                let meets = match e.corners() {
-                    Some(corners) => intersect_triangle(corners, &query, ray.t_max).is_some(),
+                let meets = match e.occludes_in_place(&query) {
+                    Some(meets) => meets,
                     None => self.shape_occludes(e.number, &query),
                 };
                 if meets {
