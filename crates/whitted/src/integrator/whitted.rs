@@ -29,7 +29,7 @@ use crate::integrator::observer::{RayObserver, ShadowStep, Unobserved};
 use crate::integrator::photon_map::{self, CausticMap};
 use crate::integrator::shadow_cache;
 use crate::integrator::{PrimarySample, RayCounts, RayKind, RecursionLimits, Shading};
-use crate::math::{Ray, Vec3, offset_ray_origin};
+use crate::math::{Ray, RayOrigins, Vec3, offset_ray_origin};
 use crate::shading::differential::Bend;
 use crate::shading::optics::reflect;
 use crate::shading::{
@@ -232,6 +232,9 @@ impl<'a> Whitted<'a> {
 
         let diffuse = m.diffuse.filtered(s.uv, footprint);
         let specular = m.specular.filtered(s.uv, footprint);
+        // The shadow rays and the secondary rays leave from the same two
+        // origins, one per side of the surface.
+        let mut origins = RayOrigins::new(s.point, s.point_error, s.normal);
         if alpha != Color::ZERO && (diffuse != Color::ZERO || specular != Color::ZERO) {
             for (index, light, sample) in direct_samples(self.shading.lights, s.point) {
                 let n_dot_l = n.dot(sample.to_light);
@@ -239,8 +242,14 @@ impl<'a> Whitted<'a> {
                     tally.observer.light(index, Some(&sample), None);
                     continue;
                 }
-                let shadow =
-                    self.transmittance(s, (index, light), sample.to_light, sample.distance, tally);
+                let shadow = self.transmittance(
+                    s,
+                    &mut origins,
+                    (index, light),
+                    sample.to_light,
+                    sample.distance,
+                    tally,
+                );
                 tally.observer.light(index, Some(&sample), Some(shadow));
                 if shadow == Color::ZERO {
                     continue;
@@ -315,7 +324,7 @@ impl<'a> Whitted<'a> {
         {
             tally.counts[RayKind::Reflected] += 1;
             let dir = reflect(incident, n);
-            let origin = offset_ray_origin(s.point, s.point_error, s.normal, dir);
+            let origin = origins.towards(dir);
             let reflected = Ray::new(origin, dir);
             let kind = RayKind::Reflected;
             tally
@@ -334,7 +343,7 @@ impl<'a> Whitted<'a> {
             let child = weight * transmitted_weight.max_element();
             if child >= self.limits.min_weight && tally.take(s.material, branches) {
                 tally.counts[RayKind::Refracted] += 1;
-                let origin = offset_ray_origin(s.point, s.point_error, s.normal, dir);
+                let origin = origins.towards(dir);
                 let refracted = Ray::new(origin, dir);
                 let kind = RayKind::Refracted;
                 tally
@@ -359,17 +368,19 @@ impl<'a> Whitted<'a> {
     /// How much of `light` (number `index`) reaches `s` along `to_light` (unit) over
     /// `distance`: 0 behind an opaque surface, the product of what every
     /// transmissive or dissolved surface crossed lets through otherwise
-    /// ([`Material::pass_through`]).
+    /// ([`Material::pass_through`]). The shadow ray leaves from `s`'s
+    /// `origins`.
     fn transmittance<O: RayObserver>(
         &self,
         s: &Surface,
+        origins: &mut RayOrigins,
         (index, light): (usize, &Light),
         to_light: Vec3,
         distance: f64,
         tally: &mut SampleTally<'_, O>,
     ) -> Color {
         tally.counts[RayKind::Shadow] += 1;
-        let origin = offset_ray_origin(s.point, s.point_error, s.normal, to_light);
+        let origin = origins.towards(to_light);
         let target = match light {
             Light::Directional { .. } => None,
             Light::Point { position, .. } | Light::Spot { position, .. } => Some(*position),

@@ -435,9 +435,15 @@ impl Transform {
 /// The bound is doubled to also cover the rounding of the next ray's trip into
 /// object space.
 pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
+    offset_to_side(p, p_error, n, w.dot(n) < 0.0)
+}
+
+/// [`offset_ray_origin`] for any direction on the side of `n` that `below`
+/// says (true: against `n`), which is all the direction decides.
+fn offset_to_side(p: Vec3, p_error: Vec3, n: Vec3, below: bool) -> Vec3 {
     let d = 2.0 * n.abs().dot(p_error);
     let mut offset = d * n;
-    if w.dot(n) < 0.0 {
+    if below {
         offset = -offset;
     }
     let po = p + offset;
@@ -446,6 +452,43 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
         round_away(po.y, offset.y),
         round_away(po.z, offset.z),
     )
+}
+
+/// The origins of the rays leaving one surface point, one per side of its
+/// geometric normal, each computed by [`offset_ray_origin`] the first time
+/// a ray leaves on that side: a point lit by several lights, or that
+/// reflects and refracts, pays for each side once, with the same origins
+/// to the bit.
+#[derive(Clone, Copy, Debug)]
+pub struct RayOrigins {
+    p: Vec3,
+    p_error: Vec3,
+    n: Vec3,
+    /// Above (along `n`) and below.
+    sides: [Option<Vec3>; 2],
+}
+
+impl RayOrigins {
+    /// The origins for point `p` with absolute error bound `p_error` and
+    /// geometric normal `n`, none computed yet.
+    #[inline]
+    pub fn new(p: Vec3, p_error: Vec3, n: Vec3) -> Self {
+        Self {
+            p,
+            p_error,
+            n,
+            sides: [None; 2],
+        }
+    }
+
+    /// The origin of a ray leaving in direction `w`:
+    /// `offset_ray_origin(p, p_error, n, w)`.
+    #[inline]
+    pub fn towards(&mut self, w: Vec3) -> Vec3 {
+        let below = w.dot(self.n) < 0.0;
+        let (p, p_error, n) = (self.p, self.p_error, self.n);
+        *self.sides[usize::from(below)].get_or_insert_with(|| offset_to_side(p, p_error, n, below))
+    }
 }
 
 /// Moves `value` one ulp further in the direction of `offset`'s sign.
@@ -604,6 +647,25 @@ mod tests {
         let up = offset_ray_origin(p, err, Vec3::Y, Vec3::new(0.0, 1.0, 1.0));
         let down = offset_ray_origin(p, err, Vec3::Y, Vec3::new(0.0, -1.0, 1.0));
         assert!(up.y > 0.0 && down.y < 0.0);
+    }
+
+    #[test]
+    fn kept_origins_are_offset_ray_origin_for_every_direction() {
+        let mut rng = random::Rng::new(5);
+        for _ in 0..2000 {
+            let p = 1e3 * rng.unit_vector() * rng.uniform();
+            let err = Vec3::splat(1e-12 * (1.0 + 1e6 * rng.uniform())) * p.abs().max_element();
+            let n = rng.unit_vector();
+            let mut origins = RayOrigins::new(p, err, n);
+            for _ in 0..4 {
+                let w = match rng.uniform() {
+                    u if u < 0.1 => n.any_orthonormal_vector(),
+                    _ => rng.unit_vector(),
+                };
+                let want = offset_ray_origin(p, err, n, w);
+                assert_eq!(origins.towards(w), want, "{p:?} {n:?} {w:?}");
+            }
+        }
     }
 
     #[test]
