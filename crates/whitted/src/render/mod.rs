@@ -40,6 +40,7 @@ pub use sources::{LineIndex, ObjectSource, ObjectSources, PrimitiveDescription, 
 pub use trace_timing::TraceTiming;
 
 use std::collections::HashMap;
+use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Mutex, PoisonError};
 
@@ -48,7 +49,7 @@ use crate::integrator::{
     FirstHit, Integrator, RayCounts, RayKind, RecursionLimits, SECONDARY_RAY_BUDGET, Shading,
 };
 use crate::limits::{MemoryBudget, MemoryError};
-use crate::math::Ray;
+use crate::math::{Ray, Vec3};
 use crate::shading::Color;
 use crate::world::{Hit, MAX_PRIMITIVES, MaterialId, Surface, World};
 use adaptive::{AdaptivePixels, Cost};
@@ -528,7 +529,6 @@ fn render_tile(
         cuts: HashMap::new(),
         selected: 0,
     };
-    let spp = settings.samples_per_pixel;
     let mut adaptive = match settings.aa {
         AntiAliasing::Stratified => None,
         AntiAliasing::Adaptive(a) => Some(AdaptivePixels::new(
@@ -539,57 +539,153 @@ fn render_tile(
             a,
         )),
     };
+    let row = x0..x0 + width;
+    let mut samples = RowSamples::new(settings, width);
     for y in y0..y0 + height {
-        for x in x0..x0 + width {
-            if !selection.contains(x, y) {
-                tile.color.extend_from_slice(&[0.0; 3]);
-                for (aov, data) in settings.aovs.iter().zip(&mut tile.aovs) {
-                    data.resize(data.len() + aov.channels(), 0.0);
+        match &mut adaptive {
+            Some(adaptive) => adaptive_row(
+                integrator,
+                camera,
+                settings,
+                selection,
+                adaptive,
+                (row.clone(), y),
+                &mut tile,
+            ),
+            None => samples.trace(
+                integrator,
+                camera,
+                settings,
+                selection,
+                (row.clone(), y),
+                &mut tile,
+            ),
+        }
+    }
+    tile
+}
+
+/// The pixels `row` of row `y` sampled adaptively, appended to `tile`.
+fn adaptive_row(
+    integrator: &Integrator,
+    camera: &Camera,
+    settings: &RenderSettings,
+    selection: &PixelSelection,
+    adaptive: &mut AdaptivePixels,
+    (row, y): (Range<u32>, u32),
+    tile: &mut Tile,
+) {
+    for x in row {
+        if !selection.contains(x, y) {
+            push_unselected(settings, tile);
+            continue;
+        }
+        tile.selected += 1;
+        let mut cost = Cost {
+            rays: &mut tile.rays,
+            cuts: &mut tile.cuts,
+        };
+        let color = adaptive.pixel(x, y, &mut cost);
+        tile.color.extend_from_slice(&color.to_f32());
+        push_aovs(integrator, camera, settings, x, y, None, &mut tile.aovs);
+    }
+}
+
+/// The ray through a pixel's centre and its first hit, if any.
+type Centre = (Ray, Option<(Hit, Surface)>);
+
+/// A tile's stratified samples, a row at a time: the row's camera rays
+/// for one sample index are made before any is traced, so that their
+/// square roots and divisions overlap rather than each waiting for the
+/// previous pixel's trace (jacks at 1024x1024 on one thread: 1.16x).
+struct RowSamples {
+    rays: [Ray; TILE_SIZE as usize],
+    patterns: [u32; TILE_SIZE as usize],
+    sums: [Color; TILE_SIZE as usize],
+    /// With one sample and AOVs, each pixel's ray and its first hit.
+    centres: Vec<Option<Centre>>,
+}
+
+impl RowSamples {
+    /// Room for rows of `width` pixels rendered with `settings`.
+    fn new(settings: &RenderSettings, width: u32) -> Self {
+        let keep_centres = settings.samples_per_pixel == 1 && !settings.aovs.is_empty();
+        Self {
+            rays: [Ray::new(Vec3::ZERO, Vec3::Z); TILE_SIZE as usize],
+            patterns: [0; TILE_SIZE as usize],
+            sums: [Color::ZERO; TILE_SIZE as usize],
+            centres: vec![None; if keep_centres { width as usize } else { 0 }],
+        }
+    }
+
+    /// The pixels `row` of row `y`, each the mean of its samples, appended
+    /// to `tile` (the unselected ones black).
+    fn trace(
+        &mut self,
+        integrator: &Integrator,
+        camera: &Camera,
+        settings: &RenderSettings,
+        selection: &PixelSelection,
+        (row, y): (Range<u32>, u32),
+        tile: &mut Tile,
+    ) {
+        let spp = settings.samples_per_pixel;
+        for (i, x) in row.clone().enumerate() {
+            self.patterns[i] = pixel_pattern(x, y);
+            self.sums[i] = Color::ZERO;
+        }
+        for s in 0..spp {
+            for (i, x) in row.clone().enumerate() {
+                self.rays[i] = sample_ray(camera, settings, (x, y), self.patterns[i], s);
+            }
+            for (i, x) in row.clone().enumerate() {
+                if !selection.contains(x, y) {
+                    continue;
                 }
-                continue;
-            }
-            tile.selected += 1;
-            if let Some(adaptive) = &mut adaptive {
-                let mut cost = Cost {
-                    rays: &mut tile.rays,
-                    cuts: &mut tile.cuts,
-                };
-                let color = adaptive.pixel(x, y, &mut cost);
-                tile.color.extend_from_slice(&color.to_f32());
-                push_aovs(integrator, camera, settings, x, y, None, &mut tile.aovs);
-                continue;
-            }
-            let pattern = pixel_pattern(x, y);
-            let mut sum = Color::ZERO;
-            let mut centre = None;
-            for s in 0..spp {
-                let ray = sample_ray(camera, settings, (x, y), pattern, s);
-                let differential = sample_differential(camera, settings, (x, y), pattern, s);
-                // With one sample, the AOVs are those of the ray just traced.
-                let sample = if spp == 1 && !settings.aovs.is_empty() {
-                    let mut first = FirstHit::default();
-                    let sample = integrator.trace_primary_observed(
-                        &ray,
-                        differential,
-                        &mut tile.rays,
-                        &mut first,
-                    );
-                    centre = Some((ray, first.hit));
-                    sample
-                } else {
-                    integrator.trace_camera_ray(&ray, differential, &mut tile.rays)
+                let ray = &self.rays[i];
+                let differential =
+                    sample_differential(camera, settings, (x, y), self.patterns[i], s);
+                let sample = match self.centres.get_mut(i) {
+                    Some(centre) => {
+                        let mut first = FirstHit::default();
+                        let sample = integrator.trace_primary_observed(
+                            ray,
+                            differential,
+                            &mut tile.rays,
+                            &mut first,
+                        );
+                        *centre = Some((*ray, first.hit));
+                        sample
+                    }
+                    None => integrator.trace_camera_ray(ray, differential, &mut tile.rays),
                 };
                 if let Some(material) = sample.cut_at {
                     *tile.cuts.entry(material).or_default() += 1;
                 }
-                sum += sample.color;
+                self.sums[i] += sample.color;
             }
-            let color = sum / f64::from(spp);
+        }
+        for (i, x) in row.enumerate() {
+            if !selection.contains(x, y) {
+                push_unselected(settings, tile);
+                continue;
+            }
+            tile.selected += 1;
+            let color = self.sums[i] / f64::from(spp);
             tile.color.extend_from_slice(&color.to_f32());
+            let centre = self.centres.get_mut(i).and_then(Option::take);
             push_aovs(integrator, camera, settings, x, y, centre, &mut tile.aovs);
         }
     }
-    tile
+}
+
+/// Appends a pixel left out of the selection to `tile`: black, and zero
+/// in every AOV.
+fn push_unselected(settings: &RenderSettings, tile: &mut Tile) {
+    tile.color.extend_from_slice(&[0.0; 3]);
+    for (aov, data) in settings.aovs.iter().zip(&mut tile.aovs) {
+        data.resize(data.len() + aov.channels(), 0.0);
+    }
 }
 
 /// Appends the AOVs of pixel (`x`, `y`): those of the ray through its
@@ -600,7 +696,7 @@ fn push_aovs(
     settings: &RenderSettings,
     x: u32,
     y: u32,
-    centre: Option<(Ray, Option<(Hit, Surface)>)>,
+    centre: Option<Centre>,
     aovs: &mut [Vec<f32>],
 ) {
     if settings.aovs.is_empty() {
