@@ -236,7 +236,7 @@ impl<'a> Whitted<'a> {
         // origins, one per side of the surface.
         let mut origins = RayOrigins::new(s.point, s.point_error, s.normal);
         if alpha != Color::ZERO && (diffuse != Color::ZERO || specular != Color::ZERO) {
-            for (index, light, sample) in direct_samples(self.shading.lights, s.point) {
+            for (index, light, sample) in direct_samples(self.shading.lights, s.point).ahead() {
                 let n_dot_l = n.dot(sample.to_light);
                 if n_dot_l <= 0.0 || (bumped && facing.dot(sample.to_light) <= 0.0) {
                     tally.observer.light(index, Some(&sample), None);
