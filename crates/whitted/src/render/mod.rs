@@ -220,21 +220,23 @@ struct Films {
 }
 
 impl Films {
-    /// Copies a finished tile in.
-    fn add(&mut self, tile: Tile) {
+    /// Copies a finished tile in, a row of its pixels at a time (the
+    /// caller holds the lock around the films meanwhile, and drops the
+    /// tile after).
+    fn add(&mut self, tile: &Tile) {
         self.rays += tile.rays;
-        for (material, samples) in tile.cuts {
+        for (&material, &samples) in &tile.cuts {
             *self.cuts.entry(material).or_default() += samples;
         }
+        let width = tile.width as usize;
         for dy in 0..tile.height {
-            for dx in 0..tile.width {
-                let i = (dy * tile.width + dx) as usize;
-                let (x, y) = (tile.x0 + dx, tile.y0 + dy);
-                self.image.set_pixel(x, y, &tile.color[3 * i..3 * i + 3]);
-                for ((aov, film), data) in self.aovs.iter_mut().zip(&tile.aovs) {
-                    let c = aov.channels();
-                    film.set_pixel(x, y, &data[c * i..c * i + c]);
-                }
+            let row = dy as usize * width..(dy as usize + 1) * width;
+            let y = tile.y0 + dy;
+            self.image
+                .set_row(tile.x0, y, &tile.color[3 * row.start..3 * row.end]);
+            for ((aov, film), data) in self.aovs.iter_mut().zip(&tile.aovs) {
+                let c = aov.channels();
+                film.set_row(tile.x0, y, &data[c * row.start..c * row.end]);
             }
         }
     }
@@ -378,7 +380,7 @@ fn trace_pixels(
     .with_caustics(caustics.map(|(map, _)| map));
     let total = selection.pixel_count();
     let done = AtomicU64::new(0);
-    let films = Mutex::new(Films {
+    let mut films = Films {
         image: Film::new(width, height, 3).with_color_space(scene.color_space),
         aovs: settings
             .aovs
@@ -387,7 +389,12 @@ fn trace_pixels(
             .collect(),
         rays: RayCounts::default(),
         cuts: HashMap::new(),
+    };
+    pool.install(|| {
+        films.image.map_pages();
+        films.aovs.iter_mut().for_each(|(_, film)| film.map_pages());
     });
+    let films = Mutex::new(films);
     let clock = trace_timing::TraceClock::start();
     // Each worker takes the next tile from a shared counter until none is
     // left: a thread that finishes early takes more, so both cores stay
@@ -415,7 +422,7 @@ fn trace_pixels(
             films
                 .lock()
                 .unwrap_or_else(PoisonError::into_inner)
-                .add(tile);
+                .add(&tile);
             let now = done.fetch_add(pixels, Ordering::Relaxed) + pixels;
             progress(Progress { done: now, total });
         }
