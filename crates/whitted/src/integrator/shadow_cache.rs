@@ -23,12 +23,7 @@ pub(super) fn occluded(world: &World<'_>, ray: &Ray, light: usize) -> bool {
     if light >= CACHED_LIGHTS {
         return world.occluded(ray);
     }
-    HINTS.with(|hints| {
-        let mut hint = hints[light].get();
-        let blocked = world.occluded_hinted(ray, &mut hint);
-        hints[light].set(hint);
-        blocked
-    })
+    with_hint(light, |hint| world.occluded_hinted(ray, hint))
 }
 
 /// What lies along `ray`, a shadow ray towards light number `light`, in a
@@ -42,11 +37,17 @@ pub(super) fn shadow_path(
     if light >= CACHED_LIGHTS {
         return world.shadow_path(ray, opaque, &mut ShadowHint::default());
     }
+    with_hint(light, |hint| world.shadow_path(ray, opaque, hint))
+}
+
+/// `query` given this thread's hint for light `light` (below
+/// [`CACHED_LIGHTS`]), keeping the hint it leaves.
+fn with_hint<T>(light: usize, query: impl FnOnce(&mut ShadowHint) -> T) -> T {
     HINTS.with(|hints| {
         let mut hint = hints[light].get();
-        let path = world.shadow_path(ray, opaque, &mut hint);
+        let answer = query(&mut hint);
         hints[light].set(hint);
-        path
+        answer
     })
 }
 

@@ -207,24 +207,44 @@ pub(super) fn leaf_occludes(
     range: Range<u32>,
     query: &Query,
     wide: bool,
+    other: impl FnMut(&Entry) -> bool,
+) -> Option<u32> {
+    leaf_meets(entries, range, query, wide, other, |_| true)
+}
+
+/// [`leaf_occludes`] that shows `stops` each entry found in the interval,
+/// in order, and ends at the first one it says stops the walk, returning
+/// it; entries that do not are only shown.
+#[inline(always)]
+pub(super) fn leaf_meets(
+    entries: &[Entry],
+    range: Range<u32>,
+    query: &Query,
+    wide: bool,
     mut other: impl FnMut(&Entry) -> bool,
+    mut stops: impl FnMut(u32) -> bool,
 ) -> Option<u32> {
     let mut entry = range.start;
     while entry < range.end {
         #[cfg(target_arch = "x86_64")]
         if wide && let Some((run, hits)) = triangle_run(entries, entry, range.end, query) {
-            if hits.mask != 0 {
-                return Some(entry + hits.mask.trailing_zeros());
+            let mut mask = hits.mask;
+            while mask != 0 {
+                let hit = entry + mask.trailing_zeros();
+                if stops(hit) {
+                    return Some(hit);
+                }
+                mask &= mask - 1;
             }
             entry += run;
             continue;
         }
         let e = &entries[entry as usize];
-        let occludes = match e.occludes_in_place(query) {
-            Some(occludes) => occludes,
+        let meets = match e.occludes_in_place(query) {
+            Some(meets) => meets,
             None => other(e),
         };
-        if occludes {
+        if meets && stops(entry) {
             return Some(entry);
         }
         entry += 1;
@@ -239,12 +259,7 @@ pub(super) fn leaf_occludes(
 /// Only called where the processor has AVX.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-pub(super) fn triangle_run(
-    entries: &[Entry],
-    entry: u32,
-    end: u32,
-    query: &Query,
-) -> Option<(u32, Hits4)> {
+fn triangle_run(entries: &[Entry], entry: u32, end: u32, query: &Query) -> Option<(u32, Hits4)> {
     let available = (end - entry).min(LANES as u32) as usize;
     let entries = &entries[entry as usize..entry as usize + available];
     let run = entries

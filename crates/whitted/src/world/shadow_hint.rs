@@ -27,6 +27,20 @@ impl Default for ShadowHint {
 }
 
 impl World<'_> {
+    /// Whether the entry `hint` names lies in the query's ray interval,
+    /// with the test the any-hit walk runs on it; false for no entry, or
+    /// for one that cannot be tested alone (an instance).
+    #[inline]
+    pub(super) fn hint_blocks(&self, hint: ShadowHint, query: &Query) -> bool {
+        let Some(e) = self.entries.get(hint.0 as usize) else {
+            return false;
+        };
+        match e.occludes_in_place(query) {
+            Some(blocks) => blocks,
+            None => e.kind == EntryKind::Primitive && self.shape_occludes(e.number, query),
+        }
+    }
+
     /// [`World::occluded`], trying `hint`'s entry first and leaving in it
     /// the entry that blocked `ray`. Worlds with instances take the plain
     /// query (their hint stays empty).
@@ -36,14 +50,8 @@ impl World<'_> {
             return self.occluded(ray);
         }
         let query = Query::new(ray, self.has_triangles);
-        if let Some(e) = self.entries.get(hint.0 as usize) {
-            let blocks = match e.occludes_in_place(&query) {
-                Some(blocks) => blocks,
-                None => e.kind == EntryKind::Primitive && self.shape_occludes(e.number, &query),
-            };
-            if blocks {
-                return true;
-            }
+        if self.hint_blocks(*hint, &query) {
+            return true;
         }
         *hint = ShadowHint::NONE;
         if self

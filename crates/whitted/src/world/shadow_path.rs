@@ -9,9 +9,7 @@
 use crate::accel::{AccelerationStructure, QueryContext};
 use crate::math::Ray;
 use crate::shape::Shape;
-#[cfg(target_arch = "x86_64")]
-use crate::world::entry::triangle_run;
-use crate::world::entry::{Entry, EntryKind, Query};
+use crate::world::entry::{Entry, EntryKind, Query, leaf_meets};
 use crate::world::{MaterialId, PrimitiveRef, ShadowHint, World};
 
 /// Which of a world's entries stop light: those every hit of which shows a
@@ -94,16 +92,8 @@ impl World<'_> {
         let query = Query::new(ray, self.has_triangles);
         // A hint left by another query may name any entry: only one that
         // stops light can answer for the walk.
-        if let Some(e) = self.entries.get(hint.0 as usize)
-            && opaque.entries[hint.0 as usize]
-        {
-            let blocks = match e.occludes_in_place(&query) {
-                Some(blocks) => blocks,
-                None => self.shape_occludes(e.number, &query),
-            };
-            if blocks {
-                return ShadowPath::Blocked;
-            }
+        if opaque.entries.get(hint.0 as usize) == Some(&true) && self.hint_blocks(*hint, &query) {
+            return ShadowPath::Blocked;
         }
         *hint = ShadowHint::NONE;
         let mut crossed = false;
@@ -117,40 +107,21 @@ impl World<'_> {
         }
         let mut ctx = QueryContext::default();
         let blocked = self.accel.occluded_in_leaf_order(ray, &mut ctx, |range| {
-            let mut entry = range.start;
-            while entry < range.end {
-                #[cfg(target_arch = "x86_64")]
-                if self.wide_triangles
-                    && let Some((run, hits)) = triangle_run(&self.entries, entry, range.end, &query)
-                {
-                    let mut mask = hits.mask;
-                    while mask != 0 {
-                        let hit = entry + mask.trailing_zeros();
-                        if opaque.entries[hit as usize] {
-                            *hint = ShadowHint(hit);
-                            return true;
-                        }
-                        crossed = true;
-                        mask &= mask - 1;
-                    }
-                    entry += run;
-                    continue;
-                }
-                let e = &self.entries[entry as usize];
-                let meets = match e.occludes_in_place(&query) {
-                    Some(meets) => meets,
-                    None => self.shape_occludes(e.number, &query),
-                };
-                if meets {
-                    if opaque.entries[entry as usize] {
-                        *hint = ShadowHint(entry);
-                        return true;
-                    }
-                    crossed = true;
-                }
-                entry += 1;
+            let blocker = leaf_meets(
+                &self.entries,
+                range,
+                &query,
+                self.wide_triangles,
+                |e| self.shape_occludes(e.number, &query),
+                |entry| {
+                    crossed |= !opaque.entries[entry as usize];
+                    opaque.entries[entry as usize]
+                },
+            );
+            if let Some(entry) = blocker {
+                *hint = ShadowHint(entry);
             }
-            false
+            blocker.is_some()
         });
         if blocked {
             ShadowPath::Blocked
