@@ -109,9 +109,16 @@ impl<'a> Whitted<'a> {
     /// and stops shadow rays at surfaces that bend light (the map carries
     /// that light); `None` leaves it as it was.
     pub fn with_caustics(self, caustics: Option<&'a CausticMap>) -> Self {
+        // Which entries stop shadow rays depends only on whether there is
+        // a map: kept when that does not change (a pass over every entry).
+        let opaque = if caustics.is_some() == self.caustics.is_some() {
+            self.opaque
+        } else {
+            opaque_entries(self.world, self.shading.materials, caustics)
+        };
         Self {
             caustics,
-            opaque: opaque_entries(self.world, self.shading.materials, caustics),
+            opaque,
             ..self
         }
     }
