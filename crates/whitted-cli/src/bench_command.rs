@@ -13,7 +13,7 @@ use whitted::accel::{AccelKind, AccelStats, AccelerationStructure};
 use whitted::bench::obj_positions::load_obj_positions;
 use whitted::bench::ray_files::{RayFile, agreement, read_ray_file};
 use whitted::bench::{
-    RayKind, RaySet, TraceResults, check_bench_size, scene_ray_sets, time_set, trace_all,
+    RayKind, RaySet, TraceResults, Walk, check_bench_size, scene_ray_sets, time_set, trace_all,
 };
 use whitted::limits::MemoryBudget;
 use whitted::render::Camera;
@@ -77,6 +77,13 @@ pub struct BenchArgs {
     /// memory).
     #[arg(long, value_name = "SIZE", value_parser = whitted::limits::parse_size)]
     max_memory: Option<u64>,
+
+    /// Walk the closest-hit rays (primary, diffuse) in packets of 8
+    /// consecutive rays, as the renderer walks a tile row's camera rays
+    /// (together where the scene allows it; shadow rays stay single), to
+    /// compare with the single-ray walk.
+    #[arg(long)]
+    packets: bool,
 
     /// Print JSON instead of a table.
     #[arg(long)]
@@ -182,6 +189,11 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
             (sets, none)
         }
     };
+    let walk = if args.packets {
+        Walk::Packets
+    } else {
+        Walk::Single
+    };
     let total_rays: usize = sets.iter().map(|s| s.rays.len()).sum();
     let primitives = scene.objects.primitive_count();
 
@@ -207,20 +219,20 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
                 kind.name(),
                 set.kind.name()
             ));
-            let (results, counters) = trace_all(&world, set);
+            let (results, counters) = trace_all(&world, set, walk);
             let per_ray = |n: u64| n as f64 / set.rays.len().max(1) as f64;
             status.set(format!(
                 "{}: {} rays, 1 thread",
                 kind.name(),
                 set.kind.name()
             ));
-            let seconds_one = time_set(&world, set, 1, args.runs)?;
+            let seconds_one = time_set(&world, set, walk, 1, args.runs)?;
             status.set(format!(
                 "{}: {} rays, {all_threads} threads",
                 kind.name(),
                 set.kind.name()
             ));
-            let seconds_all = time_set(&world, set, all_threads, args.runs)?;
+            let seconds_all = time_set(&world, set, walk, all_threads, args.runs)?;
             kind_reports.push(KindReport {
                 kind: set.kind,
                 rays: set.rays.len(),
@@ -282,8 +294,13 @@ fn table(args: &BenchArgs, primitives: usize, threads: usize, reports: &[AccelRe
         Some(dir) => format!("rays from {}", dir.display()),
         None => format!("rays for a {}x{} image", args.width, args.height),
     };
+    let walk = if args.packets {
+        "; closest hits in packets of 8"
+    } else {
+        ""
+    };
     let mut lines = vec![format!(
-        "{}: {primitives} primitives; {source}; best of {} runs",
+        "{}: {primitives} primitives; {source}{walk}; best of {} runs",
         args.scene.display(),
         args.runs
     )];
@@ -369,6 +386,7 @@ fn to_json(args: &BenchArgs, primitives: usize, threads: usize, reports: &[Accel
         "width": args.width,
         "height": args.height,
         "runs": args.runs,
+        "packets": args.packets,
         "threads": threads,
         "structures": structures,
     })

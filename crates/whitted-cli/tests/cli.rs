@@ -309,6 +309,42 @@ fn ray_record(o: [f32; 3], d: [f32; 3], t_far: f32) -> Vec<u8> {
 }
 
 #[test]
+fn bench_walks_closest_hits_in_packets_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../whitted/tests/nff/spd_like.nff");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "bench",
+            scene.to_str().unwrap(),
+            "--accel",
+            "bvh",
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--runs",
+            "1",
+        ];
+        args.extend_from_slice(extra);
+        let out = whitted(&args, dir.path());
+        assert!(out.status.success(), "{}", stderr(&out));
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let table = run(&["--packets"]);
+    assert!(table.contains("closest hits in packets of 8"), "{table}");
+    let report: serde_json::Value = serde_json::from_str(&run(&["--packets", "--json"])).unwrap();
+    assert_eq!(report["packets"], true);
+    let single: serde_json::Value = serde_json::from_str(&run(&["--json"])).unwrap();
+    assert_eq!(single["packets"], false);
+    for kind in report["structures"][0]["kinds"].as_array().unwrap() {
+        assert!(
+            finite(&kind["mrays_per_s_1_thread"], "rate") > 0.0,
+            "{kind}"
+        );
+    }
+}
+
+#[test]
 fn bench_traces_anchor_ray_files_and_counts_agreement() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

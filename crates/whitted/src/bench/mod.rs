@@ -13,7 +13,7 @@ mod scene_rays;
 mod timing;
 
 pub use scene_rays::scene_ray_sets;
-pub use timing::{TraceResults, time_set, trace_all};
+pub use timing::{TraceResults, Walk, time_set, trace_all};
 
 use crate::accel::RayCoherence;
 use crate::limits::{MemoryBudget, MemoryError};

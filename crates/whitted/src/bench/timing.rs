@@ -8,10 +8,46 @@ use std::time::Instant;
 use super::RaySet;
 use crate::accel::{QueryContext, TraversalCounters};
 use crate::math::Ray;
-use crate::world::World;
+use crate::world::{Hit, PACKET_SIZE, World};
 
 /// Rays handed to a thread at a time (as the anchor's 16 × 16 tiles).
 const CHUNK: usize = 256;
+
+/// How the closest-hit queries of a set walk the structure.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Walk {
+    /// One ray at a time.
+    #[default]
+    Single,
+    /// [`PACKET_SIZE`] consecutive rays at a time
+    /// ([`World::intersect_packet`]: together where the world and the rays
+    /// allow it, one at a time otherwise). Any-hit sets walk one ray at a
+    /// time either way.
+    Packets,
+}
+
+/// The closest hits of `rays` (one thread's chunk), walked as `walk`
+/// says, each passed to `found` in order.
+fn closest_hits(
+    world: &World,
+    rays: &[Ray],
+    walk: Walk,
+    ctx: &mut QueryContext,
+    mut found: impl FnMut(Option<Hit>),
+) {
+    match walk {
+        Walk::Single => rays
+            .iter()
+            .for_each(|r| found(world.intersect_with(r, ctx))),
+        Walk::Packets => {
+            let mut hits = [None; PACKET_SIZE];
+            for packet in rays.chunks(PACKET_SIZE) {
+                world.intersect_packet(packet, ctx, &mut hits);
+                hits[..packet.len()].iter().for_each(|&h| found(h));
+            }
+        }
+    }
+}
 
 /// What a ray set's rays hit.
 #[derive(Clone, Debug, PartialEq)]
@@ -22,10 +58,10 @@ pub enum TraceResults {
     Occluded(Vec<bool>),
 }
 
-/// Traces every ray once on this thread, keeping each result, and counts the
-/// traversal work of all of them. Here and in [`time_set`] the queries are
+/// Traces every ray once on this thread, walking as `walk` says, keeping
+/// each result, and counts the traversal work of all of them. Here and in [`time_set`] the queries are
 /// told how the set's rays relate ([`super::RayKind::coherence`]).
-pub fn trace_all(world: &World, set: &RaySet) -> (TraceResults, TraversalCounters) {
+pub fn trace_all(world: &World, set: &RaySet, walk: Walk) -> (TraceResults, TraversalCounters) {
     let mut ctx = QueryContext::new(set.kind.coherence());
     let results = if set.kind.is_any_hit() {
         TraceResults::Occluded(
@@ -35,16 +71,11 @@ pub fn trace_all(world: &World, set: &RaySet) -> (TraceResults, TraversalCounter
                 .collect(),
         )
     } else {
-        TraceResults::Closest(
-            set.rays
-                .iter()
-                .map(|r| {
-                    world
-                        .intersect_with(r, &mut ctx)
-                        .map(|h| (h.t(), h.primitive.0))
-                })
-                .collect(),
-        )
+        let mut hits = Vec::with_capacity(set.rays.len());
+        closest_hits(world, &set.rays, walk, &mut ctx, |h| {
+            hits.push(h.map(|h| (h.t(), h.primitive.0)));
+        });
+        TraceResults::Closest(hits)
     };
     (results, ctx.counters)
 }
@@ -55,7 +86,13 @@ pub fn trace_all(world: &World, set: &RaySet) -> (TraceResults, TraversalCounter
 /// Each thread takes the next 256 rays from a shared counter until
 /// none are left, as the anchor harness hands out its tiles (tried rayon's
 /// `par_chunks`: scaled worse, see docs/performance.md).
-pub fn time_set(world: &World, set: &RaySet, threads: usize, runs: usize) -> Result<f64, String> {
+pub fn time_set(
+    world: &World,
+    set: &RaySet,
+    walk: Walk,
+    threads: usize,
+    runs: usize,
+) -> Result<f64, String> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -63,14 +100,14 @@ pub fn time_set(world: &World, set: &RaySet, threads: usize, runs: usize) -> Res
     let chunks: Vec<&[Ray]> = set.rays.chunks(CHUNK).collect();
     let next = AtomicUsize::new(0);
     let trace = |chunk: &[Ray], ctx: &mut QueryContext| {
-        let found = |r: &&Ray| {
-            if set.kind.is_any_hit() {
-                world.occluded_with(r, ctx)
-            } else {
-                world.intersect_with(r, ctx).is_some()
-            }
-        };
-        chunk.iter().filter(found).count()
+        if set.kind.is_any_hit() {
+            return chunk.iter().filter(|r| world.occluded_with(r, ctx)).count();
+        }
+        let mut count = 0;
+        closest_hits(world, chunk, walk, ctx, |h| {
+            count += usize::from(h.is_some())
+        });
+        count
     };
     let pass = || {
         next.store(0, Ordering::Relaxed);
@@ -92,4 +129,29 @@ pub fn time_set(world: &World, set: &RaySet, threads: usize, runs: usize) -> Res
         best = best.min(start.elapsed().as_secs_f64());
     }
     Ok(best)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bench::scene_ray_sets;
+    use crate::scene::default_scene;
+
+    #[test]
+    fn packets_find_what_single_rays_find_and_time_the_same_sets() {
+        let scene = default_scene();
+        let world = World::new(&scene.objects);
+        assert!(world.walks_packets());
+        let sets = scene_ray_sets(&scene, &world, 96, 64);
+        for set in &sets {
+            let (single, _) = trace_all(&world, set, Walk::Single);
+            let (packets, _) = trace_all(&world, set, Walk::Packets);
+            assert_eq!(single, packets, "{}", set.kind.name());
+            assert!(time_set(&world, set, Walk::Packets, 1, 1).unwrap() > 0.0);
+        }
+        let TraceResults::Closest(primary) = trace_all(&world, &sets[0], Walk::Packets).0 else {
+            panic!("primary rays ask for the closest hit");
+        };
+        assert!(primary.iter().filter(|h| h.is_some()).count() > 1000);
+    }
 }

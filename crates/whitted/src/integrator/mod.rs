@@ -168,6 +168,23 @@ impl<'a> Integrator<'a> {
         }
     }
 
+    /// [`Integrator::trace_primary_observed`] for a camera ray whose
+    /// closest hit `hit` is already found (by
+    /// [`World::intersect_packet`](crate::world::World::intersect_packet)).
+    #[inline]
+    pub fn shade_camera_hit<O: RayObserver>(
+        &self,
+        ray: &Ray,
+        hit: Option<Hit>,
+        differential: Option<RayDifferential>,
+        counts: &mut RayCounts,
+        observer: &mut O,
+    ) -> PrimarySample {
+        match self {
+            Integrator::Whitted(w) => w.shade_camera_hit(ray, hit, differential, counts, observer),
+        }
+    }
+
     /// The first hit along a ray and its surface, without shading.
     pub fn first_hit(&self, ray: &Ray) -> Option<(Hit, Surface)> {
         let world = self.world();

@@ -142,9 +142,29 @@ impl<'a> Whitted<'a> {
         counts: &mut RayCounts,
         observer: &mut O,
     ) -> PrimarySample {
+        self.shade_camera_hit(
+            ray,
+            self.world.intersect(ray),
+            differential,
+            counts,
+            observer,
+        )
+    }
+
+    /// [`Whitted::trace_primary_observed`] for a camera ray whose closest
+    /// hit `hit` is already found (by a packet of camera rays walked
+    /// together, see [`World::intersect_packet`]).
+    pub fn shade_camera_hit<O: RayObserver>(
+        &self,
+        ray: &Ray,
+        hit: Option<Hit>,
+        differential: Option<RayDifferential>,
+        counts: &mut RayCounts,
+        observer: &mut O,
+    ) -> PrimarySample {
         counts[RayKind::Primary] += 1;
         observer.ray_start(RayKind::Primary, ray, Color::ONE, 1.0);
-        match self.world.intersect(ray) {
+        match hit {
             None => {
                 observer.ray_hit(ray, None);
                 observer.ray_end(self.shading.background);

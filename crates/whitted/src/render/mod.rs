@@ -44,14 +44,16 @@ use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Mutex, PoisonError};
 
+use crate::accel::QueryContext;
 use crate::image::{ColorSpace, Film};
 use crate::integrator::{
     FirstHit, Integrator, RayCounts, RayKind, RecursionLimits, SECONDARY_RAY_BUDGET, Shading,
+    Unobserved,
 };
 use crate::limits::{MemoryBudget, MemoryError};
 use crate::math::{Ray, Vec3};
 use crate::shading::Color;
-use crate::world::{Hit, MAX_PRIMITIVES, MaterialId, Surface, World};
+use crate::world::{Hit, MAX_PRIMITIVES, MaterialId, PACKET_SIZE, Surface, World};
 use adaptive::{AdaptivePixels, Cost};
 use sample_ray::{pixel_pattern, sample_differential, sample_ray};
 
@@ -604,11 +606,16 @@ type Centre = (Ray, Option<(Hit, Surface)>);
 /// A tile's stratified samples, a row at a time: the row's camera rays
 /// for one sample index are made before any is traced, so that their
 /// square roots and divisions overlap rather than each waiting for the
-/// previous pixel's trace (jacks at 1024x1024 on one thread: 1.16x).
+/// previous pixel's trace (jacks at 1024x1024 on one thread: 1.16x); in
+/// worlds that walk packets, their closest hits are then found
+/// [`PACKET_SIZE`] rays at a time ([`World::intersect_packet`]), before
+/// each is shaded.
 struct RowSamples {
     rays: [Ray; TILE_SIZE as usize],
     patterns: [u32; TILE_SIZE as usize],
     sums: [Color; TILE_SIZE as usize],
+    /// Each ray's closest hit, where packets found them.
+    hits: [Option<Hit>; TILE_SIZE as usize],
     /// With one sample and AOVs, each pixel's ray and its first hit.
     centres: Vec<Option<Centre>>,
 }
@@ -621,6 +628,7 @@ impl RowSamples {
             rays: [Ray::new(Vec3::ZERO, Vec3::Z); TILE_SIZE as usize],
             patterns: [0; TILE_SIZE as usize],
             sums: [Color::ZERO; TILE_SIZE as usize],
+            hits: [None; TILE_SIZE as usize],
             centres: vec![None; if keep_centres { width as usize } else { 0 }],
         }
     }
@@ -637,6 +645,8 @@ impl RowSamples {
         tile: &mut Tile,
     ) {
         let spp = settings.samples_per_pixel;
+        let world = integrator.world();
+        let packets = world.walks_packets();
         for (i, x) in row.clone().enumerate() {
             self.patterns[i] = pixel_pattern(x, y);
             self.sums[i] = Color::ZERO;
@@ -645,26 +655,33 @@ impl RowSamples {
             for (i, x) in row.clone().enumerate() {
                 self.rays[i] = sample_ray(camera, settings, (x, y), self.patterns[i], s);
             }
+            if packets {
+                self.find_hits(world, selection, (row.clone(), y));
+            }
             for (i, x) in row.clone().enumerate() {
                 if !selection.contains(x, y) {
                     continue;
                 }
                 let ray = &self.rays[i];
+                let hit = if packets {
+                    self.hits[i]
+                } else {
+                    world.intersect(ray)
+                };
                 let differential =
                     sample_differential(camera, settings, (x, y), self.patterns[i], s);
+                let counts = &mut tile.rays;
                 let sample = match self.centres.get_mut(i) {
                     Some(centre) => {
                         let mut first = FirstHit::default();
-                        let sample = integrator.trace_primary_observed(
-                            ray,
-                            differential,
-                            &mut tile.rays,
-                            &mut first,
-                        );
+                        let sample =
+                            integrator.shade_camera_hit(ray, hit, differential, counts, &mut first);
                         *centre = Some((*ray, first.hit));
                         sample
                     }
-                    None => integrator.trace_camera_ray(ray, differential, &mut tile.rays),
+                    None => {
+                        integrator.shade_camera_hit(ray, hit, differential, counts, &mut Unobserved)
+                    }
                 };
                 if let Some(material) = sample.cut_at {
                     *tile.cuts.entry(material).or_default() += 1;
@@ -682,6 +699,29 @@ impl RowSamples {
             tile.color.extend_from_slice(&color.to_f32());
             let centre = self.centres.get_mut(i).and_then(Option::take);
             push_aovs(integrator, camera, settings, x, y, centre, &mut tile.aovs);
+        }
+    }
+}
+
+impl RowSamples {
+    /// The closest hits of the selected pixels' rays of `row` (of row `y`),
+    /// found [`PACKET_SIZE`] at a time, into `hits`.
+    fn find_hits(
+        &mut self,
+        world: &World,
+        selection: &PixelSelection,
+        (row, y): (Range<u32>, u32),
+    ) {
+        if !selection.has_row(y) {
+            return;
+        }
+        let window = selection.window;
+        let first = (window.x0.max(row.start) - row.start) as usize;
+        let end = (window.x1.min(row.end).max(row.start) - row.start) as usize;
+        let mut ctx = QueryContext::default();
+        for start in (first..end).step_by(PACKET_SIZE) {
+            let lanes = start..end.min(start + PACKET_SIZE);
+            world.intersect_packet(&self.rays[lanes.clone()], &mut ctx, &mut self.hits[lanes]);
         }
     }
 }

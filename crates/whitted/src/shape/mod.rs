@@ -289,6 +289,34 @@ macro_rules! dispatch {
 }
 
 impl Shape {
+    /// True when the parameter this shape reports for a ray comes from a
+    /// closed formula, the same whatever interval the ray is tested with
+    /// as long as it lies in it; false for the shapes found by an
+    /// iterative search of the interval (torus, implicit surface, Bézier
+    /// patch, superellipsoid) and for CSG. A packet walk, which tests
+    /// primitives with other intervals than a single ray's walk does,
+    /// gives that walk's answers only for these (see the world's packets).
+    pub fn closed_form(&self) -> bool {
+        match self {
+            Shape::Sphere(_)
+            | Shape::Plane(_)
+            | Shape::Triangle(_)
+            | Shape::Parallelogram(_)
+            | Shape::Polygon(_)
+            | Shape::Disk(_)
+            | Shape::Cylinder(_)
+            | Shape::Cone(_)
+            | Shape::AxisBox(_)
+            | Shape::Quadric(_)
+            | Shape::Mesh(_) => true,
+            Shape::Torus(_)
+            | Shape::Implicit(_)
+            | Shape::BezierPatch(_)
+            | Shape::Superellipsoid(_)
+            | Shape::Csg(_) => false,
+        }
+    }
+
     /// The closest hit with `t` in the ray's open interval.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {

@@ -41,7 +41,7 @@ pub use objects::{
     DefinitionId, Instance, InstanceError, MAX_INSTANCE_DEPTH, MaterialId, MeshId, MeshInstance,
     Objects, Primitive, PrimitiveId, TransformId,
 };
-pub use packet::{PACKET_SIZE, PacketHits, RayPacket};
+pub use packet::PACKET_SIZE;
 pub use shadow_hint::ShadowHint;
 pub use shadow_path::{OpaqueEntries, ShadowPath};
 
@@ -145,6 +145,9 @@ pub struct World<'a> {
     instance_count: usize,
     /// How many primitives there are.
     primitive_count: usize,
+    /// Whether packets of rays walk the structure together (see
+    /// [`packet`]).
+    packet_walk: bool,
 }
 
 impl<'a> World<'a> {
@@ -402,7 +405,7 @@ impl<'a> World<'a> {
         let wide_triangles = is_x86_feature_detected!("avx");
         #[cfg(not(target_arch = "x86_64"))]
         let wide_triangles = false;
-        Self {
+        let mut world = Self {
             objects,
             shapes: &objects.primitives,
             instance_first,
@@ -417,7 +420,10 @@ impl<'a> World<'a> {
             unbounded,
             instance_count: slot_instances.len() + slot_placed.len() + unbounded_placed,
             primitive_count: n,
-        }
+            packet_walk: false,
+        };
+        world.packet_walk = world.packets_allowed();
+        world
     }
 
     /// What primitive `number` stands for.
@@ -691,27 +697,6 @@ impl<'a> World<'a> {
         });
         ctx.counters += inner.counters;
         occluded
-    }
-
-    /// The closest hit of each active ray of `packet`, as
-    /// [`Self::intersect_with`] finds it (rays are traced one at a time for
-    /// now, so the answers are the single-ray ones).
-    pub fn intersect_packet(&self, packet: &RayPacket, ctx: &mut QueryContext) -> PacketHits {
-        let mut out = PacketHits::default();
-        for lane in packet.lanes() {
-            out.hits[lane] = self.intersect_with(&packet.ray(lane), ctx);
-            out.mask |= u32::from(out.hits[lane].is_some()) << lane;
-        }
-        out
-    }
-
-    /// The active rays of `packet` with something in their interval, as a
-    /// mask (bit `i` for lane `i`), as [`Self::occluded_with`] answers each.
-    pub fn occluded_packet(&self, packet: &RayPacket, ctx: &mut QueryContext) -> u32 {
-        packet
-            .lanes()
-            .filter(|&lane| self.occluded_with(&packet.ray(lane), ctx))
-            .fold(0, |mask, lane| mask | 1 << lane)
     }
 
     /// The world-space surface at a hit returned for `ray`.
@@ -1201,51 +1186,5 @@ mod tests {
         let mut ctx = QueryContext::default();
         assert!(world.occluded_with(&ray, &mut ctx));
         assert!(ctx.counters.primitives > 2);
-    }
-
-    #[test]
-    fn packets_give_every_lane_the_single_ray_answer() {
-        let mut rng = Rng::new(40);
-        let mut objects = Objects::default();
-        for _ in 0..60 {
-            let centre = rng.point_in(Vec3::splat(-3.0), Vec3::splat(3.0));
-            let sphere = Sphere::new(centre, rng.range(0.1, 0.6)).unwrap();
-            objects.add_primitive(Shape::Sphere(sphere), MaterialId(0), Transform::IDENTITY);
-        }
-        let positions: Vec<Vec3> = (0..90)
-            .map(|_| rng.point_in(Vec3::splat(-3.0), Vec3::splat(3.0)))
-            .collect();
-        let triangles: Vec<[u32; 3]> = (0..30).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
-        let soup = objects.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
-        objects.add_mesh_instance(soup, MaterialId(0), Transform::IDENTITY);
-        let moved = Transform::translate(Vec3::new(1.0, 0.5, -1.0)).unwrap();
-        let other = objects.add_mesh(objects.meshes[0].clone());
-        objects.add_mesh_instance(other, MaterialId(0), moved);
-        let world = World::new(&objects);
-        assert_eq!(world.instance_count(), 1);
-        let mut hits = 0;
-        for round in 0..200 {
-            let count = round % (PACKET_SIZE + 1);
-            let rays: Vec<Ray> = (0..count)
-                .map(|_| {
-                    let origin = rng.point_in(Vec3::splat(-5.0), Vec3::splat(5.0));
-                    Ray::segment(origin, rng.unit_vector(), rng.range(1.0, 8.0))
-                })
-                .collect();
-            let packet = RayPacket::new(&rays);
-            let mut ctx = QueryContext::default();
-            let found = world.intersect_packet(&packet, &mut ctx);
-            let occluded = world.occluded_packet(&packet, &mut ctx);
-            for (lane, ray) in rays.iter().enumerate() {
-                let single = world.intersect(ray);
-                assert_eq!(found.hits[lane], single);
-                assert_eq!(found.mask >> lane & 1 == 1, single.is_some());
-                assert_eq!(occluded >> lane & 1 == 1, world.occluded(ray));
-                hits += usize::from(single.is_some());
-            }
-            assert_eq!(found.mask >> count, 0);
-            assert_eq!(occluded >> count, 0);
-        }
-        assert!(hits > 50, "{hits}");
     }
 }

@@ -1,122 +1,327 @@
-//! Rays that travel together, as one query: a packet of up to
-//! [`PACKET_SIZE`] rays stored structure-of-arrays (each coordinate of all
-//! rays side by side, as SIMD lanes want them), with a mask of the lanes in
-//! use, and the answers per lane under the same mask.
+//! Rays that travel together, as one query: up to [`PACKET_SIZE`] rays
+//! (a tile row's camera rays) whose closest hits are found by one walk of
+//! the BVH ([`Bvh::intersect_packet_in_leaf_order`]), with exactly the
+//! answers each ray's own walk gives.
 //!
-//! [`crate::world::World::intersect_packet`] and
-//! [`crate::world::World::occluded_packet`] answer a packet today by
-//! tracing its rays one at a time, so they give exactly the single-ray
-//! answers; a walk that tests the packet against a node at once can come
-//! behind the same calls.
+//! The packet walk tests a primitive with other intervals than the single
+//! walk does; the answers stay the same only where a primitive's reported
+//! parameter does not depend on its interval: triangles and closed-form
+//! shapes ([`crate::shape::Shape::closed_form`]). A world with other
+//! entries (shapes found by search, instances, whose own walks break ties
+//! by their order) or another structure walks a packet's rays one at a
+//! time, as do packets the walk cannot take together and the lanes where
+//! it saw two primitives hit at the same parameter.
 
-use crate::math::{Ray, Vec3};
-use crate::world::Hit;
+use crate::accel::bvh::PACKET_LANES;
+use crate::accel::{Accelerator, Bvh, QueryContext};
+use crate::math::Ray;
+
+use super::entry::{EntryKind, Query, leaf_hit};
+use super::{Hit, PrimitiveId, World};
 
 /// The most rays a packet holds.
-pub const PACKET_SIZE: usize = 8;
+pub const PACKET_SIZE: usize = PACKET_LANES;
 
-/// Up to [`PACKET_SIZE`] rays, structure-of-arrays.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RayPacket {
-    /// Origins, per axis then per lane.
-    pub origin: [[f64; PACKET_SIZE]; 3],
-    /// Directions, per axis then per lane.
-    pub dir: [[f64; PACKET_SIZE]; 3],
-    /// Start of each lane's interval.
-    pub t_min: [f64; PACKET_SIZE],
-    /// End of each lane's interval.
-    pub t_max: [f64; PACKET_SIZE],
-    /// Bit `i` set when lane `i` holds a ray.
-    pub active: u32,
-}
+impl<'a> World<'a> {
+    /// True when [`Self::intersect_packet`] walks packets together (else
+    /// it walks their rays one at a time, and callers may as well).
+    pub fn walks_packets(&self) -> bool {
+        self.packet_walk
+    }
 
-impl RayPacket {
-    /// The packet of `rays` (at most [`PACKET_SIZE`]; the rest are left
-    /// out), lane `i` holding `rays[i]`.
-    pub fn new(rays: &[Ray]) -> Self {
-        let mut packet = Self {
-            origin: [[0.0; PACKET_SIZE]; 3],
-            dir: [[0.0; PACKET_SIZE]; 3],
-            t_min: [0.0; PACKET_SIZE],
-            t_max: [0.0; PACKET_SIZE],
-            active: 0,
-        };
-        for (lane, ray) in rays.iter().take(PACKET_SIZE).enumerate() {
-            for axis in 0..3 {
-                packet.origin[axis][lane] = ray.origin[axis];
-                packet.dir[axis][lane] = ray.dir[axis];
+    /// Whether packets of rays may walk this world's structure together:
+    /// a BVH whose entries all report parameters that do not depend on the
+    /// interval they are tested with (see the module documentation).
+    pub(super) fn packets_allowed(&self) -> bool {
+        matches!(self.accel, Accelerator::Bvh(_))
+            && self.entries.iter().all(|e| match e.kind {
+                EntryKind::Triangle | EntryKind::Sphere => true,
+                EntryKind::Primitive => self.shapes[e.number as usize].shape.closed_form(),
+                EntryKind::Instance | EntryKind::Placed => false,
+            })
+    }
+
+    /// The closest hit of each of `rays` (at most [`PACKET_SIZE`]) into
+    /// the same place of `hits`, as [`Self::intersect_with`] finds it for
+    /// each, found by one walk where the world and the rays allow it (see
+    /// the module documentation).
+    ///
+    /// # Panics
+    ///
+    /// When there are more than [`PACKET_SIZE`] rays or fewer hits than
+    /// rays.
+    pub fn intersect_packet(&self, rays: &[Ray], ctx: &mut QueryContext, hits: &mut [Option<Hit>]) {
+        assert!(rays.len() <= PACKET_SIZE, "{} rays in a packet", rays.len());
+        let hits = &mut hits[..rays.len()];
+        let all = (1u32 << rays.len()) - 1;
+        let mut alone = match &self.accel {
+            Accelerator::Bvh(bvh) if self.packet_walk && !rays.is_empty() => {
+                self.closest_packet(bvh, rays, ctx, hits)
             }
-            packet.t_min[lane] = ray.t_min;
-            packet.t_max[lane] = ray.t_max;
-            packet.active |= 1 << lane;
+            _ => all,
+        };
+        while alone != 0 {
+            let lane = alone.trailing_zeros() as usize;
+            alone &= alone - 1;
+            hits[lane] = self.intersect_with(&rays[lane], ctx);
         }
-        packet
     }
 
-    /// The ray in `lane`, whether active or not.
-    #[inline]
-    pub fn ray(&self, lane: usize) -> Ray {
-        let at = |v: &[[f64; PACKET_SIZE]; 3]| Vec3::new(v[0][lane], v[1][lane], v[2][lane]);
-        let mut ray = Ray::segment(at(&self.origin), at(&self.dir), self.t_max[lane]);
-        ray.t_min = self.t_min[lane];
-        ray
-    }
-
-    /// The active lanes, in order.
-    pub fn lanes(&self) -> impl Iterator<Item = usize> + '_ {
-        (0..PACKET_SIZE).filter(|&lane| self.active & 1 << lane != 0)
-    }
-
-    /// How many lanes are active.
-    pub fn len(&self) -> usize {
-        self.active.count_ones() as usize
-    }
-
-    /// True when no lane is active.
-    pub fn is_empty(&self) -> bool {
-        self.active == 0
-    }
-}
-
-/// The closest hits of a packet's rays: lane `i`'s in `hits[i]`, meaningful
-/// where bit `i` of `mask` is set (the lane hit something).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PacketHits {
-    /// Each lane's hit; `None` for a miss or an inactive lane.
-    pub hits: [Option<Hit>; PACKET_SIZE],
-    /// Bit `i` set when lane `i` hit something.
-    pub mask: u32,
-}
-
-impl Default for PacketHits {
-    fn default() -> Self {
-        Self {
-            hits: [None; PACKET_SIZE],
-            mask: 0,
+    /// The packet walk of [`Self::intersect_packet`] over `bvh`, this
+    /// world's structure: each lane's closest hit in `hits`; returns the
+    /// lanes to walk again alone (all of them when the packet cannot be
+    /// walked together).
+    fn closest_packet(
+        &self,
+        bvh: &Bvh,
+        rays: &[Ray],
+        ctx: &mut QueryContext,
+        hits: &mut [Option<Hit>],
+    ) -> u32 {
+        let all = (1u32 << rays.len()) - 1;
+        let definitions = &self.definitions;
+        let queries: [Query; PACKET_SIZE] = std::array::from_fn(|lane| {
+            Query::new(&rays[lane.min(rays.len() - 1)], self.has_triangles)
+        });
+        let mut inner = QueryContext::new(ctx.coherence);
+        let mut clipped = [rays[0]; PACKET_SIZE];
+        for (lane, ray) in rays.iter().enumerate() {
+            clipped[lane] = *ray;
+            hits[lane] = None;
+            for e in &self.unbounded {
+                if let Some((primitive, h)) = self.intersect_other(
+                    definitions,
+                    e,
+                    &queries[lane],
+                    clipped[lane].t_max,
+                    &mut inner,
+                ) {
+                    clipped[lane].t_max = h.t;
+                    hits[lane] = Some(Hit {
+                        primitive: PrimitiveId(primitive),
+                        shape_hit: h,
+                    });
+                }
+            }
         }
+        let tied = bvh.intersect_packet_in_leaf_order(
+            &clipped[..rays.len()],
+            &mut ctx.counters,
+            |lane, range, t_max| {
+                let query = &queries[lane];
+                leaf_hit(
+                    &self.entries,
+                    range,
+                    query,
+                    t_max,
+                    |e, t_max| self.intersect_other(definitions, e, query, t_max, &mut inner),
+                    |primitive, shape_hit| {
+                        hits[lane] = Some(Hit {
+                            primitive: PrimitiveId(primitive),
+                            shape_hit,
+                        })
+                    },
+                )
+            },
+        );
+        ctx.counters += inner.counters;
+        tied.unwrap_or(all)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::accel::AccelKind;
+    use crate::math::random::Rng;
+    use crate::math::{Transform, Vec3};
+    use crate::mesh::TriangleMesh;
+    use crate::shape::{Cylinder, Plane, Polygon, Shape, Sphere, Torus};
+    use crate::world::{MaterialId, Objects};
+
+    /// Spheres, a triangle soup placed once, polygons, capped cylinders
+    /// (some moved) and, if `floor`, an infinite plane.
+    fn closed_form_scene(rng: &mut Rng, floor: bool) -> Objects {
+        let mut objects = Objects::default();
+        let m = MaterialId(0);
+        for _ in 0..80 {
+            let centre = rng.point_in(Vec3::splat(-3.0), Vec3::splat(3.0));
+            let sphere = Sphere::new(centre, rng.range(0.05, 0.5)).unwrap();
+            objects.add_primitive(Shape::Sphere(sphere), m, Transform::IDENTITY);
+        }
+        for _ in 0..20 {
+            let c = rng.point_in(Vec3::splat(-3.0), Vec3::splat(3.0));
+            let square = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .map(|(x, y)| c + Vec3::new(0.4 * x, 0.3 * y, 0.1 * x));
+            let polygon = Polygon::new(square.to_vec()).unwrap();
+            objects.add_primitive(Shape::Polygon(polygon), m, Transform::IDENTITY);
+            let cylinder = Cylinder::new(rng.range(0.05, 0.3), rng.range(0.2, 1.0), true).unwrap();
+            let moved = Transform::translate(c).unwrap();
+            objects.add_primitive(Shape::Cylinder(cylinder), m, moved);
+        }
+        let positions: Vec<Vec3> = (0..600)
+            .map(|_| rng.point_in(Vec3::splat(-3.0), Vec3::splat(3.0)))
+            .collect();
+        let triangles: Vec<[u32; 3]> = (0..200).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        let soup = objects.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
+        objects.add_mesh_instance(soup, m, Transform::IDENTITY);
+        if floor {
+            let plane = Plane::new(Vec3::new(0.0, -2.5, 0.0), Vec3::Y).unwrap();
+            objects.add_primitive(Shape::Plane(plane), m, Transform::IDENTITY);
+        }
+        objects
+    }
+
+    /// Packets of up to eight rays from one point, spread by up to
+    /// `spread` around a direction towards the scene, as camera rays are.
+    fn camera_packets(rng: &mut Rng, count: usize, spread: f64) -> Vec<Vec<Ray>> {
+        (0..count)
+            .map(|_| {
+                let origin = rng.point_in(Vec3::splat(-9.0), Vec3::splat(9.0));
+                let towards = rng.point_in(Vec3::splat(-2.0), Vec3::splat(2.0)) - origin;
+                let lanes = 1 + rng.below(PACKET_SIZE as u32) as usize;
+                (0..lanes)
+                    .map(|_| {
+                        let wobble = rng.point_in(Vec3::splat(-spread), Vec3::splat(spread));
+                        Ray::new(origin, (towards.normalize() + wobble).normalize())
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Every lane of each packet gets the single walk's hit and brute
+    /// force's; returns how many packets the walk took together and how
+    /// many lanes hit.
+    fn assert_packets_agree(objects: &Objects, packets: &[Vec<Ray>]) -> (usize, usize) {
+        let world = World::new(objects);
+        let brute = World::build(objects, AccelKind::Linear);
+        let (mut together, mut hits) = (0, 0);
+        for rays in packets {
+            let mut ctx = QueryContext::default();
+            let mut found = [None; PACKET_SIZE];
+            world.intersect_packet(rays, &mut ctx, &mut found);
+            if let Accelerator::Bvh(bvh) = &world.accel
+                && !rays.is_empty()
+            {
+                let mut scratch = [None; PACKET_SIZE];
+                let all = (1 << rays.len()) - 1;
+                together +=
+                    usize::from(world.closest_packet(bvh, rays, &mut ctx, &mut scratch) != all);
+            }
+            for (lane, ray) in rays.iter().enumerate() {
+                let single = world.intersect(ray);
+                assert_eq!(found[lane], single, "lane {lane} of {rays:?}");
+                let reference = brute.intersect(ray);
+                assert_eq!(
+                    single.map(|h| h.shape_hit.t),
+                    reference.map(|h| h.shape_hit.t)
+                );
+                hits += usize::from(single.is_some());
+            }
+            assert!(found[rays.len()..].iter().all(Option::is_none));
+        }
+        (together, hits)
+    }
 
     #[test]
-    fn a_packet_gives_back_each_ray_and_masks_the_unused_lanes() {
-        let rays = [
-            Ray::new(Vec3::new(1.0, 2.0, 3.0), Vec3::X),
-            Ray::segment(Vec3::ZERO, Vec3::Y, 4.0),
-            Ray::new(Vec3::splat(-1.0), Vec3::new(0.0, 0.6, 0.8)),
-        ];
-        let packet = RayPacket::new(&rays);
-        assert_eq!(packet.active, 0b111);
-        assert_eq!(packet.len(), 3);
-        assert_eq!(packet.lanes().collect::<Vec<_>>(), [0, 1, 2]);
-        for (lane, ray) in rays.iter().enumerate() {
-            assert_eq!(packet.ray(lane), *ray);
+    fn camera_packets_get_the_single_walks_hits() {
+        let mut rng = Rng::new(5);
+        for floor in [false, true] {
+            let objects = closed_form_scene(&mut rng, floor);
+            assert!(World::new(&objects).packet_walk);
+            let mut packets = camera_packets(&mut rng, 400, 0.002);
+            packets.extend(camera_packets(&mut rng, 200, 0.05));
+            let (together, hits) = assert_packets_agree(&objects, &packets);
+            if is_x86_feature_detected!("avx") {
+                assert!(together > 500, "{together}");
+            }
+            assert!(hits > 1000, "{hits}");
         }
-        let many = [rays[0]; PACKET_SIZE + 3];
-        assert_eq!(RayPacket::new(&many).len(), PACKET_SIZE);
-        assert!(RayPacket::new(&[]).is_empty());
+    }
+
+    #[test]
+    fn scattered_rays_fall_back_to_single_walks_with_the_same_hits() {
+        let mut rng = Rng::new(6);
+        let objects = closed_form_scene(&mut rng, true);
+        let packets: Vec<Vec<Ray>> = (0..200)
+            .map(|round| {
+                (0..round % (PACKET_SIZE + 1))
+                    .map(|_| {
+                        let origin = rng.point_in(Vec3::splat(-5.0), Vec3::splat(5.0));
+                        Ray::segment(origin, rng.unit_vector(), rng.range(1.0, 8.0))
+                    })
+                    .collect()
+            })
+            .collect();
+        assert_packets_agree(&objects, &packets);
+    }
+
+    #[test]
+    fn hits_tied_between_leaves_are_the_single_walks_choice() {
+        // Many overlapping triangles in the plane z = 0 (each with its own
+        // box, so they lie in many leaves): rays straight down hit several
+        // at exactly the same parameter, and the single walk keeps the
+        // first it visits.
+        let mut rng = Rng::new(7);
+        let mut objects = Objects::default();
+        let mut positions = Vec::new();
+        for _ in 0..300 {
+            let c = rng.point_in(Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0));
+            positions.extend([
+                c + Vec3::new(-3.0, -3.0, 0.0),
+                c + Vec3::new(3.0, -3.0, 0.0),
+                c + Vec3::new(0.0, 3.0, 0.0),
+            ]);
+        }
+        let triangles: Vec<[u32; 3]> = (0..300).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        let mesh = objects.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
+        objects.add_mesh_instance(mesh, MaterialId(0), Transform::IDENTITY);
+        let world = World::new(&objects);
+        let Accelerator::Bvh(bvh) = &world.accel else {
+            panic!("the default structure is a BVH");
+        };
+        let (mut distinct, mut given_back) = (0, 0);
+        for _ in 0..200 {
+            let corner = rng.point_in(Vec3::new(-0.5, -0.5, 2.0), Vec3::new(0.5, 0.5, 2.0));
+            let rays: Vec<Ray> = (0..PACKET_SIZE)
+                .map(|i| Ray::new(corner + Vec3::new(0.001 * i as f64, 0.0, 0.0), -Vec3::Z))
+                .collect();
+            let mut found = [None; PACKET_SIZE];
+            world.intersect_packet(&rays, &mut QueryContext::default(), &mut found);
+            for (lane, ray) in rays.iter().enumerate() {
+                let single = world.intersect(ray);
+                assert_eq!(found[lane], single);
+                distinct += usize::from(single.is_some_and(|h| h.primitive != PrimitiveId(0)));
+            }
+            let mut scratch = [None; PACKET_SIZE];
+            let mut ctx = QueryContext::default();
+            let alone = world.closest_packet(bvh, &rays, &mut ctx, &mut scratch);
+            given_back += alone.count_ones();
+        }
+        assert!(distinct > 100, "{distinct}");
+        if is_x86_feature_detected!("avx") {
+            assert!(given_back > 800, "{given_back}");
+        }
+    }
+
+    #[test]
+    fn searched_shapes_and_instances_keep_single_walks() {
+        let mut rng = Rng::new(8);
+        let mut objects = closed_form_scene(&mut rng, false);
+        assert!(World::new(&objects).packet_walk);
+        assert!(!World::build(&objects, AccelKind::KdTree).packet_walk);
+        let torus = Torus::new(1.0, 0.3).unwrap();
+        objects.add_primitive(Shape::Torus(torus), MaterialId(0), Transform::IDENTITY);
+        assert!(!World::new(&objects).packet_walk);
+        let packets = camera_packets(&mut rng, 100, 0.01);
+        assert_packets_agree(&objects, &packets);
+
+        let mut instanced = closed_form_scene(&mut rng, false);
+        let copy = instanced.add_mesh(instanced.meshes[0].clone());
+        let moved = Transform::translate(Vec3::new(1.0, 0.5, -1.0)).unwrap();
+        instanced.add_mesh_instance(copy, MaterialId(0), moved);
+        assert!(!World::new(&instanced).packet_walk);
+        assert_packets_agree(&instanced, &packets);
     }
 }

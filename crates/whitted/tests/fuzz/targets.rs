@@ -9,7 +9,7 @@ use std::sync::Arc;
 use whitted::accel::{AccelKind, AccelerationStructure};
 use whitted::bench::obj_positions::parse_obj_positions;
 use whitted::bench::ray_files::read_ray_file;
-use whitted::bench::{RayKind, trace_all};
+use whitted::bench::{RayKind, Walk, trace_all};
 use whitted::math::{DVec2, Vec3};
 use whitted::render::Camera;
 use whitted::render::Scene;
@@ -221,7 +221,7 @@ fn run_ray_files(workspace: &Workspace, parts: &[Vec<u8>], accel: AccelKind) -> 
     }
     SCENE.with(|scene| {
         let world = World::build(&scene.objects, accel);
-        let _ = trace_all(&world, &file.set);
+        let _ = trace_all(&world, &file.set, Walk::Single);
     });
     true
 }

@@ -21,6 +21,7 @@ mod build;
 mod collapse;
 mod fbox;
 mod node;
+mod packet;
 mod prims;
 mod slabs;
 #[cfg(target_arch = "x86_64")]
@@ -31,6 +32,7 @@ mod validate;
 
 pub use build::{BvhBuildParams, SplitMethod};
 pub use node::{BvhNode, WIDTH};
+pub use packet::PACKET_LANES;
 
 use super::AccelStats;
 use crate::math::Aabb;

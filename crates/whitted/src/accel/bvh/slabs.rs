@@ -17,7 +17,7 @@ pub(super) const GROW: f32 = 1.0 + 1.0 / (1 << 21) as f32;
 
 /// The inverse direction of an axis that must not cull (see the
 /// documentation of `traverse`).
-const NEVER_CULLS: f32 = (1u128 << 100) as f32;
+pub(super) const NEVER_CULLS: f32 = (1u128 << 100) as f32;
 
 /// What the slab test needs of a ray, per axis, computed once per ray.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -94,16 +94,16 @@ use crate::math::Ray;
 /// Entries the stack needs for a tree whose leaves lie at most `depth` deep:
 /// a node at depth `d` finds at most `(WIDTH − 1)·d` entries pending and
 /// pushes its (at most [`WIDTH`]) children before it pops the nearest.
-const fn stack_size(depth: usize) -> usize {
+pub(super) const fn stack_size(depth: usize) -> usize {
     (WIDTH - 1) * depth + WIDTH
 }
 
 /// Trees at most this deep use a short stack.
-const SHALLOW: usize = 12;
+pub(super) const SHALLOW: usize = 12;
 
 /// Trees deeper than [`SHALLOW`] but at most this deep use a middle-sized
 /// stack, under half the one for [`MAX_DEPTH`].
-const MIDDLE: usize = 24;
+pub(super) const MIDDLE: usize = 24;
 
 /// A child to visit: a node (`count == 0`) or a leaf, and a lower bound on
 /// the parameter where the ray enters its box.
