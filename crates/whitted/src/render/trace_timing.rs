@@ -100,14 +100,20 @@ mod tests {
     #[test]
     fn busy_time_adds_over_tiles_and_the_tail_runs_from_the_first_idle_thread() {
         let clock = TraceClock::start();
+        let (idle, wait_for_idle) = std::sync::mpsc::channel();
         std::thread::scope(|scope| {
-            // One thread with a short tile, one with two long ones.
-            scope.spawn(|| {
+            // One thread with a short tile, one with two long ones, the
+            // second started only once the first thread is out of work, so
+            // that the tail holds it whatever the scheduler does.
+            let clock = &clock;
+            scope.spawn(move || {
                 clock.tile(|| std::thread::sleep(Duration::from_millis(10)));
                 clock.out_of_work();
+                idle.send(()).unwrap();
             });
-            scope.spawn(|| {
+            scope.spawn(move || {
                 clock.tile(|| std::thread::sleep(Duration::from_millis(30)));
+                wait_for_idle.recv().unwrap();
                 clock.tile(|| std::thread::sleep(Duration::from_millis(30)));
                 clock.out_of_work();
             });
@@ -116,11 +122,11 @@ mod tests {
         assert_eq!(timing.tiles, 3);
         assert!(timing.busy_seconds >= 0.07, "{timing:?}");
         assert!(timing.seconds >= 0.06, "{timing:?}");
-        // The first thread ran out of work after its 10 ms, the other
-        // went on for 50 ms more.
-        assert!(timing.tail_seconds >= 0.05, "{timing:?}");
+        // The first thread ran out of work after at least its 10 ms; the
+        // other then spent at least 30 ms more.
+        assert!(timing.tail_seconds >= 0.03, "{timing:?}");
         assert!(timing.tail_seconds <= timing.seconds - 0.01, "{timing:?}");
-        assert!(timing.utilisation() > 0.5 && timing.utilisation() <= 1.0);
+        assert!(timing.utilisation() > 0.0 && timing.utilisation() <= 1.0);
     }
 
     #[test]
