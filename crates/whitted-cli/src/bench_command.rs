@@ -151,6 +151,10 @@ struct AccelReport {
     kind: AccelKind,
     build_seconds: f64,
     stats: AccelStats,
+    /// Whether `--packets` was asked for and this structure, in this
+    /// scene, walks packets together (otherwise its rays went one at a
+    /// time).
+    packets: bool,
     kinds: Vec<KindReport>,
 }
 
@@ -247,6 +251,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
             kind,
             build_seconds,
             stats,
+            packets: args.packets && world.walks_packets(),
             kinds: kind_reports,
         });
     }
@@ -294,13 +299,8 @@ fn table(args: &BenchArgs, primitives: usize, threads: usize, reports: &[AccelRe
         Some(dir) => format!("rays from {}", dir.display()),
         None => format!("rays for a {}x{} image", args.width, args.height),
     };
-    let walk = if args.packets {
-        "; closest hits in packets of 8"
-    } else {
-        ""
-    };
     let mut lines = vec![format!(
-        "{}: {primitives} primitives; {source}{walk}; best of {} runs",
+        "{}: {primitives} primitives; {source}; best of {} runs",
         args.scene.display(),
         args.runs
     )];
@@ -318,6 +318,13 @@ fn table(args: &BenchArgs, primitives: usize, threads: usize, reports: &[AccelRe
             s.sah_cost,
             s.max_depth
         ));
+        if args.packets {
+            lines.push(if r.packets {
+                "        closest hits in packets of 8 rays".to_string()
+            } else {
+                "        rays one at a time: this structure or scene walks no packets".to_string()
+            });
+        }
         let agree_header = if args.rays.is_some() { "  agree" } else { "" };
         lines.push(format!(
             "        {:<8} {:>9} {:>11} {:>11} {:>10} {:>10}{agree_header}",
@@ -375,6 +382,7 @@ fn to_json(args: &BenchArgs, primitives: usize, threads: usize, reports: &[Accel
                 "references": r.stats.references,
                 "sah_cost": r.stats.sah_cost,
                 "max_depth": r.stats.max_depth,
+                "packets": r.packets,
                 "kinds": kinds,
             })
         })

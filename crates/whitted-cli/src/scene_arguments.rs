@@ -74,6 +74,11 @@ pub struct SceneArgs {
     #[arg(long, value_name = "NAME", value_parser = parse_texture_filter)]
     texture_filter: Option<TextureFilter>,
 
+    /// Walk camera rays one at a time rather than a tile row's eight at a
+    /// time (the same picture; to compare the time).
+    #[arg(long)]
+    no_packets: bool,
+
     /// Put the camera's eye here (replaces the scene's).
     #[arg(long, value_name = "X,Y,Z", value_parser = arguments::vec3, allow_hyphen_values = true)]
     eye: Option<Vec3>,
@@ -185,6 +190,7 @@ impl SceneArgs {
         settings.photons.count = self.photons.unwrap_or(settings.photons.count);
         settings.aa = self.aa.apply(settings.aa)?;
         settings.texture_filter = self.texture_filter.unwrap_or(settings.texture_filter);
+        settings.packets &= !self.no_packets;
         Ok(scene)
     }
 }

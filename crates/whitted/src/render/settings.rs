@@ -125,6 +125,10 @@ pub struct RenderSettings {
     /// Worker threads; `None` uses every core. The picture is the same for
     /// any count.
     pub threads: Option<usize>,
+    /// Whether a tile row's camera rays are walked eight at a time where
+    /// the world allows it ([`crate::world::World::intersect_packet`]);
+    /// the picture is the same either way, only the time differs.
+    pub packets: bool,
     /// Per-pixel data to produce alongside the colour.
     pub aovs: Vec<Aov>,
 }
@@ -165,6 +169,7 @@ impl Default for RenderSettings {
             photons: PhotonSettings::default(),
             texture_filter: TextureFilter::None,
             threads: None,
+            packets: true,
             aovs: Vec::new(),
         }
     }
