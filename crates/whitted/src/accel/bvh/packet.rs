@@ -159,10 +159,10 @@ impl Bvh {
 #[cfg(target_arch = "x86_64")]
 mod avx {
     use std::arch::x86_64::{
-        __m256, _CMP_LE_OQ, _mm_cvtss_f32, _mm_max_ps, _mm_max_ss, _mm_min_ps, _mm_min_ss,
-        _mm_movehl_ps, _mm_shuffle_ps, _mm256_castps256_ps128, _mm256_cmp_ps,
-        _mm256_extractf128_ps, _mm256_loadu_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps,
-        _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps,
+        __m128, __m256, _CMP_LE_OQ, _mm_cvtss_f32, _mm_max_ps, _mm_min_ps, _mm_movehl_ps,
+        _mm_shuffle_ps, _mm256_castps256_ps128, _mm256_cmp_ps, _mm256_extractf128_ps,
+        _mm256_loadu_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps,
+        _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps,
     };
 
     use super::super::node::{BvhNode, WIDTH};
@@ -226,22 +226,38 @@ mod avx {
         }
     }
 
+    /// The least of a register's lanes or, with `MAX`, the greatest.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn reduce<const MAX: bool>(v: __m256) -> f32 {
+        let half = pick::<MAX>(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v));
+        let quarter = pick::<MAX>(half, _mm_movehl_ps(half, half));
+        _mm_cvtss_f32(pick::<MAX>(quarter, _mm_shuffle_ps::<1>(quarter, quarter)))
+    }
+
+    /// `min(a, b)` or, with `MAX`, `max(a, b)`, lane by lane.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn pick<const MAX: bool>(a: __m128, b: __m128) -> __m128 {
+        if MAX {
+            _mm_max_ps(a, b)
+        } else {
+            _mm_min_ps(a, b)
+        }
+    }
+
     /// The least of a register's lanes.
     #[target_feature(enable = "avx")]
     #[inline]
     fn least(v: __m256) -> f32 {
-        let half = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v));
-        let quarter = _mm_min_ps(half, _mm_movehl_ps(half, half));
-        _mm_cvtss_f32(_mm_min_ss(quarter, _mm_shuffle_ps::<1>(quarter, quarter)))
+        reduce::<false>(v)
     }
 
     /// The greatest of a register's lanes.
     #[target_feature(enable = "avx")]
     #[inline]
     fn most(v: __m256) -> f32 {
-        let half = _mm_max_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v));
-        let quarter = _mm_max_ps(half, _mm_movehl_ps(half, half));
-        _mm_cvtss_f32(_mm_max_ss(quarter, _mm_shuffle_ps::<1>(quarter, quarter)))
+        reduce::<true>(v)
     }
 
     /// Widens `near` and `far` as the single-ray test does, and compares.
