@@ -701,9 +701,7 @@ impl RowSamples {
             push_aovs(integrator, camera, settings, x, y, centre, &mut tile.aovs);
         }
     }
-}
 
-impl RowSamples {
     /// The closest hits of the selected pixels' rays of `row` (of row `y`),
     /// found [`PACKET_SIZE`] at a time, into `hits`.
     fn find_hits(
