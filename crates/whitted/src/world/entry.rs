@@ -129,6 +129,7 @@ impl Entry {
 /// A ray with what the triangle test needs of it, computed once per query
 /// when the structure holds triangles (a world of other shapes does not pay
 /// for it).
+#[derive(Clone, Copy)]
 pub(super) struct Query<'r> {
     /// The ray, in the space of the structure's entries.
     pub(super) ray: &'r Ray,

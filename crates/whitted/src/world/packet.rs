@@ -84,35 +84,36 @@ impl<'a> World<'a> {
     ) -> u32 {
         let all = (1u32 << rays.len()) - 1;
         let definitions = &self.definitions;
-        let queries: [Query; PACKET_SIZE] = std::array::from_fn(|lane| {
-            Query::new(&rays[lane.min(rays.len() - 1)], self.has_triangles)
-        });
+        // A lane's query (its triangle shear) is made when the lane first
+        // reaches an entry: most of a packet's lanes that miss never do.
+        let mut queries: [Option<Query>; PACKET_SIZE] = [None; PACKET_SIZE];
         let mut inner = QueryContext::new(ctx.coherence);
+        hits.fill(None);
         let mut clipped = [rays[0]; PACKET_SIZE];
-        for (lane, ray) in rays.iter().enumerate() {
-            clipped[lane] = *ray;
-            hits[lane] = None;
-            for e in &self.unbounded {
-                if let Some((primitive, h)) = self.intersect_other(
-                    definitions,
-                    e,
-                    &queries[lane],
-                    clipped[lane].t_max,
-                    &mut inner,
-                ) {
-                    clipped[lane].t_max = h.t;
-                    hits[lane] = Some(Hit {
-                        primitive: PrimitiveId(primitive),
-                        shape_hit: h,
-                    });
+        let rays = if self.unbounded.is_empty() {
+            rays
+        } else {
+            for (lane, ray) in rays.iter().enumerate() {
+                clipped[lane] = *ray;
+                let query = queries[lane].insert(Query::new(ray, self.has_triangles));
+                for e in &self.unbounded {
+                    if let Some((primitive, h)) =
+                        self.intersect_other(definitions, e, query, clipped[lane].t_max, &mut inner)
+                    {
+                        clipped[lane].t_max = h.t;
+                        hits[lane] = Some(Hit {
+                            primitive: PrimitiveId(primitive),
+                            shape_hit: h,
+                        });
+                    }
                 }
             }
-        }
-        let tied = bvh.intersect_packet_in_leaf_order(
-            &clipped[..rays.len()],
-            &mut ctx.counters,
-            |lane, range, t_max| {
-                let query = &queries[lane];
+            &clipped[..rays.len()]
+        };
+        let tied =
+            bvh.intersect_packet_in_leaf_order(rays, &mut ctx.counters, |lane, range, t_max| {
+                let query = queries[lane]
+                    .get_or_insert_with(|| Query::new(&rays[lane], self.has_triangles));
                 leaf_hit(
                     &self.entries,
                     range,
@@ -126,8 +127,7 @@ impl<'a> World<'a> {
                         })
                     },
                 )
-            },
-        );
+            });
         ctx.counters += inner.counters;
         tied.unwrap_or(all)
     }

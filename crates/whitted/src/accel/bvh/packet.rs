@@ -159,10 +159,12 @@ impl Bvh {
 #[cfg(target_arch = "x86_64")]
 mod avx {
     use std::arch::x86_64::{
-        __m128, __m256, _CMP_LE_OQ, _mm_cvtss_f32, _mm_max_ps, _mm_min_ps, _mm_movehl_ps,
-        _mm_shuffle_ps, _mm256_castps256_ps128, _mm256_cmp_ps, _mm256_extractf128_ps,
-        _mm256_loadu_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps,
-        _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps,
+        __m128, __m256, _CMP_LE_OQ, _CMP_LT_OQ, _mm_cvtss_f32, _mm_max_ps, _mm_min_ps,
+        _mm_movehl_ps, _mm_shuffle_ps, _mm256_and_ps, _mm256_castps128_ps256,
+        _mm256_castps256_ps128, _mm256_cmp_ps, _mm256_cvtpd_ps, _mm256_extractf128_ps,
+        _mm256_insertf128_ps, _mm256_loadu_pd, _mm256_loadu_ps, _mm256_max_ps, _mm256_min_ps,
+        _mm256_movemask_ps, _mm256_mul_ps, _mm256_set1_ps, _mm256_setzero_ps, _mm256_storeu_ps,
+        _mm256_sub_ps,
     };
 
     use super::super::node::{BvhNode, WIDTH};
@@ -273,6 +275,7 @@ mod avx {
     }
 
     /// A packet's rays, prepared for both tests.
+    #[derive(Debug)]
     pub(super) struct Lanes {
         /// Per lane, as the single-ray test has them.
         entry_origin: [[f32; 8]; 3],
@@ -297,19 +300,75 @@ mod avx {
         /// packet cannot be walked together.
         #[target_feature(enable = "avx")]
         pub(super) fn new(rays: &[Ray]) -> Option<Self> {
+            let first = &rays[0];
+            let shared = rays.iter().all(|ray| {
+                ray.t_min.to_bits() == first.t_min.to_bits()
+                    && (0..3).all(|axis| ray.origin[axis].to_bits() == first.origin[axis].to_bits())
+            });
+            if shared && let Some(lanes) = Self::sharing_start(rays) {
+                return Some(lanes);
+            }
+            Self::each_its_own(rays)
+        }
+
+        /// [`Self::new`] for rays that share the first's origin and `t_min`
+        /// bit for bit, as a pinhole camera's rays do, or `None` (the
+        /// general way then decides). Where every lane's direction has the
+        /// first's signs, each lane's planes are the first's but for the
+        /// inverse direction, which is converted eight lanes at a time.
+        #[target_feature(enable = "avx")]
+        pub(super) fn sharing_start(rays: &[Ray]) -> Option<Self> {
             let first = Planes::new(&rays[0]);
-            let mut lanes = Self {
-                entry_origin: first.entry_origin.map(|o| [o; PACKET_LANES]),
-                exit_origin: first.exit_origin.map(|o| [o; PACKET_LANES]),
-                inv_dir: first.inv_dir.map(|i| [i; PACKET_LANES]),
-                t_min: [first.t_min; PACKET_LANES],
-                rows: first.rows,
-                entry_bound: [0.0; 3],
-                exit_bound: [0.0; 3],
-                inv_low: [0.0; 3],
-                inv_high: [0.0; 3],
-                t_min_low: 0.0,
-            };
+            let finite = |row: [f32; 3]| row.iter().all(|o| o.abs() < f32::INFINITY);
+            if !(first.t_min.is_finite() && finite(first.entry_origin) && finite(first.exit_origin))
+            {
+                return None;
+            }
+            let mut lanes = Self::repeating(&first);
+            let never_culls = _mm256_set1_ps(NEVER_CULLS);
+            let magnitude = _mm256_set1_ps(f32::from_bits(0x7fff_ffff));
+            for axis in 0..3 {
+                let mut inv = [rays[0].inv_dir[axis]; PACKET_LANES];
+                for (lane, ray) in rays.iter().enumerate().skip(1) {
+                    inv[lane] = ray.inv_dir[axis];
+                }
+                // SAFETY: `inv` is eight readable `f64`s; the loads are
+                // unaligned.
+                let (low, high) = unsafe {
+                    (
+                        _mm256_cvtpd_ps(_mm256_loadu_pd(inv.as_ptr())),
+                        _mm256_cvtpd_ps(_mm256_loadu_pd(inv[4..].as_ptr())),
+                    )
+                };
+                // `i as f32`, lane by lane, as `Planes::new` converts it.
+                let v = _mm256_insertf128_ps::<1>(_mm256_castps128_ps256(low), high);
+                // Beyond `NEVER_CULLS` (or beyond `f32`, or NaN) a lane
+                // is not walked together.
+                let ordinary =
+                    _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_and_ps(v, magnitude), never_culls);
+                let negative = _mm256_movemask_ps(v) as u32;
+                let below =
+                    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(v, _mm256_setzero_ps())) as u32;
+                let all = (1 << PACKET_LANES) - 1;
+                let uniform = |mask: u32| mask == 0 || mask == all;
+                if _mm256_movemask_ps(ordinary) as u32 != all
+                    || !uniform(negative)
+                    || !uniform(below)
+                    || (negative != 0) != first.inv_dir[axis].is_sign_negative()
+                {
+                    return None;
+                }
+                lanes.inv_dir[axis] = store(v);
+                (lanes.inv_low[axis], lanes.inv_high[axis]) = (least(v), most(v));
+            }
+            Some(lanes)
+        }
+
+        /// [`Self::new`] for any rays: each lane's planes of its own.
+        #[target_feature(enable = "avx")]
+        pub(super) fn each_its_own(rays: &[Ray]) -> Option<Self> {
+            let first = Planes::new(&rays[0]);
+            let mut lanes = Self::repeating(&first);
             let mut ordinary = first.t_min.is_finite();
             for (lane, ray) in rays.iter().enumerate() {
                 let p = if lane == 0 { first } else { Planes::new(ray) };
@@ -346,6 +405,22 @@ mod avx {
             }
             lanes.t_min_low = least(load(&lanes.t_min));
             Some(lanes)
+        }
+
+        /// Every lane the ray with planes `first`, bounds included.
+        fn repeating(first: &Planes) -> Self {
+            Self {
+                entry_origin: first.entry_origin.map(|o| [o; PACKET_LANES]),
+                exit_origin: first.exit_origin.map(|o| [o; PACKET_LANES]),
+                inv_dir: first.inv_dir.map(|i| [i; PACKET_LANES]),
+                t_min: [first.t_min; PACKET_LANES],
+                rows: first.rows,
+                entry_bound: first.entry_origin,
+                exit_bound: first.exit_origin,
+                inv_low: first.inv_dir,
+                inv_high: first.inv_dir,
+                t_min_low: first.t_min,
+            }
         }
 
         /// Pushes the children of `node` that some lane of `active` may
@@ -517,6 +592,57 @@ mod tests {
             })
         })?;
         Some((which?, t))
+    }
+
+    #[test]
+    fn lanes_of_rays_sharing_a_start_are_the_lanes_each_ray_makes_alone() {
+        if !crate::math::test_support::has_avx_or_skip_allowed() {
+            return;
+        }
+        // Packets from one origin, now and then with a direction component
+        // at zero, negative zero, too small for an `f32` inverse or between
+        // `NEVER_CULLS` and `f32::MAX`, or with signs that differ.
+        let mut rng = Rng::new(31);
+        let (mut shared, mut general) = (0, 0);
+        for case in 0..20_000 {
+            let origin = rng.point_in(Vec3::splat(-50.0), Vec3::splat(50.0));
+            let t_min = if case % 3 == 0 {
+                0.0
+            } else {
+                rng.range(0.0, 1.0)
+            };
+            let base = rng.unit_vector();
+            let spread = [0.001, 0.1, 1.0][case % 3];
+            let count = 1 + rng.below(PACKET_LANES as u32) as usize;
+            let rays: Vec<Ray> = (0..count)
+                .map(|_| {
+                    let mut dir = base + rng.point_in(Vec3::splat(-spread), Vec3::splat(spread));
+                    let axis = rng.below(3) as usize;
+                    match rng.below(60) {
+                        0 => dir[axis] = 0.0,
+                        1 => dir[axis] = -0.0,
+                        2 => dir[axis] = 1e-40_f64.copysign(dir[axis]),
+                        3 => dir[axis] = 1e-35_f64.copysign(dir[axis]),
+                        4 => dir[axis] = 1e50_f64.copysign(dir[axis]),
+                        _ => {}
+                    }
+                    let mut ray = Ray::new(origin, dir);
+                    ray.t_min = t_min;
+                    ray
+                })
+                .collect();
+            // SAFETY (all three): the processor has AVX.
+            let alone = format!("{:?}", unsafe { Lanes::each_its_own(&rays) });
+            assert_eq!(format!("{:?}", unsafe { Lanes::new(&rays) }), alone);
+            match unsafe { Lanes::sharing_start(&rays) } {
+                Some(lanes) => {
+                    shared += 1;
+                    assert_eq!(format!("{:?}", Some(lanes)), alone);
+                }
+                None => general += 1,
+            }
+        }
+        assert!(shared > 5000 && general > 1000, "{shared} {general}");
     }
 
     #[test]
