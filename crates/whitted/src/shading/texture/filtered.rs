@@ -24,9 +24,20 @@ use crate::shading::differential::Footprint;
 
 impl Texture {
     /// The colour averaged over `footprint` around `uv`, or the colour at
-    /// `uv` when there is no footprint.
-    #[inline]
+    /// `uv` when there is no footprint. A constant is answered where it is
+    /// asked (a shaded point asks up to seven times), the others out of
+    /// line.
+    #[inline(always)]
     pub fn filtered(&self, uv: DVec2, footprint: Option<&Footprint>) -> Color {
+        match self {
+            Texture::Constant(c) => *c,
+            _ => self.filtered_varying(uv, footprint),
+        }
+    }
+
+    /// [`Self::filtered`] for a texture that is not a constant.
+    #[inline(never)]
+    fn filtered_varying(&self, uv: DVec2, footprint: Option<&Footprint>) -> Color {
         let Some(footprint) = footprint else {
             return self.at(uv);
         };
