@@ -104,8 +104,12 @@ impl PartHeader {
     /// scene file as the user named it, `sha256` its hash
     /// ([`scene_sha256`], or [`BUILT_IN_SCENE`]).
     pub fn new(scene: &Scene, name: &str, sha256: &str, selection: PixelSelection) -> Self {
+        // The settings that change the time and never the pixels are left
+        // out of the comparison, so parts of one frame may use them as
+        // each machine suits.
         let settings = super::RenderSettings {
             threads: None,
+            packets: true,
             ..scene.settings.clone()
         };
         Self {
@@ -470,7 +474,8 @@ mod tests {
     }
 
     #[test]
-    fn renders_that_differ_are_told_apart_by_their_first_differing_line() {
+    fn renders_that_differ_are_told_apart_by_their_first_differing_line_and_time_settings_are_not()
+    {
         let scene = small_scene();
         let whole = PixelSelection::whole(20, 9);
         let header = PartHeader::new(&scene, "a.toml", "aa", whole);
@@ -478,6 +483,10 @@ mod tests {
         threads.settings.threads = Some(3);
         let renamed = PartHeader::new(&threads, "b.toml", "aa", whole);
         assert_eq!(header.render_difference(&renamed), None);
+        let mut single_rays = scene.clone();
+        single_rays.settings.packets = false;
+        let single_rays = PartHeader::new(&single_rays, "a.toml", "aa", whole);
+        assert_eq!(header.render_difference(&single_rays), None);
         let mut deeper = scene.clone();
         deeper.settings.max_depth = 2;
         let (key, _, _) = header
