@@ -51,11 +51,11 @@ use crate::integrator::{
     Unobserved,
 };
 use crate::limits::{MemoryBudget, MemoryError};
-use crate::math::{Ray, Vec3};
+use crate::math::{DVec2, Ray, Vec3};
 use crate::shading::Color;
 use crate::world::{Hit, MAX_PRIMITIVES, MaterialId, PACKET_SIZE, Surface, World};
 use adaptive::{AdaptivePixels, Cost};
-use sample_ray::{pixel_pattern, sample_differential, sample_ray};
+use sample_ray::{pixel_pattern, sample_differential, sample_position};
 
 /// Side of the square tiles the image is cut into, in pixels.
 const TILE_SIZE: u32 = 16;
@@ -611,6 +611,7 @@ type Centre = (Ray, Option<(Hit, Surface)>);
 /// [`PACKET_SIZE`] rays at a time ([`World::intersect_packet`]), before
 /// each is shaded.
 struct RowSamples {
+    positions: [DVec2; TILE_SIZE as usize],
     rays: [Ray; TILE_SIZE as usize],
     patterns: [u32; TILE_SIZE as usize],
     sums: [Color; TILE_SIZE as usize],
@@ -625,6 +626,7 @@ impl RowSamples {
     fn new(settings: &RenderSettings, width: u32) -> Self {
         let keep_centres = settings.samples_per_pixel == 1 && !settings.aovs.is_empty();
         Self {
+            positions: [DVec2::ZERO; TILE_SIZE as usize],
             rays: [Ray::new(Vec3::ZERO, Vec3::Z); TILE_SIZE as usize],
             patterns: [0; TILE_SIZE as usize],
             sums: [Color::ZERO; TILE_SIZE as usize],
@@ -653,8 +655,11 @@ impl RowSamples {
         }
         for s in 0..spp {
             for (i, x) in row.clone().enumerate() {
-                self.rays[i] = sample_ray(camera, settings, (x, y), self.patterns[i], s);
+                self.positions[i] = sample_position(settings, (x, y), self.patterns[i], s);
             }
+            let count = row.len();
+            let (width, height) = (settings.width, settings.height);
+            camera.rays(width, height, &self.positions[..count], &mut self.rays);
             if packets {
                 self.find_hits(world, selection, (row.clone(), y));
             }

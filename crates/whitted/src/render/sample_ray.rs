@@ -24,12 +24,24 @@ pub(crate) fn sample_ray(
     pattern: u32,
     s: u32,
 ) -> Ray {
-    let offset = pixel_sample(s, settings.samples_per_pixel, pattern);
     position_ray(
         camera,
         settings,
-        DVec2::new(f64::from(x) + offset.x, f64::from(y) + offset.y),
+        sample_position(settings, (x, y), pattern, s),
     )
+}
+
+/// Where on the image (in pixels from its top-left corner) sample `s` of
+/// pixel (`x`, `y`) whose pattern is `pattern` lies.
+#[inline]
+pub(crate) fn sample_position(
+    settings: &RenderSettings,
+    (x, y): (u32, u32),
+    pattern: u32,
+    s: u32,
+) -> DVec2 {
+    let offset = pixel_sample(s, settings.samples_per_pixel, pattern);
+    DVec2::new(f64::from(x) + offset.x, f64::from(y) + offset.y)
 }
 
 /// The camera ray through `position` on the image, in pixels from its
@@ -51,10 +63,9 @@ pub(crate) fn sample_differential(
     pattern: u32,
     s: u32,
 ) -> Option<RayDifferential> {
-    let spp = settings.samples_per_pixel;
-    let offset = pixel_sample(s, spp, pattern);
-    let position = DVec2::new(f64::from(x) + offset.x, f64::from(y) + offset.y);
-    position_differential(camera, settings, position, 1.0 / f64::from(spp).sqrt())
+    let position = sample_position(settings, (x, y), pattern, s);
+    let scale = 1.0 / f64::from(settings.samples_per_pixel).sqrt();
+    position_differential(camera, settings, position, scale)
 }
 
 /// The ray differential of the camera ray through `position` on the image
