@@ -127,20 +127,23 @@ pub fn remove_partial_files() -> PartialFilesRemoved {
 mod tests {
     use super::*;
 
-    /// The tests' own registry: emptying the process's one would remove
-    /// the files of other tests running at the same time.
-    static TESTS: Registry = Registry::new();
+    /// Each test's own registry: emptying one that another test uses
+    /// (the process's, or a shared one) would remove that test's files
+    /// while it runs beside it.
+    static LISTED: Registry = Registry::new();
+    static EMPTIED: Registry = Registry::new();
 
-    fn listed() -> Vec<PathBuf> {
-        TESTS.lock().clone()
+    /// The files `registry` lists.
+    fn listed(registry: &Registry) -> Vec<PathBuf> {
+        registry.lock().clone()
     }
 
     #[test]
     fn a_partial_file_is_listed_while_it_exists() {
         let dir = tempfile::tempdir().unwrap();
-        let partial = PartialFile::create_in(dir.path(), &TESTS).unwrap();
+        let partial = PartialFile::create_in(dir.path(), &LISTED).unwrap();
         let path = partial.temp.as_ref().unwrap().path().to_path_buf();
-        assert!(listed().contains(&path));
+        assert!(listed(&LISTED).contains(&path));
         assert!(
             path.file_name()
                 .unwrap()
@@ -149,29 +152,29 @@ mod tests {
         );
         drop(partial);
         assert!(!path.exists());
-        assert!(!listed().contains(&path));
+        assert!(!listed(&LISTED).contains(&path));
 
-        let mut partial = PartialFile::create_in(dir.path(), &TESTS).unwrap();
+        let mut partial = PartialFile::create_in(dir.path(), &LISTED).unwrap();
         let path = partial.temp.as_ref().unwrap().path().to_path_buf();
         std::io::Write::write_all(partial.file(), b"image").unwrap();
         let target = dir.path().join("done");
         partial.persist(&target).unwrap();
-        assert!(!listed().contains(&path));
+        assert!(!listed(&LISTED).contains(&path));
         assert_eq!(std::fs::read(&target).unwrap(), b"image");
     }
 
     #[test]
     fn removing_the_partial_files_empties_the_folder_of_them() {
         let dir = tempfile::tempdir().unwrap();
-        let partial = PartialFile::create_in(dir.path(), &TESTS).unwrap();
+        let partial = PartialFile::create_in(dir.path(), &EMPTIED).unwrap();
         let path = partial.temp.as_ref().unwrap().path().to_path_buf();
         {
-            let _removed = TESTS.remove_all();
+            let _removed = EMPTIED.remove_all();
         }
         assert!(!path.exists());
         // Dropping it afterwards finds nothing to remove and no entry.
         drop(partial);
-        assert!(!listed().contains(&path));
+        assert!(!listed(&EMPTIED).contains(&path));
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     }
 }
