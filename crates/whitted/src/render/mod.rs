@@ -649,6 +649,9 @@ impl RowSamples {
         let spp = settings.samples_per_pixel;
         let world = integrator.world();
         let packets = settings.packets && world.walks_packets();
+        // The selection, asked once for the row rather than per pixel.
+        let (row_selected, columns) = (selection.has_row(y), selection.columns());
+        let selected = |x: u32| row_selected && columns.contains(&x);
         for (i, x) in row.clone().enumerate() {
             self.patterns[i] = pixel_pattern(x, y);
             self.sums[i] = Color::ZERO;
@@ -664,7 +667,7 @@ impl RowSamples {
                 self.find_hits(world, selection, (row.clone(), y));
             }
             for (i, x) in row.clone().enumerate() {
-                if !selection.contains(x, y) {
+                if !selected(x) {
                     continue;
                 }
                 let ray = &self.rays[i];
@@ -695,15 +698,17 @@ impl RowSamples {
             }
         }
         for (i, x) in row.enumerate() {
-            if !selection.contains(x, y) {
+            if !selected(x) {
                 push_unselected(settings, tile);
                 continue;
             }
             tile.selected += 1;
             let color = self.sums[i] / f64::from(spp);
             tile.color.extend_from_slice(&color.to_f32());
-            let centre = self.centres.get_mut(i).and_then(Option::take);
-            push_aovs(integrator, camera, settings, x, y, centre, &mut tile.aovs);
+            if !settings.aovs.is_empty() {
+                let centre = self.centres.get_mut(i).and_then(Option::take);
+                push_aovs(integrator, camera, settings, x, y, centre, &mut tile.aovs);
+            }
         }
     }
 

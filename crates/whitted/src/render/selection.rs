@@ -7,6 +7,7 @@
 //! and of the costly glass as the others.
 
 use std::fmt;
+use std::ops::Range;
 
 /// A rectangle of pixels: columns `x0..x1`, rows `y0..y1` (ends excluded).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -132,7 +133,12 @@ impl PixelSelection {
 
     /// Whether pixel (`x`, `y`) is selected.
     pub fn contains(&self, x: u32, y: u32) -> bool {
-        (self.window.x0..self.window.x1).contains(&x) && self.has_row(y)
+        self.columns().contains(&x) && self.has_row(y)
+    }
+
+    /// The columns selected in every selected row.
+    pub fn columns(&self) -> Range<u32> {
+        self.window.x0..self.window.x1
     }
 
     /// The selected rows, top to bottom.
