@@ -604,9 +604,10 @@ fn adaptive_row(
 type Centre = (Ray, Option<(Hit, Surface)>);
 
 /// A tile's stratified samples, a row at a time: the row's camera rays
-/// for one sample index are made before any is traced, so that their
-/// square roots and divisions overlap rather than each waiting for the
-/// previous pixel's trace (jacks at 1024x1024 on one thread: 1.16x); in
+/// for one sample index are made before any is traced, four at a time
+/// ([`Camera::rays`]), so that their square roots and divisions overlap
+/// rather than each waiting for the previous pixel's trace (jacks at
+/// 1024x1024 on one thread: 1.16x, and 1.07x for the four lanes); in
 /// worlds that walk packets, their closest hits are then found
 /// [`PACKET_SIZE`] rays at a time ([`World::intersect_packet`]), before
 /// each is shaded.
