@@ -36,6 +36,8 @@ mod quadric;
 mod small_mesh;
 mod solid;
 mod sphere;
+#[cfg(target_arch = "x86_64")]
+mod sphere_avx;
 mod superellipsoid;
 mod torus;
 mod triangle;
@@ -57,6 +59,8 @@ pub use quadric::Quadric;
 pub use small_mesh::{OpenEdge, SmallMesh};
 pub use solid::{Crossing, Crossings, Solidity};
 pub use sphere::Sphere;
+#[cfg(target_arch = "x86_64")]
+pub(crate) use sphere_avx::sphere_candidates4;
 pub use superellipsoid::{MAX_EXPONENT, MIN_EXPONENT, Superellipsoid, exponent};
 pub use torus::Torus;
 pub use triangle::{RayShear, Triangle, watertight};

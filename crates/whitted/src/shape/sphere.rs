@@ -25,6 +25,9 @@ pub struct Sphere {
     radius: f64,
 }
 
+/// `1 + 2⁻⁴⁰`, the factor from `t_max` to `t′` in [`beyond`].
+pub(super) const BEYOND_MARGIN: f64 = 1.0 + 1.0 / (1u64 << 40) as f64;
+
 /// True when no root that [`quadratic::solve`] computes for
 /// `a t² + 2 b t + c` (reduced discriminant `disc`) lies in `(t_min, t_max)`
 /// with `t_min ≥ 0`, decided without the square root or a division: the
@@ -47,9 +50,7 @@ pub struct Sphere {
 /// NaN never culls.
 #[inline]
 fn beyond(a: f64, b: f64, c: f64, disc: f64, t_min: f64, t_max: f64) -> bool {
-    /// `1 + 2⁻⁴⁰`, the factor from `t_max` to `t′`.
-    const MARGIN: f64 = 1.0 + 1.0 / (1u64 << 40) as f64;
-    let t = t_max * MARGIN;
+    let t = t_max * BEYOND_MARGIN;
     let root_beyond = |left: f64, error: f64| {
         let left = left - gamma(4) * error;
         left > 0.0 && left * left >= t * t * disc * (1.0 + gamma(4))
@@ -98,7 +99,7 @@ impl Sphere {
     /// which stays accurate for small spheres far away; that distance times
     /// `a` is `|f × d|²` (Lagrange's identity), which needs no division, so
     /// a ray that misses costs no division or square root.
-    fn roots(&self, ray: &Ray) -> Option<(f64, f64)> {
+    pub(super) fn roots(&self, ray: &Ray) -> Option<(f64, f64)> {
         let f = ray.origin - self.center;
         let a = ray.dir.length_squared();
         let b = f.dot(ray.dir);

@@ -11,7 +11,7 @@ use std::ops::Range;
 
 use crate::math::{Ray, Vec3};
 #[cfg(target_arch = "x86_64")]
-use crate::shape::{Hits4, LANES, watertight4};
+use crate::shape::{Hits4, LANES, sphere_candidates4, watertight4};
 use crate::shape::{RayShear, ShapeHit, Sphere, watertight};
 
 /// What an entry's number names.
@@ -167,23 +167,48 @@ pub(super) fn intersect_triangle(
 }
 
 /// The closest of `entries[range]` hit by the query's ray closer than
-/// `t_max`: triangles here, other entries by `other(entry, t_max)`, which
-/// returns the number to report and the hit. `found(number, hit)` is
-/// told of each nearer hit; returns the closest `t`. One entry at a time:
-/// tried testing runs of triangles four at a time as [`leaf_occludes`]
-/// does: slower, see docs/performance.md (four-at-once triangle test).
+/// `t_max`: triangles and spheres here, other entries by
+/// `other(entry, t_max)`, which returns the number to report and the hit.
+/// `found(number, hit)` is told of each nearer hit; returns the closest `t`.
+/// Where `wide` (the processor has AVX), runs of two to four spheres are
+/// culled at once and only the spheres kept are tested, one by one in
+/// order, so the answers are those of one by one. Triangles are tested one
+/// at a time: tried testing runs of them four at a time as
+/// [`leaf_occludes`] does: slower, see docs/performance.md (four-at-once
+/// triangle test).
 #[inline(always)]
 pub(super) fn leaf_hit(
     entries: &[Entry],
     range: Range<u32>,
     query: &Query,
     mut t_max: f64,
+    wide: bool,
     mut other: impl FnMut(&Entry, f64) -> Option<(u32, ShapeHit)>,
     mut found: impl FnMut(u32, ShapeHit),
 ) -> Option<f64> {
     let mut closest = None;
-    for entry in range {
+    let mut entry = range.start;
+    while entry < range.end {
         let e = &entries[entry as usize];
+        #[cfg(target_arch = "x86_64")]
+        if wide
+            && e.kind == EntryKind::Sphere
+            && let Some((run, mut mask)) = sphere_run(entries, entry, range.end, query, t_max)
+        {
+            while mask != 0 {
+                let e = &entries[(entry + mask.trailing_zeros()) as usize];
+                let mut ray = *query.ray;
+                ray.t_max = t_max;
+                if let Some(h) = e.as_sphere().intersect(&ray) {
+                    found(e.number, h);
+                    t_max = h.t;
+                    closest = Some(h.t);
+                }
+                mask &= mask - 1;
+            }
+            entry += run;
+            continue;
+        }
         let hit = match e.intersect_in_place(query, t_max) {
             Some(hit) => hit.map(|h| (e.number, h)),
             None => other(e, t_max),
@@ -193,7 +218,9 @@ pub(super) fn leaf_hit(
             t_max = h.t;
             closest = Some(h.t);
         }
+        entry += 1;
     }
+    let _ = wide;
     closest
 }
 
@@ -201,7 +228,8 @@ pub(super) fn leaf_hit(
 /// first one found), if any: triangles here, other entries when
 /// `other(entry)` says so.
 /// Where `wide` (the processor has AVX), runs of two to four triangles are
-/// tested at once, with the same answers as one by one.
+/// tested at once, and runs of two to four spheres culled at once, with the
+/// same answers as one by one.
 #[inline(always)]
 pub(super) fn leaf_occludes(
     entries: &[Entry],
@@ -233,6 +261,22 @@ pub(super) fn leaf_meets(
             while mask != 0 {
                 let hit = entry + mask.trailing_zeros();
                 if stops(hit) {
+                    return Some(hit);
+                }
+                mask &= mask - 1;
+            }
+            entry += run;
+            continue;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if wide
+            && entries[entry as usize].kind == EntryKind::Sphere
+            && let Some((run, mut mask)) =
+                sphere_run(entries, entry, range.end, query, query.ray.t_max)
+        {
+            while mask != 0 {
+                let hit = entry + mask.trailing_zeros();
+                if entries[hit as usize].as_sphere().occluded(query.ray) && stops(hit) {
                     return Some(hit);
                 }
                 mask &= mask - 1;
@@ -284,4 +328,120 @@ fn triangle_run(entries: &[Entry], entry: u32, end: u32, query: &Query) -> Optio
     };
     let mask = hits.mask & ((1 << run) - 1);
     Some((run as u32, Hits4 { mask, ..hits }))
+}
+
+/// The run of two to [`LANES`] spheres that starts at `entry` (and ends
+/// before `end`), culled at once for the query's ray ending at `t_max`: its
+/// length and the spheres kept, bit `i` for entry `entry + i`. A sphere not
+/// kept has no hit closer than `t_max` or any smaller end. `None` without
+/// such a run. Only called where the processor has AVX.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn sphere_run(
+    entries: &[Entry],
+    entry: u32,
+    end: u32,
+    query: &Query,
+    t_max: f64,
+) -> Option<(u32, u32)> {
+    let available = (end - entry).min(LANES as u32) as usize;
+    let entries = &entries[entry as usize..entry as usize + available];
+    let run = entries
+        .iter()
+        .take_while(|e| e.kind == EntryKind::Sphere)
+        .count();
+    if run < 2 {
+        return None;
+    }
+    // Lanes past the run repeat the first sphere; their answers are masked
+    // out.
+    let lane = |i: usize| &entries[if i < run { i } else { 0 }].corners;
+    let centers = [0, 1, 2, 3].map(|i| &lane(i)[0]);
+    let radii = [0, 1, 2, 3].map(|i| &lane(i)[1].x);
+    // SAFETY: callers pass `wide` only where the processor has AVX.
+    let mask = unsafe { sphere_candidates4(centers, radii, query.ray, t_max) };
+    Some((run as u32, mask & ((1 << run) - 1)))
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use super::*;
+    use crate::math::random::Rng;
+    use crate::math::test_support::has_avx_or_skip_allowed;
+
+    /// A leaf of overlapping spheres with, now and then, a triangle or an
+    /// entry tested through the tables among them, so that runs of every
+    /// length from one to beyond four occur.
+    fn leaf(rng: &mut Rng) -> Vec<Entry> {
+        let size = 1 + rng.below(9);
+        (0..size)
+            .map(|number| match rng.below(8) {
+                0 => Entry::triangle(
+                    number,
+                    [0, 1, 2].map(|_| rng.point_in(Vec3::splat(-2.0), Vec3::splat(2.0))),
+                ),
+                1 => Entry::other(number, EntryKind::Primitive),
+                _ => Entry::sphere(
+                    number,
+                    &Sphere::new(
+                        rng.point_in(Vec3::splat(-2.0), Vec3::splat(2.0)),
+                        0.05 + 2.0 * rng.uniform(),
+                    )
+                    .unwrap(),
+                ),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn culling_runs_of_spheres_four_at_a_time_changes_no_answer() {
+        if !has_avx_or_skip_allowed() {
+            return;
+        }
+        let mut rng = Rng::new(21);
+        let (mut hits, mut culled_runs) = (0, 0);
+        for _ in 0..20_000 {
+            let entries = leaf(&mut rng);
+            let origin = rng.point_in(Vec3::splat(-4.0), Vec3::splat(4.0));
+            let mut ray = Ray::new(origin, rng.unit_vector() * (0.1 + 3.0 * rng.uniform()));
+            ray.t_max = [f64::INFINITY, 1.0, 0.2][rng.below(3) as usize];
+            let query = Query::new(&ray, true);
+            let range = 0..entries.len() as u32;
+            // Entries tested through the tables hit at a fixed distance.
+            let other =
+                |e: &Entry, t_max: f64| (0.5 < t_max).then_some((e.number, ShapeHit::at(0.5)));
+            let closest = |wide: bool| {
+                let mut found = Vec::new();
+                let t = leaf_hit(
+                    &entries,
+                    range.clone(),
+                    &query,
+                    ray.t_max,
+                    wide,
+                    other,
+                    |n, h| found.push((n, h.t.to_bits())),
+                );
+                (t.map(f64::to_bits), found)
+            };
+            let one_by_one = closest(false);
+            assert_eq!(closest(true), one_by_one, "{entries:?} {ray:?}");
+            hits += usize::from(one_by_one.0.is_some());
+            let meets = |e: &Entry| e.number.is_multiple_of(2) && 0.5 < ray.t_max;
+            let first = |wide: bool| {
+                let mut shown = Vec::new();
+                let stop = leaf_meets(&entries, range.clone(), &query, wide, meets, |n| {
+                    shown.push(n);
+                    n % 3 == 2
+                });
+                (stop, shown)
+            };
+            assert_eq!(first(true), first(false), "{entries:?} {ray:?}");
+            culled_runs += usize::from(
+                entries
+                    .windows(2)
+                    .any(|w| w.iter().all(|e| e.kind == EntryKind::Sphere)),
+            );
+        }
+        assert!(hits > 5_000 && culled_runs > 10_000, "{hits} {culled_runs}");
+    }
 }

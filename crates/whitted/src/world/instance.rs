@@ -82,6 +82,7 @@ impl MeshStructure {
                     range,
                     &query,
                     t_max,
+                    false,
                     |_, _| None,
                     |triangle, hit| best = Some((triangle, hit)),
                 )

@@ -134,9 +134,9 @@ pub struct World<'a> {
     /// Whether some entry of `entries` is a triangle, so queries compute
     /// the ray's shear up front.
     has_triangles: bool,
-    /// Whether the processor has AVX, so shadow rays test runs of a leaf's
-    /// triangles four at a time.
-    wide_triangles: bool,
+    /// Whether the processor has AVX, so leaves cull runs of spheres four
+    /// at a time, and shadow rays test runs of triangles four at a time.
+    wide: bool,
     /// The unbounded shapes (infinite planes) and instances of definitions
     /// holding one, tested beside the structure.
     unbounded: Vec<Entry>,
@@ -402,9 +402,9 @@ impl<'a> World<'a> {
             .filter(|e| e.kind == EntryKind::Placed)
             .count();
         #[cfg(target_arch = "x86_64")]
-        let wide_triangles = is_x86_feature_detected!("avx");
+        let wide = is_x86_feature_detected!("avx");
         #[cfg(not(target_arch = "x86_64"))]
-        let wide_triangles = false;
+        let wide = false;
         let mut world = Self {
             objects,
             shapes: &objects.primitives,
@@ -416,7 +416,7 @@ impl<'a> World<'a> {
             bounds,
             entries,
             has_triangles,
-            wide_triangles,
+            wide,
             unbounded,
             instance_count: slot_instances.len() + slot_placed.len() + unbounded_placed,
             primitive_count: n,
@@ -550,7 +550,7 @@ impl<'a> World<'a> {
         match e.kind {
             EntryKind::Instance => {
                 let (structure, local) = self.instance_ray(e.number, query.ray);
-                structure.occluded(&local, self.wide_triangles, inner)
+                structure.occluded(&local, self.wide, inner)
             }
             EntryKind::Placed => {
                 let (definition, local) = self.placed_ray(definitions, e.number, query.ray);
@@ -643,6 +643,7 @@ impl<'a> World<'a> {
                     range,
                     &query,
                     t_max,
+                    self.wide,
                     |e, t_max| self.intersect_other(definitions, e, &query, t_max, &mut inner),
                     |primitive, shape_hit| {
                         best = Some(Hit {
@@ -683,14 +684,14 @@ impl<'a> World<'a> {
             // One level, no instance walk to count apart (tried one path for
             // both: slower, see docs/performance.md).
             return self.accel.occluded_in_leaf_order(ray, ctx, |range| {
-                leaf_occludes(&self.entries, range, &query, self.wide_triangles, |e| {
+                leaf_occludes(&self.entries, range, &query, self.wide, |e| {
                     self.shape_occludes(e.number, &query)
                 })
                 .is_some()
             });
         }
         let occluded = self.accel.occluded_in_leaf_order(ray, ctx, |range| {
-            leaf_occludes(&self.entries, range, &query, self.wide_triangles, |e| {
+            leaf_occludes(&self.entries, range, &query, self.wide, |e| {
                 self.other_occludes(definitions, e, &query, &mut inner)
             })
             .is_some()

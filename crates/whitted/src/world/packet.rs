@@ -34,9 +34,8 @@ impl<'a> World<'a> {
     /// interval they are tested with (see the module documentation), on a
     /// processor with AVX.
     pub(super) fn packets_allowed(&self) -> bool {
-        // The walk runs on AVX, which `wide_triangles` says the processor
-        // has.
-        self.wide_triangles
+        // The walk runs on AVX, which `wide` says the processor has.
+        self.wide
             && matches!(self.accel, Accelerator::Bvh(_))
             && self.entries.iter().all(|e| match e.kind {
                 EntryKind::Triangle | EntryKind::Sphere => true,
@@ -119,6 +118,7 @@ impl<'a> World<'a> {
                     range,
                     query,
                     t_max,
+                    self.wide,
                     |e, t_max| self.intersect_other(definitions, e, query, t_max, &mut inner),
                     |primitive, shape_hit| {
                         hits[lane] = Some(Hit {

@@ -63,7 +63,7 @@ impl World<'_> {
         }
         let mut ctx = QueryContext::default();
         self.accel.occluded_in_leaf_order(ray, &mut ctx, |range| {
-            let blocker = leaf_occludes(&self.entries, range, &query, self.wide_triangles, |e| {
+            let blocker = leaf_occludes(&self.entries, range, &query, self.wide, |e| {
                 self.shape_occludes(e.number, &query)
             });
             if let Some(entry) = blocker {

@@ -111,7 +111,7 @@ impl World<'_> {
                 &self.entries,
                 range,
                 &query,
-                self.wide_triangles,
+                self.wide,
                 |e| self.shape_occludes(e.number, &query),
                 |entry| {
                     crossed |= !opaque.entries[entry as usize];
