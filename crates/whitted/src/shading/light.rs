@@ -114,7 +114,7 @@ impl Light {
     /// The light arriving at `p`, or `None` when none can (outside a spot's
     /// cone, or at the light's own position). For an area light, the whole
     /// estimate from the middle of its sample square.
-    #[inline]
+    #[inline(always)]
     pub fn sample(&self, p: Vec3) -> Option<LightSample> {
         match self {
             Light::Point {
@@ -234,8 +234,8 @@ impl<'l> DirectSamples<'l> {
     pub fn ahead(self) -> SamplesAhead<'l> {
         SamplesAhead {
             samples: self,
-            ready: [None; AHEAD],
-            next: AHEAD,
+            ready: [None; AHEAD - 1],
+            next: AHEAD - 1,
         }
     }
 }
@@ -247,35 +247,50 @@ const AHEAD: usize = 4;
 #[derive(Clone, Debug)]
 pub struct SamplesAhead<'l> {
     samples: DirectSamples<'l>,
-    ready: [Option<(usize, &'l Light, LightSample)>; AHEAD],
-    /// The next of `ready` to hand out; [`AHEAD`] when all were.
+    /// The samples made after the one handed out with them.
+    ready: [Option<(usize, &'l Light, LightSample)>; AHEAD - 1],
+    /// The next of `ready` to hand out; `AHEAD - 1` when all were.
     next: usize,
 }
 
 impl<'l> Iterator for SamplesAhead<'l> {
     type Item = (usize, &'l Light, LightSample);
 
-    #[inline]
+    /// The first sample of each batch goes out as it is made, in
+    /// registers: stored with the others and read back at once, its read
+    /// waited on those stores (a third of `Whitted::shade`'s own time on
+    /// `tree`). The others are read a shadow ray later, from the cache.
+    #[inline(always)]
     fn next(&mut self) -> Option<Self::Item> {
-        if self.next == AHEAD {
+        if let Some(slot) = self.ready.get_mut(self.next) {
+            let sample = slot.take();
+            self.next = if sample.is_some() {
+                self.next + 1
+            } else {
+                AHEAD - 1
+            };
+            return sample;
+        }
+        let first = self.samples.next();
+        if first.is_some() {
+            // Every slot is empty here (each was taken or never filled),
+            // and after its first `None` the samples give only `None`.
             for slot in &mut self.ready {
                 *slot = self.samples.next();
+                if slot.is_none() {
+                    break;
+                }
             }
             self.next = 0;
         }
-        let sample = self.ready[self.next].take();
-        self.next = if sample.is_some() {
-            self.next + 1
-        } else {
-            AHEAD
-        };
-        sample
+        first
     }
 }
 
 impl<'l> Iterator for DirectSamples<'l> {
     type Item = (usize, &'l Light, LightSample);
 
+    #[inline(always)]
     fn next(&mut self) -> Option<Self::Item> {
         while let Some(light) = self.lights.get(self.light) {
             let light_index = self.light;
