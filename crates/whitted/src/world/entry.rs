@@ -298,6 +298,28 @@ pub(super) fn leaf_meets(
     None
 }
 
+/// The run of two to [`LANES`] entries of `kind` that starts at `entry`
+/// (and ends before `end`): its length and each lane's corners, lane `i`
+/// for entry `entry + i`. Lanes past the run repeat the first entry; their
+/// answers are to be masked out. `None` without such a run.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn run_of(
+    entries: &[Entry],
+    entry: u32,
+    end: u32,
+    kind: EntryKind,
+) -> Option<(u32, [&[Vec3; 3]; LANES])> {
+    let available = (end - entry).min(LANES as u32) as usize;
+    let entries = &entries[entry as usize..entry as usize + available];
+    let run = entries.iter().take_while(|e| e.kind == kind).count();
+    if run < 2 {
+        return None;
+    }
+    let lane = |i: usize| &entries[if i < run { i } else { 0 }].corners;
+    Some((run as u32, [lane(0), lane(1), lane(2), lane(3)]))
+}
+
 /// The run of two to [`LANES`] triangles that starts at `entry` (and ends
 /// before `end`), tested at once against the query's ray: its length and
 /// the hits, lane `i` for entry `entry + i`. `None` without such a run.
@@ -305,29 +327,11 @@ pub(super) fn leaf_meets(
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn triangle_run(entries: &[Entry], entry: u32, end: u32, query: &Query) -> Option<(u32, Hits4)> {
-    let available = (end - entry).min(LANES as u32) as usize;
-    let entries = &entries[entry as usize..entry as usize + available];
-    let run = entries
-        .iter()
-        .take_while(|e| e.kind == EntryKind::Triangle)
-        .count();
-    if run < 2 {
-        return None;
-    }
-    // Lanes past the run repeat the first triangle; their answers are
-    // masked out.
-    let lane = |i: usize| &entries[if i < run { i } else { 0 }].corners;
+    let (run, lanes) = run_of(entries, entry, end, EntryKind::Triangle)?;
     // SAFETY: callers pass `wide` only where the processor has AVX.
-    let hits = unsafe {
-        watertight4(
-            [lane(0), lane(1), lane(2), lane(3)],
-            query.ray,
-            &query.shear(),
-            query.ray.t_max,
-        )
-    };
+    let hits = unsafe { watertight4(lanes, query.ray, &query.shear(), query.ray.t_max) };
     let mask = hits.mask & ((1 << run) - 1);
-    Some((run as u32, Hits4 { mask, ..hits }))
+    Some((run, Hits4 { mask, ..hits }))
 }
 
 /// The run of two to [`LANES`] spheres that starts at `entry` (and ends
@@ -344,23 +348,12 @@ fn sphere_run(
     query: &Query,
     t_max: f64,
 ) -> Option<(u32, u32)> {
-    let available = (end - entry).min(LANES as u32) as usize;
-    let entries = &entries[entry as usize..entry as usize + available];
-    let run = entries
-        .iter()
-        .take_while(|e| e.kind == EntryKind::Sphere)
-        .count();
-    if run < 2 {
-        return None;
-    }
-    // Lanes past the run repeat the first sphere; their answers are masked
-    // out.
-    let lane = |i: usize| &entries[if i < run { i } else { 0 }].corners;
-    let centers = [0, 1, 2, 3].map(|i| &lane(i)[0]);
-    let radii = [0, 1, 2, 3].map(|i| &lane(i)[1].x);
+    let (run, lanes) = run_of(entries, entry, end, EntryKind::Sphere)?;
+    let centers = lanes.map(|corners| &corners[0]);
+    let radii = lanes.map(|corners| &corners[1].x);
     // SAFETY: callers pass `wide` only where the processor has AVX.
     let mask = unsafe { sphere_candidates4(centers, radii, query.ray, t_max) };
-    Some((run as u32, mask & ((1 << run) - 1)))
+    Some((run, mask & ((1 << run) - 1)))
 }
 
 #[cfg(all(test, target_arch = "x86_64"))]
