@@ -54,12 +54,13 @@ pub use disk::Disk;
 pub use implicit::{Expression, ExpressionError, Implicit};
 pub use parallelogram::Parallelogram;
 pub use plane::Plane;
+#[cfg(target_arch = "x86_64")]
+pub(crate) use plane::plane_hit;
 pub use polygon::Polygon;
 pub use quadric::Quadric;
 pub use small_mesh::{OpenEdge, SmallMesh};
 pub use solid::{Crossing, Crossings, Solidity};
 pub use sphere::Sphere;
-#[cfg(target_arch = "x86_64")]
 pub(crate) use sphere_avx::sphere_candidates4;
 pub use superellipsoid::{MAX_EXPONENT, MIN_EXPONENT, Superellipsoid, exponent};
 pub use torus::Torus;

@@ -83,7 +83,7 @@ impl Plane {
 ///
 /// The distance is measured from `point`, not from the world origin, so it
 /// stays precise for planes far from the origin.
-pub(super) fn plane_hit(point: Vec3, normal: Vec3, ray: &Ray) -> Option<f64> {
+pub(crate) fn plane_hit(point: Vec3, normal: Vec3, ray: &Ray) -> Option<f64> {
     let denominator = normal.dot(ray.dir);
     if denominator == 0.0 {
         return None;

@@ -12,7 +12,7 @@ use std::ops::Range;
 use crate::math::{Ray, Vec3};
 #[cfg(target_arch = "x86_64")]
 use crate::shape::{Hits4, LANES, sphere_candidates4, watertight4};
-use crate::shape::{RayShear, ShapeHit, Sphere, watertight};
+use crate::shape::{Polygon, RayShear, ShapeHit, Sphere, plane_hit, watertight};
 
 /// What an entry's number names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -23,6 +23,10 @@ pub(super) enum EntryKind {
     /// A sphere without a transform, its centre and radius in the entry:
     /// tested right there too.
     Sphere,
+    /// A polygon without a transform, its first vertex and unit normal in
+    /// the entry: a ray that does not cross its plane in the interval is
+    /// turned away right there, the others are tested through the tables.
+    Polygon,
     /// A primitive tested through the world's tables (a shape).
     Primitive,
     /// A mesh instance, tested through its mesh's own structure.
@@ -74,6 +78,17 @@ impl Entry {
         }
     }
 
+    /// A polygon, reported as `number`, with the first vertex and unit
+    /// normal its test starts from ([`Polygon::vertices`],
+    /// [`Polygon::normal`]).
+    pub(super) fn polygon(number: u32, polygon: &Polygon) -> Self {
+        Self {
+            number,
+            kind: EntryKind::Polygon,
+            corners: [polygon.vertices()[0], polygon.normal(), Vec3::ZERO],
+        }
+    }
+
     /// An entry tested through the world's tables.
     pub(super) fn other(number: u32, kind: EntryKind) -> Self {
         Self {
@@ -101,8 +116,25 @@ impl Entry {
                 ray.t_max = t_max;
                 Some(self.as_sphere().intersect(&ray))
             }
+            EntryKind::Polygon => {
+                let mut ray = *query.ray;
+                ray.t_max = t_max;
+                self.polygon_plane_missed(&ray).then_some(None)
+            }
             _ => None,
         }
+    }
+
+    /// Whether a polygon entry's plane is not crossed by `ray` in its
+    /// interval: then the polygon is not hit, since its test
+    /// ([`Polygon::intersect`]) starts with this same plane test on the
+    /// same vertex and normal, and goes on only where it succeeds. This
+    /// spares the trip to the polygon's vertices and outline, three
+    /// allocations away, for most rays that reach its leaf (gears: 9,345
+    /// polygons, a third of the render in their test).
+    #[inline(always)]
+    fn polygon_plane_missed(&self, ray: &Ray) -> bool {
+        plane_hit(self.corners[0], self.corners[1], ray).is_none()
     }
 
     /// Whether the entry, a triangle or a sphere, lies in the query's ray
@@ -115,6 +147,7 @@ impl Entry {
                 Some(intersect_triangle(&self.corners, query, query.ray.t_max).is_some())
             }
             EntryKind::Sphere => Some(self.as_sphere().occluded(query.ray)),
+            EntryKind::Polygon => self.polygon_plane_missed(query.ray).then_some(false),
             _ => None,
         }
     }

@@ -359,6 +359,11 @@ impl<'a> World<'a> {
                         transform: None,
                         ..
                     } => Entry::sphere(i, sphere),
+                    Primitive {
+                        shape: Shape::Polygon(polygon),
+                        transform: None,
+                        ..
+                    } => Entry::polygon(i, polygon),
                     _ => Entry::other(i, EntryKind::Primitive),
                 };
             }
@@ -796,7 +801,7 @@ mod tests {
     use crate::math::random::Rng;
     use crate::math::{DVec2, Vec3};
     use crate::mesh::TriangleMesh;
-    use crate::shape::{Plane, Shape, Sphere, Triangle};
+    use crate::shape::{Plane, Polygon, Shape, Sphere, Triangle, plane_hit};
 
     fn scene_with(shape: Shape, transform: Transform) -> Objects {
         let mut objects = Objects::default();
@@ -1021,6 +1026,84 @@ mod tests {
     }
 
     #[test]
+    fn polygons_turned_away_in_place_are_missed_through_the_primitive_table() {
+        let mut rng = Rng::new(22);
+        let mut objects = Objects::default();
+        for i in 0..200 {
+            let centre = 10.0 * rng.unit_vector() * rng.uniform();
+            let (u, v) = rng.unit_vector().any_orthonormal_pair();
+            let corners = 3 + i % 6;
+            let vertices = (0..corners)
+                .map(|k| {
+                    let angle = std::f64::consts::TAU * k as f64 / corners as f64;
+                    let radius = 0.2 + 2.0 * rng.uniform();
+                    centre + radius * (angle.cos() * u + angle.sin() * v)
+                })
+                .collect();
+            let polygon = Polygon::new(vertices).unwrap();
+            let transform = if i % 4 == 0 {
+                Transform::translate(rng.unit_vector()).unwrap()
+            } else {
+                Transform::IDENTITY
+            };
+            objects.add_primitive(Shape::Polygon(polygon), MaterialId(0), transform);
+        }
+        let world = World::new(&objects);
+        let polygons: Vec<&Entry> = world
+            .entries
+            .iter()
+            .filter(|e| e.kind == EntryKind::Polygon)
+            .collect();
+        assert_eq!(polygons.len(), 150);
+        let (mut turned_away, mut hits) = (0, 0);
+        for i in 0..300 {
+            // Every other ray aims at the middle of an untransformed polygon.
+            let origin = 15.0 * rng.unit_vector() * rng.uniform();
+            let aimed = &world.shapes[polygons[rng.below(150) as usize].number as usize].shape;
+            let direction = match aimed {
+                Shape::Polygon(p) if i % 2 == 0 => {
+                    let middle = p.vertices().iter().sum::<Vec3>() / p.vertices().len() as f64;
+                    (middle - origin).normalize()
+                }
+                _ => rng.unit_vector(),
+            };
+            let mut ray = Ray::new(origin, direction);
+            ray.t_max = 30.0 * rng.uniform();
+            let query = Query::new(&ray, world.has_triangles);
+            for e in &polygons {
+                let Shape::Polygon(polygon) = &world.shapes[e.number as usize].shape else {
+                    panic!("entry {} is not a polygon", e.number);
+                };
+                // Ends at the plane's own parameter, a few ulps either side
+                // of it, and anywhere in the ray's interval.
+                let at_plane = plane_hit(polygon.vertices()[0], polygon.normal(), &ray);
+                let t_max = match (rng.below(3), at_plane) {
+                    (0, Some(t)) => t,
+                    (1, Some(t)) => f64::from_bits(t.to_bits() - 2 + u64::from(rng.below(5))),
+                    _ => ray.t_max * rng.uniform(),
+                };
+                let table = world.intersect_shape(e.number, &query, t_max);
+                hits += usize::from(table.is_some());
+                if e.intersect_in_place(&query, t_max) == Some(None) {
+                    turned_away += 1;
+                    assert_eq!(table, None, "{ray:?} {t_max}");
+                } else {
+                    assert_eq!(e.intersect_in_place(&query, t_max), None);
+                }
+                let occludes = world.shape_occludes(e.number, &query);
+                match e.occludes_in_place(&query) {
+                    Some(blocks) => assert!(!blocks && !occludes, "{ray:?}"),
+                    None => {
+                        assert!(plane_hit(polygon.vertices()[0], polygon.normal(), &ray).is_some())
+                    }
+                }
+            }
+        }
+        assert!(turned_away > 20_000, "{turned_away} turned away");
+        assert!(hits > 100, "{hits} hits");
+    }
+
+    #[test]
     fn spheres_tested_in_place_answer_as_through_the_primitive_table() {
         let mut rng = Rng::new(21);
         let mut objects = Objects::default();
@@ -1060,7 +1143,7 @@ mod tests {
                         assert_eq!(hit, table, "{ray:?}");
                         assert_eq!(e.occludes_in_place(&query), Some(occludes));
                     }
-                    None => assert_eq!(e.kind, EntryKind::Primitive),
+                    None => assert!(matches!(e.kind, EntryKind::Primitive | EntryKind::Polygon)),
                 }
             }
         }

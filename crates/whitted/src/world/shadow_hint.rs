@@ -37,7 +37,10 @@ impl World<'_> {
         };
         match e.occludes_in_place(query) {
             Some(blocks) => blocks,
-            None => e.kind == EntryKind::Primitive && self.shape_occludes(e.number, query),
+            None => {
+                matches!(e.kind, EntryKind::Primitive | EntryKind::Polygon)
+                    && self.shape_occludes(e.number, query)
+            }
         }
     }
 

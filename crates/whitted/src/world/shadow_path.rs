@@ -60,7 +60,7 @@ impl World<'_> {
     fn entry_material(&self, e: &Entry) -> Option<MaterialId> {
         if !matches!(
             e.kind,
-            EntryKind::Triangle | EntryKind::Sphere | EntryKind::Primitive
+            EntryKind::Triangle | EntryKind::Sphere | EntryKind::Polygon | EntryKind::Primitive
         ) {
             return None;
         }
