@@ -20,6 +20,24 @@
 //! with the loop over all edges of the 3D vertices (the polygon test was 47%
 //! of the time), 0.23 s with the 2D points, the repeated first point (no
 //! modulo) and the bands; the same picture to the bit.
+//!
+//! # Cells no edge comes near
+//!
+//! The same polygons get a grid over their bounding rectangle whose cells
+//! that no edge comes near are marked inside or outside once, so that most
+//! points of a large face are answered by one look-up. The mark is the
+//! answer the loop gives at any point of the cell, for these reasons. Each
+//! edge's box, grown by a margin `m`, is kept apart from each marked
+//! cell's rectangle, grown by `m` too. A point the look-up places in a
+//! cell lies within a few ulps (far less than `m`) of that rectangle, so
+//! every edge is either wholly above or below it, and then counts for no
+//! point there, or wholly beside it, more than `m` away. The crossing
+//! test's rounding (a few ulps of the polygon's size) cannot turn the sign
+//! of its side test across a distance of `m`, so for every edge the test
+//! gives the exact answer at every such point. The exact even-odd count
+//! is the same at all of them (a convex region no edge enters), so the
+//! loop's answer is the same at the point and at the cell's middle, where
+//! the mark was computed.
 
 use crate::math::{DVec2, Vec3};
 
@@ -31,6 +49,17 @@ const BANDED_FROM: usize = 9;
 /// never grow with the square of the vertex count.
 const ENTRIES_PER_EDGE: usize = 16;
 
+/// Cells per side of the grid are four times the square root of the
+/// number of edges, within these bounds.
+const CELLS_PER_SIDE: (usize, usize) = (16, 128);
+
+/// The margin kept between edges and marked cells, relative to the
+/// outline's size: far above the rounding of the crossing test and of the
+/// look-up, a few times 1e-16 of the size (both round differences of
+/// coordinates, whose error is relative to the difference, not to the
+/// coordinates).
+const CELL_MARGIN: f64 = 1e-9;
+
 /// The polygon's outline projected onto two coordinate axes.
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct Outline {
@@ -41,6 +70,108 @@ pub(super) struct Outline {
     points: Box<[DVec2]>,
     /// The edges by band, for polygons with many vertices.
     bands: Option<Bands>,
+    /// The cells no edge comes near, for the same polygons.
+    cells: Option<Cells>,
+}
+
+/// What a cell of [`Cells`] says of the points in it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Mark {
+    /// An edge comes near: the loop decides.
+    Edges,
+    /// Every point is outside.
+    Outside,
+    /// Every point is inside.
+    Inside,
+}
+
+/// A grid over an outline's bounding rectangle, each cell marked with the
+/// answer for all its points where no edge comes near it (see the module
+/// documentation).
+#[derive(Clone, Debug, PartialEq)]
+struct Cells {
+    /// The bounding rectangle's lower corner.
+    low: DVec2,
+    /// Its upper corner.
+    high: DVec2,
+    /// Cells per unit along each axis.
+    per_unit: DVec2,
+    /// Cells per side.
+    side: usize,
+    /// The marks, row by row.
+    marks: Box<[Mark]>,
+}
+
+impl Cells {
+    /// The grid for the closed outline `points` (the first point repeated
+    /// last), whose loop over the edges is `contains`; `None` when the
+    /// outline spans no area or is not finite.
+    fn new(points: &[DVec2], contains: impl Fn(DVec2) -> bool) -> Option<Self> {
+        let (low, high) = points
+            .iter()
+            .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
+                (lo.min(p), hi.max(p))
+            });
+        let size = high - low;
+        if !(size.x > 0.0 && size.y > 0.0 && size.is_finite()) {
+            return None;
+        }
+        let edges = points.len() - 1;
+        let side =
+            ((4.0 * (edges as f64).sqrt()) as usize).clamp(CELLS_PER_SIDE.0, CELLS_PER_SIDE.1);
+        let per_unit = DVec2::splat(side as f64) / size;
+        let margin = CELL_MARGIN * (size.x + size.y);
+        // The cells whose rectangle, grown by `margin`, meets [a, b] grown
+        // by `margin` (one more margin covers this computation's rounding).
+        let span = |a: f64, b: f64, axis: usize| {
+            let cell = |v: f64| {
+                (((v - low[axis]) * per_unit[axis]).floor().max(0.0) as usize).min(side - 1)
+            };
+            cell(a - 3.0 * margin)..=cell(b + 3.0 * margin)
+        };
+        let mut marks = vec![Mark::Inside; side * side];
+        for edge in points.windows(2) {
+            let (lo, hi) = (edge[0].min(edge[1]), edge[0].max(edge[1]));
+            for row in span(lo.y, hi.y, 1) {
+                for column in span(lo.x, hi.x, 0) {
+                    marks[row * side + column] = Mark::Edges;
+                }
+            }
+        }
+        for (i, mark) in marks.iter_mut().enumerate() {
+            if *mark != Mark::Edges {
+                let cell = DVec2::new((i % side) as f64 + 0.5, (i / side) as f64 + 0.5);
+                *mark = if contains(low + cell / per_unit) {
+                    Mark::Inside
+                } else {
+                    Mark::Outside
+                };
+            }
+        }
+        Some(Self {
+            low,
+            high,
+            per_unit,
+            side,
+            marks: marks.into_boxed_slice(),
+        })
+    }
+
+    /// Whether `p` is inside, if its cell says so for all its points.
+    #[inline]
+    fn look_up(&self, p: DVec2) -> Option<bool> {
+        if !(p.x >= self.low.x && p.x <= self.high.x && p.y >= self.low.y && p.y <= self.high.y) {
+            return None;
+        }
+        let cell = (p - self.low) * self.per_unit;
+        let column = (cell.x as usize).min(self.side - 1);
+        let row = (cell.y as usize).min(self.side - 1);
+        match self.marks[row * self.side + column] {
+            Mark::Edges => None,
+            Mark::Outside => Some(false),
+            Mark::Inside => Some(true),
+        }
+    }
 }
 
 /// The edges of an outline sorted into horizontal bands of equal height:
@@ -154,11 +285,16 @@ impl Outline {
             .map(|v| DVec2::new(v[axes[0]], v[axes[1]]))
             .collect();
         let bands = (vertices.len() >= BANDED_FROM).then(|| Bands::new(&points));
-        Self {
+        let mut outline = Self {
             axes: axes.map(|a| a as u8),
             points,
             bands,
+            cells: None,
+        };
+        if outline.bands.is_some() {
+            outline.cells = Cells::new(&outline.points, |p| outline.edges_contain(p));
         }
+        outline
     }
 
     /// The two kept axes.
@@ -181,6 +317,15 @@ impl Outline {
     /// end whatever the vertex order, so a point on an edge shared by two
     /// polygons of the same plane is inside exactly one of them.
     fn contains_2d(&self, p: DVec2) -> bool {
+        if let Some(inside) = self.cells.as_ref().and_then(|cells| cells.look_up(p)) {
+            return inside;
+        }
+        self.edges_contain(p)
+    }
+
+    /// [`Self::contains_2d`] by the edges alone: those of the point's
+    /// band, or all of them.
+    fn edges_contain(&self, p: DVec2) -> bool {
         match &self.bands {
             Some(bands) => bands.edges_at(p.y).iter().fold(false, |inside, &i| {
                 let i = i as usize;
@@ -216,6 +361,7 @@ mod tests {
     fn unbanded(points: &[DVec2]) -> Outline {
         Outline {
             bands: None,
+            cells: None,
             ..Outline::new(&lift(points), [0, 1])
         }
     }
@@ -288,6 +434,80 @@ mod tests {
             for &v in &points {
                 for dx in [-0.5, -1e-9, 0.0, 1e-9, 0.5] {
                     check(DVec2::new(v.x + dx, v.y));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn cells_answer_as_the_loop_over_all_edges() {
+        let mut rng = Rng::new(6);
+        // Stars and a gear, also small and far from the origin, where the
+        // margin is set by the coordinates rather than the size.
+        let gear: Vec<DVec2> = (0..144)
+            .map(|k| {
+                let angle = TAU * k as f64 / 144.0;
+                let radius = if (k / 2) % 2 == 0 { 1.0 } else { 0.85 };
+                radius * DVec2::new(angle.cos(), angle.sin())
+            })
+            .collect();
+        // Each with the share of its cells that must be marked at least
+        // (the stars' long slanted edges have boxes that cover most cells).
+        let shapes = [
+            (star(12, &mut rng), 0.0),
+            (star(72, &mut rng), 0.0),
+            (gear, 0.5),
+        ];
+        let placements = [(DVec2::ZERO, 1.0), (DVec2::new(1e5, -3e4), 1e-3)];
+        for (points, share) in &shapes {
+            for &(offset, scale) in &placements {
+                let points: Vec<DVec2> = points.iter().map(|&p| offset + scale * p).collect();
+                let outline = Outline::new(&lift(&points), [0, 1]);
+                let reference = unbanded(&points);
+                let cells = outline.cells.as_ref().expect("a banded outline has cells");
+                let marked = cells.marks.iter().filter(|&&m| m != Mark::Edges).count();
+                assert!(
+                    marked as f64 >= share * cells.marks.len() as f64,
+                    "{marked} of {} cells marked",
+                    cells.marks.len()
+                );
+                let check = |p: DVec2| {
+                    assert_eq!(
+                        outline.contains_2d(p),
+                        reference.contains_2d(p),
+                        "{} points at {p}",
+                        points.len()
+                    );
+                };
+                let size = cells.high - cells.low;
+                for _ in 0..20_000 {
+                    check(cells.low - 0.1 * size + 1.2 * size * rng.uniform());
+                }
+                // On every cell border and a few ulps either side of it.
+                for k in 0..=cells.side {
+                    let border = cells.low + DVec2::splat(k as f64) / cells.per_unit;
+                    for _ in 0..20 {
+                        let along = cells.low + size * rng.uniform();
+                        let ulps = rng.below(9) as i64 - 4;
+                        let nudge = |v: f64| f64::from_bits((v.to_bits() as i64 + ulps) as u64);
+                        check(DVec2::new(nudge(border.x), along.y));
+                        check(DVec2::new(along.x, nudge(border.y)));
+                    }
+                }
+                // Along every edge and just off it on either side.
+                for edge in points
+                    .windows(2)
+                    .chain([[points[points.len() - 1], points[0]].as_slice()])
+                {
+                    let (a, b) = (edge[0], edge[1]);
+                    let across = (b - a).perp().normalize();
+                    for _ in 0..10 {
+                        let on = a + (b - a) * rng.uniform();
+                        for distance in [0.0, 1e-15, 1e-12, 1e-9, 1e-6, 1e-3] {
+                            check(on + distance * scale * across);
+                            check(on - distance * scale * across);
+                        }
+                    }
                 }
             }
         }
