@@ -305,15 +305,12 @@ impl<'a> Whitted<'a> {
             return color;
         }
 
-        let Crossing {
-            n_from,
-            n_to,
-            after: inside_after,
-        } = media.cross(
+        let crossing = media.cross(
             s.medium,
             self.shading.materials[s.medium.0 as usize].ior,
             entering,
         );
+        let Crossing { n_from, n_to, .. } = crossing;
         let lobes = Lobes::new(
             Weights {
                 opacity: alpha,
@@ -378,7 +375,7 @@ impl<'a> Whitted<'a> {
                     .ray_start(kind, &refracted, transmitted_weight, child);
                 let differential = bend.map(|b| b.refracted(dir, n_from / n_to));
                 let differential = differential.as_ref();
-                let media = &inside_after;
+                let media = &crossing.after();
                 let c = self.trace(&refracted, differential, depth + 1, child, media, tally);
                 tally.observer.ray_end(c);
                 color += transmitted_weight * c;

@@ -63,24 +63,40 @@ impl MediumStack {
 
 /// What a ray crossing a surface goes from and to.
 #[derive(Clone, Copy, Debug)]
-pub struct Crossing {
+pub struct Crossing<'m> {
     /// Index of refraction on the incoming side.
     pub n_from: f64,
     /// Index of refraction on the far side.
     pub n_to: f64,
-    /// The media of a ray that goes through.
-    pub after: MediumStack,
+    /// The media before the surface.
+    before: &'m MediumStack,
+    /// The object's material, its index of refraction, and whether the
+    /// ray enters it.
+    object: (MaterialId, f64, bool),
+}
+
+impl Crossing<'_> {
+    /// The media of a ray that goes through. Made only when one does: most
+    /// crossings only reflect, and a copy of the stack is 136 bytes.
+    pub fn after(&self) -> MediumStack {
+        match self.object {
+            (material, ior, true) => self.before.entered(material, ior),
+            (material, _, false) => self.before.left(material),
+        }
+    }
 }
 
 impl MediumStack {
     /// Crossing the surface of an object of `material` (index `ior`),
     /// `entering` it or leaving it.
-    pub fn cross(&self, material: MaterialId, ior: f64, entering: bool) -> Crossing {
+    pub fn cross(&self, material: MaterialId, ior: f64, entering: bool) -> Crossing<'_> {
+        let object = (material, ior, entering);
         if entering {
             return Crossing {
                 n_from: self.ior(),
                 n_to: ior,
-                after: self.entered(material, ior),
+                before: self,
+                object,
             };
         }
         // Leaving an object that is not the innermost medium changes nothing
@@ -91,11 +107,27 @@ impl MediumStack {
         } else {
             ior
         };
-        let after = self.left(material);
         Crossing {
             n_from,
-            n_to: after.ior(),
-            after,
+            n_to: self.ior_after_leaving(material),
+            before: self,
+            object,
+        }
+    }
+
+    /// [`MediumStack::ior`] of [`MediumStack::left`] without making it:
+    /// only leaving the innermost medium changes it.
+    fn ior_after_leaving(&self, material: MaterialId) -> f64 {
+        let innermost = self.len.checked_sub(1);
+        match self.entries[..self.len]
+            .iter()
+            .rposition(|&(m, _)| m == material.0)
+        {
+            Some(i) if Some(i) == innermost => match i.checked_sub(1) {
+                Some(below) => self.entries[below].1,
+                None => 1.0,
+            },
+            _ => self.ior(),
         }
     }
 }
@@ -120,20 +152,49 @@ mod tests {
     }
 
     #[test]
+    fn the_index_beyond_is_the_one_of_the_media_after_the_crossing() {
+        // Every stack of up to four media out of three materials (some
+        // repeated), crossed each way at each material.
+        let iors = [1.5, 1.33, 2.4];
+        let mut stacks = vec![MediumStack::default()];
+        for _ in 0..4 {
+            let deeper: Vec<MediumStack> = stacks
+                .iter()
+                .flat_map(|s| (0..3).map(move |m| s.entered(MaterialId(m), iors[m as usize])))
+                .collect();
+            stacks.extend(deeper);
+        }
+        for stack in &stacks {
+            for m in 0..4 {
+                let ior = iors.get(m as usize).copied().unwrap_or(1.1);
+                for entering in [true, false] {
+                    let crossing = stack.cross(MaterialId(m), ior, entering);
+                    assert_eq!(
+                        crossing.n_to.to_bits(),
+                        crossing.after().ior().to_bits(),
+                        "{stack:?} material {m} entering {entering}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
     fn crossings_refract_only_where_the_medium_really_changes() {
         let (glass, bubble) = (MaterialId(1), MaterialId(2));
         let air = MediumStack::default();
         let into_glass = air.cross(glass, 1.5, true);
         assert_eq!((into_glass.n_from, into_glass.n_to), (1.0, 1.5));
-        let out_of_glass = into_glass.after.cross(glass, 1.5, false);
+        let in_glass = into_glass.after();
+        let out_of_glass = in_glass.cross(glass, 1.5, false);
         assert_eq!((out_of_glass.n_from, out_of_glass.n_to), (1.5, 1.0));
         // Entering an overlapping ior-1 object from air, then the glass, then
         // leaving the first object while still in the glass: no interface.
         let in_both = air
             .cross(bubble, 1.0, true)
-            .after
+            .after()
             .cross(glass, 1.5, true)
-            .after;
+            .after();
         let leave_outer = in_both.cross(bubble, 1.0, false);
         assert_eq!((leave_outer.n_from, leave_outer.n_to), (1.5, 1.5));
         // A ray that started inside the glass leaves it into air.

@@ -159,7 +159,7 @@ fn follow(
             ScatterKind::Diffuse => return,
             ScatterKind::Mirror => specular = true,
             ScatterKind::Refract => {
-                media = crossing.after;
+                media = crossing.after();
                 specular |= bends_light(m);
             }
         }

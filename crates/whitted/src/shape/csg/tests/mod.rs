@@ -504,7 +504,7 @@ fn a_lens_of_two_spheres_focuses_where_the_thick_lens_equation_says() {
             let origin = offset_ray_origin(s.point, s.point_error, s.normal, dir);
             ray = Ray::new(origin, dir);
             inside = entering;
-            media = crossing.after;
+            media = crossing.after();
         }
         // Out in the air again, the stack empty.
         assert_eq!(media.ior(), 1.0);
@@ -606,7 +606,7 @@ fn a_ray_through_children_of_different_materials_leaves_in_the_outside_medium() 
         let crossing = media.cross(s.medium, ior[s.medium.0 as usize], entering);
         assert_eq!(crossing.n_from, if entering { 1.0 } else { 1.5 });
         assert_eq!(crossing.n_to, if entering { 1.5 } else { 1.0 });
-        media = crossing.after;
+        media = crossing.after();
         ray = Ray::new(
             offset_ray_origin(s.point, s.point_error, s.normal, ray.dir),
             ray.dir,
