@@ -14,6 +14,9 @@ use crate::math::{Ray, Vec3};
 use crate::shape::{Hits4, LANES, sphere_candidates4, watertight4};
 use crate::shape::{Polygon, RayShear, ShapeHit, Sphere, plane_hit, watertight};
 
+/// The margin of [`Entry::axis_missed`], relative to the sizes it adds.
+const AXIAL_MARGIN: f64 = 1e-6;
+
 /// What an entry's number names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u32)]
@@ -27,6 +30,11 @@ pub(super) enum EntryKind {
     /// the entry: a ray that does not cross its plane in the interval is
     /// turned away right there, the others are tested through the tables.
     Polygon,
+    /// A cylinder or a cone, in the entry as the ends of its axis and a
+    /// bound on its points' distance from the axis: a ray whose line
+    /// passes farther from the axis is turned away right there, the others
+    /// are tested through the tables.
+    Axial,
     /// A primitive tested through the world's tables (a shape).
     Primitive,
     /// A mesh instance, tested through its mesh's own structure.
@@ -89,6 +97,16 @@ impl Entry {
         }
     }
 
+    /// A cylinder or a cone, reported as `number`: points within `radius`
+    /// of the segment from `base` to `top` (see [`Entry::axis_missed`]).
+    pub(super) fn axial(number: u32, base: Vec3, top: Vec3, radius: f64) -> Self {
+        Self {
+            number,
+            kind: EntryKind::Axial,
+            corners: [base, top - base, Vec3::new(radius, 0.0, 0.0)],
+        }
+    }
+
     /// An entry tested through the world's tables.
     pub(super) fn other(number: u32, kind: EntryKind) -> Self {
         Self {
@@ -121,8 +139,29 @@ impl Entry {
                 ray.t_max = t_max;
                 self.polygon_plane_missed(&ray).then_some(None)
             }
+            EntryKind::Axial => self.axis_missed(query.ray).then_some(None),
             _ => None,
         }
+    }
+
+    /// Whether an axial entry's shape is surely missed by `ray`: its line
+    /// passes farther from the axis's line than any point of the shape,
+    /// by a margin (a millionth of the shape's size and of the ray origin's
+    /// distance) far above the rounding of the shape's own test, which
+    /// then finds no hit either. Rays along the axis are never turned
+    /// away. Spares the trip through the primitive and transform tables
+    /// for most rays that reach a slanted cylinder's loose box (rings:
+    /// 4,200 cylinders, a third of the render in their test).
+    #[inline(always)]
+    fn axis_missed(&self, ray: &Ray) -> bool {
+        let [base, axis, radius] = self.corners;
+        let across = ray.dir.cross(axis);
+        let from_base = ray.origin - base;
+        let margin =
+            AXIAL_MARGIN * (radius.x + axis.abs().max_element() + from_base.abs().max_element());
+        let reach = radius.x + margin;
+        let distance = from_base.dot(across);
+        distance * distance > reach * reach * across.length_squared()
     }
 
     /// Whether a polygon entry's plane is not crossed by `ray` in its
@@ -148,6 +187,7 @@ impl Entry {
             }
             EntryKind::Sphere => Some(self.as_sphere().occluded(query.ray)),
             EntryKind::Polygon => self.polygon_plane_missed(query.ray).then_some(false),
+            EntryKind::Axial => self.axis_missed(query.ray).then_some(false),
             _ => None,
         }
     }

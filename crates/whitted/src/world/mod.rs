@@ -48,7 +48,7 @@ pub use shadow_path::{OpaqueEntries, ShadowPath};
 use crate::accel::{
     AccelKind, AccelerationStructure, Accelerator, Clipper, KdTree, KdTreeBuildParams, QueryContext,
 };
-use crate::math::{Aabb, Ray, Transform};
+use crate::math::{Aabb, Ray, Transform, Vec3};
 use crate::shape::{Shape, ShapeHit, clipped_triangle_bounds};
 use entry::{Entry, EntryKind, Query, leaf_hit, leaf_occludes};
 use instance::MeshStructure;
@@ -148,6 +148,34 @@ pub struct World<'a> {
     /// Whether packets of rays walk the structure together (see
     /// [`packet`]).
     packet_walk: bool,
+}
+
+/// The entry of primitive `number`, a cylinder or a cone whose canonical
+/// shape has `bounds` (its points within `bounds.max.x` of the z axis
+/// between `bounds.min.z` and `bounds.max.z`), placed by `transform`: the
+/// axis's ends in the world and a bound on its points' distance from it,
+/// the radius times the most the transform stretches a vector across the
+/// axis (the largest singular value of its x and y columns), a little
+/// grown for the rounding of this computation.
+fn axial_entry(number: u32, bounds: &Aabb, transform: Option<&Transform>) -> Entry {
+    let (base, top) = (
+        Vec3::new(0.0, 0.0, bounds.min.z),
+        Vec3::new(0.0, 0.0, bounds.max.z),
+    );
+    let Some(t) = transform else {
+        return Entry::axial(number, base, top, bounds.max.x);
+    };
+    let m = &t.world_from_object().matrix3;
+    let (x, y) = (Vec3::from(m.x_axis), Vec3::from(m.y_axis));
+    let (a, b, c) = (x.length_squared(), x.dot(y), y.length_squared());
+    let stretch = (0.5 * (a + c) + (0.25 * (a - c) * (a - c) + b * b).sqrt()).sqrt();
+    let radius = bounds.max.x * stretch * (1.0 + 1e-9);
+    Entry::axial(
+        number,
+        t.point_to_world(base),
+        t.point_to_world(top),
+        radius,
+    )
 }
 
 impl<'a> World<'a> {
@@ -364,6 +392,11 @@ impl<'a> World<'a> {
                         transform: None,
                         ..
                     } => Entry::polygon(i, polygon),
+                    Primitive {
+                        shape: shape @ (Shape::Cylinder(_) | Shape::Cone(_)),
+                        transform,
+                        ..
+                    } => axial_entry(i, &shape.bounds(), objects.transform(*transform)),
                     _ => Entry::other(i, EntryKind::Primitive),
                 };
             }
@@ -801,7 +834,7 @@ mod tests {
     use crate::math::random::Rng;
     use crate::math::{DVec2, Vec3};
     use crate::mesh::TriangleMesh;
-    use crate::shape::{Plane, Polygon, Shape, Sphere, Triangle, plane_hit};
+    use crate::shape::{Cone, Cylinder, Plane, Polygon, Shape, Sphere, Triangle, plane_hit};
 
     fn scene_with(shape: Shape, transform: Transform) -> Objects {
         let mut objects = Objects::default();
@@ -1104,6 +1137,90 @@ mod tests {
     }
 
     #[test]
+    fn cylinders_and_cones_turned_away_in_place_are_missed_through_the_tables() {
+        let mut rng = Rng::new(23);
+        let mut objects = Objects::default();
+        let mut surface_points = Vec::new();
+        for i in 0..120 {
+            let (radius, height) = (0.05 + rng.uniform(), 0.1 + 3.0 * rng.uniform());
+            let shape = if i % 2 == 0 {
+                Shape::Cylinder(Cylinder::new(radius, height, i % 4 == 0).unwrap())
+            } else {
+                let r1 = if i % 3 == 0 { 0.0 } else { rng.uniform() };
+                Shape::Cone(Cone::new(radius, r1, height, i % 5 != 0).unwrap())
+            };
+            // Rigid placements, stretched ones and none at all.
+            let frame =
+                Transform::frame(8.0 * rng.unit_vector() * rng.uniform(), rng.unit_vector())
+                    .unwrap();
+            let transform = match i % 3 {
+                0 => frame,
+                1 => frame.then_after(
+                    &Transform::scale(Vec3::new(
+                        rng.range(0.2, 3.0),
+                        rng.range(0.2, 3.0),
+                        rng.range(0.2, 3.0),
+                    ))
+                    .unwrap(),
+                ),
+                _ => Transform::IDENTITY,
+            };
+            // Points on the side, to aim rays that graze it.
+            let (angle, z) = (
+                std::f64::consts::TAU * rng.uniform(),
+                height * rng.uniform(),
+            );
+            let r = match &shape {
+                Shape::Cone(c) => c.radius0() + (c.radius1() - c.radius0()) * z / height,
+                _ => radius,
+            };
+            let local = Vec3::new(r * angle.cos(), r * angle.sin(), z);
+            let tangent = Vec3::new(-angle.sin(), angle.cos(), 0.0);
+            surface_points.push((
+                transform.point_to_world(local),
+                transform.vector_to_world(tangent).normalize(),
+            ));
+            objects.add_primitive(shape, MaterialId(0), transform);
+        }
+        let world = World::new(&objects);
+        let axial: Vec<&Entry> = world
+            .entries
+            .iter()
+            .filter(|e| e.kind == EntryKind::Axial)
+            .collect();
+        assert_eq!(axial.len(), 120);
+        let (mut turned_away, mut hits) = (0, 0);
+        for i in 0..2000 {
+            // Random rays, and rays grazing a side point, a few ulps either
+            // way of the tangent.
+            let ray = if i % 2 == 0 {
+                Ray::new(12.0 * rng.unit_vector(), rng.unit_vector())
+            } else {
+                let (point, tangent) = surface_points[rng.below(120) as usize];
+                let wobble = 1e-15 * rng.unit_vector();
+                Ray::new(point - 10.0 * tangent, (tangent + wobble).normalize())
+            };
+            let query = Query::new(&ray, world.has_triangles);
+            for e in &axial {
+                let table = world.intersect_shape(e.number, &query, ray.t_max);
+                hits += usize::from(table.is_some());
+                match e.intersect_in_place(&query, ray.t_max) {
+                    Some(hit) => {
+                        turned_away += 1;
+                        assert_eq!(hit, None);
+                        assert_eq!(table, None, "{ray:?}");
+                        assert!(!world.shape_occludes(e.number, &query), "{ray:?}");
+                        assert_eq!(e.occludes_in_place(&query), Some(false));
+                    }
+                    None => assert_eq!(e.occludes_in_place(&query), None),
+                }
+            }
+        }
+        assert!(turned_away > 150_000, "{turned_away} turned away");
+        assert!(hits > 1000, "{hits} hits");
+    }
+
+    #[test]
     fn spheres_tested_in_place_answer_as_through_the_primitive_table() {
         let mut rng = Rng::new(21);
         let mut objects = Objects::default();
@@ -1143,7 +1260,10 @@ mod tests {
                         assert_eq!(hit, table, "{ray:?}");
                         assert_eq!(e.occludes_in_place(&query), Some(occludes));
                     }
-                    None => assert!(matches!(e.kind, EntryKind::Primitive | EntryKind::Polygon)),
+                    None => assert!(matches!(
+                        e.kind,
+                        EntryKind::Primitive | EntryKind::Polygon | EntryKind::Axial
+                    )),
                 }
             }
         }

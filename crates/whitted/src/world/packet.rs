@@ -38,7 +38,9 @@ impl<'a> World<'a> {
         self.wide
             && matches!(self.accel, Accelerator::Bvh(_))
             && self.entries.iter().all(|e| match e.kind {
-                EntryKind::Triangle | EntryKind::Sphere | EntryKind::Polygon => true,
+                EntryKind::Triangle | EntryKind::Sphere | EntryKind::Polygon | EntryKind::Axial => {
+                    true
+                }
                 EntryKind::Primitive => self.shapes[e.number as usize].shape.closed_form(),
                 EntryKind::Instance | EntryKind::Placed => false,
             })

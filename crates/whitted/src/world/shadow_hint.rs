@@ -38,8 +38,10 @@ impl World<'_> {
         match e.occludes_in_place(query) {
             Some(blocks) => blocks,
             None => {
-                matches!(e.kind, EntryKind::Primitive | EntryKind::Polygon)
-                    && self.shape_occludes(e.number, query)
+                matches!(
+                    e.kind,
+                    EntryKind::Primitive | EntryKind::Polygon | EntryKind::Axial
+                ) && self.shape_occludes(e.number, query)
             }
         }
     }

@@ -60,7 +60,11 @@ impl World<'_> {
     fn entry_material(&self, e: &Entry) -> Option<MaterialId> {
         if !matches!(
             e.kind,
-            EntryKind::Triangle | EntryKind::Sphere | EntryKind::Polygon | EntryKind::Primitive
+            EntryKind::Triangle
+                | EntryKind::Sphere
+                | EntryKind::Polygon
+                | EntryKind::Axial
+                | EntryKind::Primitive
         ) {
             return None;
         }
