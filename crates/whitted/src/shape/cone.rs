@@ -21,7 +21,7 @@
 
 use std::f64::consts::TAU;
 
-use super::disk::{azimuth, cap_hit, cap_surface};
+use super::disk::{azimuth, cap_geometry, cap_hit, cap_surface};
 use super::{LocalSurface, ShapeError, ShapeHit, non_negative, positive, quadratic};
 use crate::math::{Aabb, DVec2, Ray, Vec3, gamma};
 
@@ -177,6 +177,24 @@ impl Cone {
     /// `γ(8)|r1 - r0| z / h` along the normal, covers the rounding of the
     /// radius at that height, here and when a new ray is tested from there.
     fn side_surface(&self, p: Vec3) -> LocalSurface {
+        let (s, (cos, sin)) = self.side_geometry(p);
+        let point = s.point;
+        LocalSurface {
+            uv: DVec2::new(azimuth(cos, sin) / TAU, point.z / self.height),
+            dpdu: Vec3::new(-TAU * point.y, TAU * point.x, 0.0),
+            dpdv: Vec3::new(
+                (self.radius1 - self.radius0) * cos,
+                (self.radius1 - self.radius0) * sin,
+                self.height,
+            ),
+            ..s
+        }
+    }
+
+    /// The side's point, error bound and normal at `p` (see
+    /// [`Self::side_surface`]), (u, v) and the tangents zero; and the
+    /// cosine and sine of the point's angle about the axis.
+    fn side_geometry(&self, p: Vec3) -> (LocalSurface, (f64, f64)) {
         let z = p.z.clamp(0.0, self.height);
         let rho = self.radius_at(z);
         let r = p.x.hypot(p.y);
@@ -187,7 +205,7 @@ impl Cone {
         };
         let point = Vec3::new(rho * cos, rho * sin, z);
         let slant = self.height.hypot(self.radius0 - self.radius1);
-        LocalSurface {
+        let surface = LocalSurface {
             point,
             point_error: gamma(8) * point.abs(),
             normal: Vec3::new(
@@ -195,13 +213,21 @@ impl Cone {
                 sin * (self.height / slant),
                 (self.radius0 - self.radius1) / slant,
             ),
-            uv: DVec2::new(azimuth(cos, sin) / TAU, z / self.height),
-            dpdu: Vec3::new(-TAU * point.y, TAU * point.x, 0.0),
-            dpdv: Vec3::new(
-                (self.radius1 - self.radius0) * cos,
-                (self.radius1 - self.radius0) * sin,
-                self.height,
-            ),
+            uv: DVec2::ZERO,
+            dpdu: Vec3::ZERO,
+            dpdv: Vec3::ZERO,
+        };
+        (surface, (cos, sin))
+    }
+
+    /// The surface at a hit without its parametric part: (u, v) and the
+    /// tangents are left zero (see [`crate::shape::Shape::surface_geometry`]).
+    pub fn surface_geometry(&self, ray: &Ray, hit: &ShapeHit) -> LocalSurface {
+        let p = ray.at(hit.t);
+        match hit.part {
+            BOTTOM => cap_geometry(p, 0.0, -1.0),
+            TOP => cap_geometry(p, self.height, 1.0),
+            _ => self.side_geometry(p).0,
         }
     }
 

@@ -16,7 +16,7 @@
 
 use std::f64::consts::TAU;
 
-use super::disk::{azimuth, cap_hit, cap_surface};
+use super::disk::{azimuth, cap_geometry, cap_hit, cap_surface};
 use super::{LocalSurface, ShapeError, ShapeHit, positive, quadratic};
 use crate::math::{Aabb, DVec2, Ray, Vec3, gamma};
 
@@ -120,9 +120,33 @@ impl Cylinder {
         }
     }
 
-    /// The side's surface at `p`, moved radially onto the radius. The error
-    /// bound `γ(5)|p|` per axis covers the rounding of that move.
+    /// The surface at a hit without its parametric part: (u, v) and the
+    /// tangents are left zero (see [`crate::shape::Shape::surface_geometry`]).
+    pub fn surface_geometry(&self, ray: &Ray, hit: &ShapeHit) -> LocalSurface {
+        let p = ray.at(hit.t);
+        match hit.part {
+            BOTTOM => cap_geometry(p, 0.0, -1.0),
+            TOP => cap_geometry(p, self.height, 1.0),
+            _ => self.side_geometry(p),
+        }
+    }
+
+    /// The side's surface at `p` (see [`Self::side_geometry`]).
     fn side_surface(&self, p: Vec3) -> LocalSurface {
+        let s = self.side_geometry(p);
+        let point = s.point;
+        LocalSurface {
+            uv: DVec2::new(azimuth(point.x, point.y) / TAU, point.z / self.height),
+            dpdu: Vec3::new(-TAU * point.y, TAU * point.x, 0.0),
+            dpdv: Vec3::new(0.0, 0.0, self.height),
+            ..s
+        }
+    }
+
+    /// The side's point, error bound and normal at `p`, moved radially onto
+    /// the radius; (u, v) and the tangents zero. The error bound `γ(5)|p|`
+    /// per axis covers the rounding of that move.
+    fn side_geometry(&self, p: Vec3) -> LocalSurface {
         let r = p.x.hypot(p.y);
         let normal = if r > 0.0 {
             Vec3::new(p.x / r, p.y / r, 0.0)
@@ -138,9 +162,9 @@ impl Cylinder {
             point,
             point_error: gamma(5) * point.abs(),
             normal,
-            uv: DVec2::new(azimuth(point.x, point.y) / TAU, point.z / self.height),
-            dpdu: Vec3::new(-TAU * point.y, TAU * point.x, 0.0),
-            dpdv: Vec3::new(0.0, 0.0, self.height),
+            uv: DVec2::ZERO,
+            dpdu: Vec3::ZERO,
+            dpdv: Vec3::ZERO,
         }
     }
 

@@ -107,20 +107,31 @@ pub(super) fn cap_surface(
     radius: f64,
     inner_radius: f64,
 ) -> LocalSurface {
-    let point = Vec3::new(p.x, p.y, height);
     let r = p.x.hypot(p.y);
     let phi = azimuth(p.x, p.y);
     let (sin_phi, cos_phi) = phi.sin_cos();
     LocalSurface {
-        point,
-        point_error: gamma(5) * point.abs(),
-        normal: Vec3::new(0.0, 0.0, normal_z),
         uv: DVec2::new(
             phi / TAU,
             ((radius - r) / (radius - inner_radius)).clamp(0.0, 1.0),
         ),
         dpdu: Vec3::new(-TAU * p.y, TAU * p.x, 0.0),
         dpdv: -(radius - inner_radius) * Vec3::new(cos_phi, sin_phi, 0.0),
+        ..cap_geometry(p, height, normal_z)
+    }
+}
+
+/// [`cap_surface`] without its parametric part: the point, its error
+/// bound and the normal, (u, v) and the tangents left zero.
+pub(super) fn cap_geometry(p: Vec3, height: f64, normal_z: f64) -> LocalSurface {
+    let point = Vec3::new(p.x, p.y, height);
+    LocalSurface {
+        point,
+        point_error: gamma(5) * point.abs(),
+        normal: Vec3::new(0.0, 0.0, normal_z),
+        uv: DVec2::ZERO,
+        dpdu: Vec3::ZERO,
+        dpdv: Vec3::ZERO,
     }
 }
 

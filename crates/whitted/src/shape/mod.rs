@@ -347,6 +347,8 @@ impl Shape {
     pub fn surface_geometry(&self, ray: &Ray, hit: &ShapeHit) -> LocalSurface {
         match self {
             Shape::Sphere(s) => s.surface_geometry(ray, hit),
+            Shape::Cylinder(s) => s.surface_geometry(ray, hit),
+            Shape::Cone(s) => s.surface_geometry(ray, hit),
             Shape::Quadric(s) => s.surface_geometry(ray, hit),
             _ => self.surface(ray, hit),
         }
