@@ -836,6 +836,20 @@ mod tests {
     use crate::mesh::TriangleMesh;
     use crate::shape::{Cone, Cylinder, Plane, Polygon, Shape, Sphere, Triangle, plane_hit};
 
+    /// A random unit move if `moved`, else none.
+    fn moved_if(moved: bool, rng: &mut Rng) -> Transform {
+        if moved {
+            Transform::translate(rng.unit_vector()).unwrap()
+        } else {
+            Transform::IDENTITY
+        }
+    }
+
+    /// The world's entries of kind `kind`.
+    fn entries_of<'w>(world: &'w World, kind: EntryKind) -> Vec<&'w Entry> {
+        world.entries.iter().filter(|e| e.kind == kind).collect()
+    }
+
     fn scene_with(shape: Shape, transform: Transform) -> Objects {
         let mut objects = Objects::default();
         objects.add_primitive(shape, MaterialId(0), transform);
@@ -1074,19 +1088,11 @@ mod tests {
                 })
                 .collect();
             let polygon = Polygon::new(vertices).unwrap();
-            let transform = if i % 4 == 0 {
-                Transform::translate(rng.unit_vector()).unwrap()
-            } else {
-                Transform::IDENTITY
-            };
+            let transform = moved_if(i % 4 == 0, &mut rng);
             objects.add_primitive(Shape::Polygon(polygon), MaterialId(0), transform);
         }
         let world = World::new(&objects);
-        let polygons: Vec<&Entry> = world
-            .entries
-            .iter()
-            .filter(|e| e.kind == EntryKind::Polygon)
-            .collect();
+        let polygons = entries_of(&world, EntryKind::Polygon);
         assert_eq!(polygons.len(), 150);
         let (mut turned_away, mut hits) = (0, 0);
         for i in 0..300 {
@@ -1183,11 +1189,7 @@ mod tests {
             objects.add_primitive(shape, MaterialId(0), transform);
         }
         let world = World::new(&objects);
-        let axial: Vec<&Entry> = world
-            .entries
-            .iter()
-            .filter(|e| e.kind == EntryKind::Axial)
-            .collect();
+        let axial = entries_of(&world, EntryKind::Axial);
         assert_eq!(axial.len(), 120);
         let (mut turned_away, mut hits) = (0, 0);
         for i in 0..2000 {
@@ -1227,11 +1229,7 @@ mod tests {
         for i in 0..300 {
             let centre = 20.0 * rng.unit_vector() * rng.uniform();
             let sphere = Sphere::new(centre, 0.01 + 3.0 * rng.uniform()).unwrap();
-            let transform = if i % 3 == 0 {
-                Transform::translate(rng.unit_vector()).unwrap()
-            } else {
-                Transform::IDENTITY
-            };
+            let transform = moved_if(i % 3 == 0, &mut rng);
             objects.add_primitive(Shape::Sphere(sphere), MaterialId(0), transform);
         }
         let world = World::new(&objects);
