@@ -17,6 +17,12 @@ use crate::shape::{Polygon, RayShear, ShapeHit, Sphere, plane_hit, watertight};
 /// The margin of [`Entry::axis_missed`], relative to the sizes it adds.
 const AXIAL_MARGIN: f64 = 1e-6;
 
+/// The squared sine of the angle between a ray and an axis below which
+/// [`Entry::axis_missed`] does not judge: the cross product's rounding, up
+/// to a few times 1e-16 of the lengths' product, is then more than a
+/// millionth of it.
+const NEAR_AXIS: f64 = 1e-16;
+
 /// What an entry's number names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u32)]
@@ -99,11 +105,24 @@ impl Entry {
 
     /// A cylinder or a cone, reported as `number`: points within `radius`
     /// of the segment from `base` to `top` (see [`Entry::axis_missed`]).
+    /// Holds the base, the axis and, in the third corner, the reach and
+    /// the near-axis threshold.
     pub(super) fn axial(number: u32, base: Vec3, top: Vec3, radius: f64) -> Self {
+        let axis = top - base;
+        // What `axis_missed` needs that does not depend on the ray: the
+        // reach without the origin's part of the margin, and the least
+        // squared length of a cross product with a unit direction that it
+        // judges.
+        let reach =
+            radius + AXIAL_MARGIN * (radius + axis.abs().max_element() + base.abs().max_element());
         Self {
             number,
             kind: EntryKind::Axial,
-            corners: [base, top - base, Vec3::new(radius, 0.0, 0.0)],
+            corners: [
+                base,
+                axis,
+                Vec3::new(reach, NEAR_AXIS * axis.length_squared(), 0.0),
+            ],
         }
     }
 
@@ -145,23 +164,30 @@ impl Entry {
     }
 
     /// Whether an axial entry's shape is surely missed by `ray`: its line
-    /// passes farther from the axis's line than any point of the shape,
-    /// by a margin (a millionth of the shape's size and of the ray origin's
-    /// distance) far above the rounding of the shape's own test, which
-    /// then finds no hit either. Rays along the axis are never turned
-    /// away. Spares the trip through the primitive and transform tables
-    /// for most rays that reach a slanted cylinder's loose box (rings:
-    /// 4,200 cylinders, a third of the render in their test).
+    /// passes farther from the axis's line than any point of the shape, by
+    /// a margin far above the rounding of the shape's own test, which then
+    /// finds no hit either. The margin is a millionth of the shape's size,
+    /// of the ray origin's distance and of the coordinates (the axis's ends
+    /// are rounded where they lie). Rays within 1e-8 radians of the axis's
+    /// direction are never turned away: there the cross product below is
+    /// mostly rounding, which the margin would not cover. Spares the trip
+    /// through the primitive and transform tables for most rays that reach
+    /// a slanted cylinder's loose box (rings: 4,200 cylinders, a third of
+    /// the render in their test).
     #[inline(always)]
     fn axis_missed(&self, ray: &Ray) -> bool {
-        let [base, axis, radius] = self.corners;
+        let [base, axis, fixed] = self.corners;
         let across = ray.dir.cross(axis);
+        let across_squared = across.length_squared();
+        // False for NaN too: such a ray is left to the tables.
+        let judged = across_squared > fixed.y * ray.dir.length_squared();
+        if !judged {
+            return false;
+        }
         let from_base = ray.origin - base;
-        let margin =
-            AXIAL_MARGIN * (radius.x + axis.abs().max_element() + from_base.abs().max_element());
-        let reach = radius.x + margin;
+        let reach = fixed.x + AXIAL_MARGIN * from_base.abs().max_element();
         let distance = from_base.dot(across);
-        distance * distance > reach * reach * across.length_squared()
+        distance * distance > reach * reach * across_squared
     }
 
     /// Whether a polygon entry's plane is not crossed by `ray` in its

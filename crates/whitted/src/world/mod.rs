@@ -1222,6 +1222,67 @@ mod tests {
         assert!(hits > 1000, "{hits} hits");
     }
 
+    /// Whether the in-place cull of `world`'s only entry, an axial one,
+    /// turns `ray` away; panics if it does while the tables find a hit.
+    fn axial_cull_holds(world: &World, ray: &Ray) -> bool {
+        let e = &world.entries[0];
+        assert_eq!(e.kind, EntryKind::Axial);
+        let query = Query::new(ray, world.has_triangles);
+        let table = world.intersect_shape(e.number, &query, ray.t_max);
+        let turned_away = e.intersect_in_place(&query, ray.t_max) == Some(None);
+        assert!(!(turned_away && table.is_some()), "{ray:?} hits {table:?}");
+        turned_away
+    }
+
+    #[test]
+    fn rays_nearly_along_a_slanted_axis_or_far_from_the_origin_are_not_turned_away() {
+        // Found in review: a ray one ulp off a slanted axis, from 100
+        // heights back, meets the bottom cap, but the cross product of the
+        // two directions was mostly rounding.
+        let w = Vec3::new(0.9754675549367186, 0.1899991037878796, -0.11119078120771787);
+        let cylinder = Shape::Cylinder(Cylinder::new(1.0, 1.0, true).unwrap());
+        let objects = scene_with(cylinder, Transform::frame(Vec3::ZERO, w).unwrap());
+        let world = World::new(&objects);
+        let origin = Vec3::new(-97.43669139913086, -19.417876390503203, 11.370454945765113);
+        let ray = Ray::new(origin, Vec3::new(0.9754675549367187, w.y, w.z));
+        let query = Query::new(&ray, world.has_triangles);
+        assert!(world.intersect_shape(0, &query, ray.t_max).is_some());
+        assert!(!axial_cull_holds(&world, &ray));
+        // And rays tilted off random slanted axes by 1e-16 to 1e-6 radians,
+        // from far back, passing inside the radius.
+        let mut rng = Rng::new(24);
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let axis = rng.unit_vector();
+            let cylinder = Shape::Cylinder(Cylinder::new(1.0, 1.0, true).unwrap());
+            let objects = scene_with(cylinder, Transform::frame(Vec3::ZERO, axis).unwrap());
+            let world = World::new(&objects);
+            let (u, _) = axis.any_orthonormal_pair();
+            let tilt = 10f64.powf(-rng.range(6.0, 16.0));
+            let dir = (axis + tilt * rng.unit_vector()).normalize();
+            let ray = Ray::new(0.5 * u - 1000.0 * dir, dir);
+            let query = Query::new(&ray, world.has_triangles);
+            hits += usize::from(world.intersect_shape(0, &query, ray.t_max).is_some());
+            axial_cull_holds(&world, &ray);
+        }
+        assert!(hits > 1000, "{hits} hits");
+        // Found in review: a thin cylinder at x = 1e12, whose axis's ends
+        // are rounded to the spacing of numbers there.
+        let cylinder = Shape::Cylinder(Cylinder::new(1e-4, 1.0, true).unwrap());
+        let rows = [
+            [1.0, 0.0, 1.0 / 3.0, 1e12],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+        ];
+        let objects = scene_with(cylinder, Transform::from_rows(rows).unwrap());
+        let world = World::new(&objects);
+        let dir = Vec3::new(0.3033032291625134, -10.000004454312469, 0.9101850589387533);
+        let ray = Ray::new(Vec3::new(1e12, 10.0, 0.0), dir);
+        let query = Query::new(&ray, world.has_triangles);
+        assert!(world.intersect_shape(0, &query, ray.t_max).is_some());
+        assert!(!axial_cull_holds(&world, &ray));
+    }
+
     #[test]
     fn spheres_tested_in_place_answer_as_through_the_primitive_table() {
         let mut rng = Rng::new(21);
