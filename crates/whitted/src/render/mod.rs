@@ -7,6 +7,7 @@ mod camera;
 mod explain;
 mod gradient_note;
 mod merge;
+mod non_finite;
 mod part;
 mod photon_pass;
 mod prepared;
@@ -55,6 +56,7 @@ use crate::math::{DVec2, Ray, Vec3};
 use crate::shading::Color;
 use crate::world::{Hit, MAX_PRIMITIVES, MaterialId, PACKET_SIZE, Surface, World};
 use adaptive::{AdaptivePixels, Cost};
+use non_finite::NonFinite;
 use sample_ray::{pixel_pattern, sample_differential, sample_position};
 
 /// Side of the square tiles the image is cut into, in pixels.
@@ -213,20 +215,31 @@ struct Tile {
     selected: u64,
 }
 
+impl Tile {
+    /// Its pixels whose colour is not finite.
+    fn non_finite(&self) -> NonFinite {
+        NonFinite::of_tile(self.x0, self.y0, self.width, &self.color)
+    }
+}
+
 /// The films of a render being filled in as tiles finish.
 struct Films {
     image: Film,
     aovs: Vec<(Aov, Film)>,
     rays: RayCounts,
     cuts: HashMap<MaterialId, u64>,
+    /// The image's pixels whose colour is not finite, as the workers
+    /// found them in their tiles.
+    non_finite: NonFinite,
 }
 
 impl Films {
-    /// Copies a finished tile in, a row of its pixels at a time (the
-    /// caller holds the lock around the films meanwhile, and drops the
-    /// tile after).
-    fn add(&mut self, tile: &Tile) {
+    /// Copies a finished tile in, a row of its pixels at a time, with
+    /// `non_finite`, what its worker found of its pixels (the caller holds
+    /// the lock around the films meanwhile, and drops the tile after).
+    fn add(&mut self, tile: &Tile, non_finite: NonFinite) {
         self.rays += tile.rays;
+        self.non_finite.add(non_finite);
         for (&material, &samples) in &tile.cuts {
             *self.cuts.entry(material).or_default() += samples;
         }
@@ -391,6 +404,7 @@ fn trace_pixels(
             .collect(),
         rays: RayCounts::default(),
         cuts: HashMap::new(),
+        non_finite: NonFinite::default(),
     };
     pool.install(|| {
         films.image.map_pages();
@@ -421,10 +435,11 @@ fn trace_pixels(
                 )
             });
             let pixels = tile.selected;
+            let non_finite = tile.non_finite();
             films
                 .lock()
                 .unwrap_or_else(PoisonError::into_inner)
-                .add(&tile);
+                .add(&tile, non_finite);
             let now = done.fetch_add(pixels, Ordering::Relaxed) + pixels;
             progress(Progress { done: now, total });
         }
@@ -435,7 +450,7 @@ fn trace_pixels(
         return Err(RenderError::Cancelled);
     }
     let films = films.into_inner().unwrap_or_else(PoisonError::into_inner);
-    check_finite(&films.image)?;
+    films.non_finite.check()?;
     let ray_budget_cut = budget_cut(scene, settings, &films.cuts, films.rays[RayKind::Primary]);
     Ok(RenderOutput {
         image: films.image,
@@ -477,26 +492,6 @@ fn budget_cut(
         material,
         material_name: scene.material_name(material),
         max_depth: settings.max_depth,
-    })
-}
-
-/// The final guard on the colour film: an error naming the first pixel
-/// that holds inf or NaN, and how many do.
-fn check_finite(image: &Film) -> Result<(), RenderError> {
-    let mut bad = image
-        .data()
-        .chunks_exact(image.channels())
-        .enumerate()
-        .filter(|(_, pixel)| pixel.iter().any(|v| !v.is_finite()))
-        .map(|(i, _)| i);
-    let Some(first) = bad.next() else {
-        return Ok(());
-    };
-    let width = image.width() as usize;
-    Err(RenderError::NotFinite {
-        count: 1 + bad.count() as u64,
-        x: (first % width) as u32,
-        y: (first / width) as u32,
     })
 }
 
@@ -925,17 +920,5 @@ mod tests {
         });
         assert!(matches!(stopped, Err(RenderError::Cancelled)));
         assert_eq!(tiles.load(Ordering::Relaxed), 3, "tiles rendered of 12");
-    }
-
-    #[test]
-    fn a_film_with_inf_or_nan_is_refused_naming_the_first_pixel() {
-        let mut film = Film::new(4, 3, 3);
-        assert!(check_finite(&film).is_ok());
-        film.set_pixel(2, 1, &[0.0, f32::INFINITY, 0.0]);
-        film.set_pixel(3, 2, &[f32::NAN, 0.0, 0.0]);
-        let Err(RenderError::NotFinite { count, x, y }) = check_finite(&film) else {
-            panic!("an infinite pixel was let through");
-        };
-        assert_eq!((count, x, y), (2, 2, 1));
     }
 }
