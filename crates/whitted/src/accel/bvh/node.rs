@@ -142,15 +142,36 @@ impl BinaryNode {
 }
 
 /// The largest `f32` not above `x` (`-∞` below the `f32` range).
+///
+/// Every ray's walk rounds its origin, `t_min` and `t_max` so (seven
+/// times), and whether the nearest `f32` lies above `x` goes either way at
+/// random from one ray to the next: the step to the next `f32` below is
+/// written as a select, not a branch, and without `f32::next_down`'s own
+/// branches for values it never meets here. When the nearest `f32` is above
+/// `x` it is neither NaN, `+0` (only a negative `x` rounds up to zero, and
+/// to `-0`) nor `-∞`, so one step of the bits towards `-∞` is the next
+/// `f32` below: down for a positive value (`+∞` to `f32::MAX` included), up
+/// for a negative one (`-0` to the least negative `f32`).
+#[inline(always)]
 pub fn round_down(x: f64) -> f32 {
     let f = x as f32;
-    if f64::from(f) > x { f.next_down() } else { f }
+    let bits = f.to_bits();
+    let negative = bits >> 31;
+    let below = f32::from_bits(bits.wrapping_add(negative << 1).wrapping_sub(1));
+    if f64::from(f) > x { below } else { f }
 }
 
-/// The smallest `f32` not below `x` (`+∞` above the `f32` range).
+/// The smallest `f32` not below `x` (`+∞` above the `f32` range); the
+/// mirror of [`round_down`]: when the nearest `f32` is below `x` it is
+/// neither NaN, `-0` nor `+∞`, and one step of the bits towards `+∞` is
+/// the next `f32` above.
+#[inline(always)]
 pub fn round_up(x: f64) -> f32 {
     let f = x as f32;
-    if f64::from(f) < x { f.next_up() } else { f }
+    let bits = f.to_bits();
+    let negative = bits >> 31;
+    let above = f32::from_bits(bits.wrapping_add(1).wrapping_sub(negative << 1));
+    if f64::from(f) < x { above } else { f }
 }
 
 #[cfg(test)]
@@ -185,6 +206,63 @@ mod tests {
         assert_eq!(round_up(1e300), f32::INFINITY);
         assert_eq!(round_down(1e300), f32::MAX);
         assert_eq!(round_down(-1e300), f32::NEG_INFINITY);
+    }
+
+    #[test]
+    fn rounding_agrees_with_the_next_f32_of_the_standard_library() {
+        let reference_down = |x: f64| {
+            let f = x as f32;
+            if f64::from(f) > x { f.next_down() } else { f }
+        };
+        let reference_up = |x: f64| {
+            let f = x as f32;
+            if f64::from(f) < x { f.next_up() } else { f }
+        };
+        let tiny = f64::from(f32::from_bits(1));
+        let max = f64::from(f32::MAX);
+        let special = [
+            0.0,
+            -0.0,
+            tiny,
+            -tiny,
+            tiny / 3.0,
+            -tiny / 3.0,
+            1e-50,
+            -1e-50,
+            1e-39,
+            -1e-39,
+            max,
+            -max,
+            max * (1.0 + 1e-9),
+            -max * (1.0 + 1e-9),
+            1e300,
+            -1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            f64::MIN_POSITIVE,
+            0.1,
+            -0.1,
+        ];
+        let mut rng = crate::math::random::Rng::new(5);
+        let random = (0..200_000).map(|i| {
+            let bits = (u64::from(rng.next_u32()) << 32) | u64::from(rng.next_u32());
+            let near = f64::from(f32::from_bits(rng.next_u32()));
+            match i % 3 {
+                // Any bits; values near an f32 of any size; values near zero.
+                0 => f64::from_bits(bits),
+                1 => near * (1.0 + (rng.uniform() - 0.5) * 1e-7),
+                _ => (rng.uniform() - 0.5) * tiny * 1e3,
+            }
+        });
+        for x in special.into_iter().chain(random) {
+            assert_eq!(
+                round_down(x).to_bits(),
+                reference_down(x).to_bits(),
+                "{x:e}"
+            );
+            assert_eq!(round_up(x).to_bits(), reference_up(x).to_bits(), "{x:e}");
+        }
     }
 
     #[test]
