@@ -815,6 +815,74 @@ mod tests {
     }
 
     #[test]
+    fn tiles_gathered_in_any_order_name_the_image_s_first_bad_pixel() {
+        // Edge tiles narrower and shorter than the others, bad pixels off
+        // the diagonal, tiles added in a shuffled order.
+        let (width, height) = (2 * TILE_SIZE + 7, TILE_SIZE + 5);
+        let mut picture = Film::new(width, height, 3);
+        for y in 0..height {
+            for x in 0..width {
+                let i = (y * width + x) as f32;
+                picture.set_pixel(x, y, &[i, i + 0.25, i + 0.5]);
+            }
+        }
+        let bad = [
+            (TILE_SIZE + 3, 2),
+            (5, TILE_SIZE + 1),
+            (2 * TILE_SIZE + 4, 1),
+        ];
+        for (k, &(x, y)) in bad.iter().enumerate() {
+            let value = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY][k];
+            picture.set_pixel(x, y, &[0.5, value, 0.5]);
+        }
+        let mut tiles: Vec<Tile> = (0..tile_count(width, height) as u32)
+            .map(|index| {
+                let tiles_x = width.div_ceil(TILE_SIZE);
+                let (x0, y0) = (index % tiles_x * TILE_SIZE, index / tiles_x * TILE_SIZE);
+                let (w, h) = (TILE_SIZE.min(width - x0), TILE_SIZE.min(height - y0));
+                let color = (y0..y0 + h)
+                    .flat_map(|y| (x0..x0 + w).map(move |x| (x, y)))
+                    .flat_map(|(x, y)| picture.pixel(x, y).to_vec())
+                    .collect();
+                Tile {
+                    x0,
+                    y0,
+                    width: w,
+                    height: h,
+                    color,
+                    aovs: Vec::new(),
+                    rays: RayCounts::default(),
+                    cuts: HashMap::new(),
+                    selected: u64::from(w * h),
+                }
+            })
+            .collect();
+        tiles.reverse();
+        tiles.swap(0, 2);
+        let mut films = Films {
+            image: Film::new(width, height, 3),
+            aovs: Vec::new(),
+            rays: RayCounts::default(),
+            cuts: HashMap::new(),
+            non_finite: NonFinite::default(),
+        };
+        for tile in &tiles {
+            films.add(tile, tile.non_finite());
+        }
+        let same = |a: &Film, b: &Film| {
+            a.data()
+                .iter()
+                .zip(b.data())
+                .all(|(p, q)| p.to_bits() == q.to_bits())
+        };
+        assert!(same(&films.image, &picture));
+        let Err(RenderError::NotFinite { count, x, y }) = films.non_finite.check() else {
+            panic!("the bad pixels went unnoticed");
+        };
+        assert_eq!((count, x, y), (3, 2 * TILE_SIZE + 4, 1));
+    }
+
+    #[test]
     fn an_exploding_ray_tree_is_cut_at_the_budget_and_names_its_material() {
         let scene = glass_in_mirrors();
         let output = render(&scene, &|_| {}).unwrap();
