@@ -36,7 +36,7 @@ use crate::shading::{
     Color, Crossing, Light, Lobes, Material, MediumStack, RayDifferential, Weights, direct_samples,
     phong, shading_normal,
 };
-use crate::world::{Hit, MaterialId, OpaqueEntries, ShadowPath, Surface, World};
+use crate::world::{Hit, MaterialId, OpaqueEntries, PassedEntries, ShadowPath, Surface, World};
 
 /// Longest chain of transmissive surfaces one shadow ray passes through.
 const MAX_SHADOW_CROSSINGS: usize = 64;
@@ -422,15 +422,13 @@ impl<'a> Whitted<'a> {
                 .shadow_ray(&ray, ShadowStep::AnyHit { blocked });
             return if blocked { Color::ZERO } else { Color::ONE };
         }
-        // A shadow ray that leaves a surface letting light through on its
-        // inner side most often crosses it again (a closed glass solid): it
-        // goes straight to the surface-to-surface walk.
-        if let Some(opaque) = &self.opaque
-            && (to_light.dot(s.normal) > 0.0
-                || !self.shading.materials[s.material.0 as usize].is_transmissive())
-        {
+        // One any-hit walk tells most shadow rays apart; for those that
+        // cross surfaces letting light through, it lists them, and the
+        // surface-to-surface walk tests only those.
+        let mut passed = PassedEntries::UNLISTED;
+        if let Some(opaque) = &self.opaque {
             match shadow_cache::shadow_path(self.world, &ray, opaque, index) {
-                ShadowPath::Crossed => {}
+                ShadowPath::Crossed(entries) => passed = entries,
                 path => {
                     let blocked = path == ShadowPath::Blocked;
                     tally
@@ -442,7 +440,7 @@ impl<'a> Whitted<'a> {
         }
         let mut through = Color::ONE;
         for _ in 0..MAX_SHADOW_CROSSINGS {
-            let Some(hit) = self.world.intersect(&ray) else {
+            let Some(hit) = self.world.intersect_passed(&ray, &passed) else {
                 let step = ShadowStep::Closest { blocker: None };
                 tally.observer.shadow_ray(&ray, step);
                 return through;

@@ -4,13 +4,19 @@
 //! or nothing at all, and one any-hit walk tells those apart: it stops at
 //! the first entry whose material lets nothing through, and only notes the
 //! others. Only a ray that crosses such surfaces and nothing opaque needs
-//! the surface-to-surface walk.
+//! the surface-to-surface walk, and the any-hit walk lists the entries it
+//! met ([`PassedEntries`]): each step of that walk then tests those alone
+//! instead of walking the whole structure again.
 
 use crate::accel::{AccelerationStructure, QueryContext};
 use crate::math::Ray;
 use crate::shape::Shape;
 use crate::world::entry::{Entry, EntryKind, Query, leaf_meets};
-use crate::world::{MaterialId, PrimitiveRef, ShadowHint, World};
+use crate::world::{Hit, MaterialId, PrimitiveId, PrimitiveRef, ShadowHint, World};
+
+/// Most entries a [`PassedEntries`] lists; a shadow ray that meets more
+/// takes whole-structure steps.
+const PASSED_CAPACITY: usize = 12;
 
 /// Which of a world's entries stop light: those every hit of which shows a
 /// material that lets nothing through ([`World::opaque_entries`]).
@@ -29,9 +35,73 @@ pub enum ShadowPath {
     Clear,
     /// Something opaque: no light arrives, whatever else lies in the way.
     Blocked,
-    /// Only surfaces that may let light through: the light that arrives is
-    /// what each lets through, found by walking from one to the next.
-    Crossed,
+    /// Only surfaces that may let light through, on these entries: the
+    /// light that arrives is what each lets through, found by walking from
+    /// one to the next ([`World::intersect_passed`]).
+    Crossed(PassedEntries),
+}
+
+/// The entries letting light through that a shadow ray's interval meets,
+/// as the any-hit walk of [`World::shadow_path`] found them (in its order),
+/// or [`PassedEntries::UNLISTED`] when they are not known.
+///
+/// The surface-to-surface walk that follows steps along the same line
+/// towards the same end, so its hits are on these entries: testing them
+/// alone answers as a walk of the whole structure would. The one exception
+/// is a step ray, which leaves each surface a few rounding errors off the
+/// line, grazing the edge of a shape that the line itself missed by less
+/// than that (the same uncertainty a ray's own rounding already has).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PassedEntries {
+    /// Positions in the world's entries.
+    entries: [u32; PASSED_CAPACITY],
+    /// How many of `entries` are listed; more than the capacity when the
+    /// list is not known.
+    len: usize,
+    /// The unbounded entries met, bit `i` for entry `i`.
+    unbounded: u32,
+}
+
+impl PassedEntries {
+    /// Entries not known: every step walks the whole structure.
+    pub const UNLISTED: Self = Self {
+        entries: [0; PASSED_CAPACITY],
+        len: PASSED_CAPACITY + 1,
+        unbounded: 0,
+    };
+
+    /// No entry yet.
+    const EMPTY: Self = Self {
+        entries: [0; PASSED_CAPACITY],
+        len: 0,
+        unbounded: 0,
+    };
+
+    /// Whether the entries are listed.
+    pub fn is_listed(&self) -> bool {
+        self.len <= PASSED_CAPACITY
+    }
+
+    /// Adds the entry at position `entry`; past the capacity the list is
+    /// [`PassedEntries::UNLISTED`].
+    fn push(&mut self, entry: u32) {
+        if self.len < PASSED_CAPACITY {
+            self.entries[self.len] = entry;
+            self.len += 1;
+        } else {
+            *self = Self::UNLISTED;
+        }
+    }
+
+    /// Adds unbounded entry `i`; one past the bits makes the list
+    /// [`PassedEntries::UNLISTED`].
+    fn push_unbounded(&mut self, i: usize) {
+        if i < u32::BITS as usize {
+            self.unbounded |= 1 << i;
+        } else {
+            *self = Self::UNLISTED;
+        }
+    }
 }
 
 impl World<'_> {
@@ -100,13 +170,13 @@ impl World<'_> {
             return ShadowPath::Blocked;
         }
         *hint = ShadowHint::NONE;
-        let mut crossed = false;
-        for (e, &stops) in self.unbounded.iter().zip(&opaque.unbounded) {
+        let mut passed = PassedEntries::EMPTY;
+        for (i, (e, &stops)) in self.unbounded.iter().zip(&opaque.unbounded).enumerate() {
             if self.shape_occludes(e.number, &query) {
                 if stops {
                     return ShadowPath::Blocked;
                 }
-                crossed = true;
+                passed.push_unbounded(i);
             }
         }
         let mut ctx = QueryContext::default();
@@ -118,8 +188,11 @@ impl World<'_> {
                 self.wide,
                 |e| self.shape_occludes(e.number, &query),
                 |entry| {
-                    crossed |= !opaque.entries[entry as usize];
-                    opaque.entries[entry as usize]
+                    let stops = opaque.entries[entry as usize];
+                    if !stops {
+                        passed.push(entry);
+                    }
+                    stops
                 },
             );
             if let Some(entry) = blocker {
@@ -129,11 +202,53 @@ impl World<'_> {
         });
         if blocked {
             ShadowPath::Blocked
-        } else if crossed {
-            ShadowPath::Crossed
+        } else if passed.len != 0 || passed.unbounded != 0 {
+            ShadowPath::Crossed(passed)
         } else {
             ShadowPath::Clear
         }
+    }
+
+    /// The closest hit in `ray`'s interval among the entries `passed`
+    /// lists (a shadow ray's, found by [`World::shadow_path`] for a ray
+    /// along the same line), each tested as the closest-hit walk tests it;
+    /// [`World::intersect`] when they are not listed.
+    pub fn intersect_passed(&self, ray: &Ray, passed: &PassedEntries) -> Option<Hit> {
+        if !passed.is_listed() {
+            return self.intersect(ray);
+        }
+        let query = Query::new(ray, self.has_triangles);
+        let mut inner = QueryContext::default();
+        let mut best: Option<Hit> = None;
+        let mut t_max = ray.t_max;
+        let unbounded = (0..self.unbounded.len()).filter(|&i| passed.unbounded >> i & 1 == 1);
+        for i in unbounded {
+            let e = &self.unbounded[i];
+            if let Some((primitive, h)) =
+                self.intersect_other(&self.definitions, e, &query, t_max, &mut inner)
+            {
+                t_max = h.t;
+                best = Some(Hit {
+                    primitive: PrimitiveId(primitive),
+                    shape_hit: h,
+                });
+            }
+        }
+        for &entry in &passed.entries[..passed.len] {
+            let e = &self.entries[entry as usize];
+            let hit = match e.intersect_in_place(&query, t_max) {
+                Some(hit) => hit.map(|h| (e.number, h)),
+                None => self.intersect_other(&self.definitions, e, &query, t_max, &mut inner),
+            };
+            if let Some((primitive, h)) = hit {
+                t_max = h.t;
+                best = Some(Hit {
+                    primitive: PrimitiveId(primitive),
+                    shape_hit: h,
+                });
+            }
+        }
+        best
     }
 }
 
@@ -179,23 +294,44 @@ mod tests {
         objects
     }
 
-    /// What the surface-to-surface walk finds along `ray`: every surface
-    /// in its interval, in order, by its material.
-    fn walk(world: &World<'_>, ray: &Ray) -> ShadowPath {
+    /// What the surface-to-surface walk finds along `ray`, each step's
+    /// closest hit found by `step`: whether it meets something opaque
+    /// (material 0), and the hits up to that.
+    fn walk(
+        world: &World<'_>,
+        ray: &Ray,
+        step: impl Fn(&Ray) -> Option<Hit>,
+    ) -> (PathKind, Vec<Hit>) {
         let mut ray = *ray;
-        let mut crossed = false;
-        while let Some(hit) = world.intersect(&ray) {
-            let material = world.surface(&ray, &hit).material;
-            if material == MaterialId(0) {
-                return ShadowPath::Blocked;
+        let mut hits = Vec::new();
+        while let Some(hit) = step(&ray) {
+            hits.push(hit);
+            if world.surface(&ray, &hit).material == MaterialId(0) {
+                return (PathKind::Blocked, hits);
             }
-            crossed = true;
             ray.t_min = hit.shape_hit.t;
         }
-        if crossed {
-            ShadowPath::Crossed
+        let kind = if hits.is_empty() {
+            PathKind::Clear
         } else {
-            ShadowPath::Clear
+            PathKind::Crossed
+        };
+        (kind, hits)
+    }
+
+    /// A [`ShadowPath`] without its entries.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+    enum PathKind {
+        Clear,
+        Blocked,
+        Crossed,
+    }
+
+    fn kind_of(path: ShadowPath) -> PathKind {
+        match path {
+            ShadowPath::Clear => PathKind::Clear,
+            ShadowPath::Blocked => PathKind::Blocked,
+            ShadowPath::Crossed(_) => PathKind::Crossed,
         }
     }
 
@@ -219,12 +355,74 @@ mod tests {
                 let ray = Ray::segment(from, (light - from).normalize(), (light - from).length());
                 let path = world.shadow_path(&ray, &opaque, &mut ShadowHint::default());
                 assert_eq!(world.shadow_path(&ray, &opaque, &mut hint), path, "hinted");
-                assert_eq!(path, walk(&world, &ray), "{kind:?} {ray:?}");
+                let (expected, _) = walk(&world, &ray, |r| world.intersect(r));
+                assert_eq!(kind_of(path), expected, "{kind:?} {ray:?}");
                 assert_eq!(path != ShadowPath::Clear, world.occluded(&ray), "{kind:?}");
-                seen[path as usize] += 1;
+                seen[expected as usize] += 1;
             }
             assert!(seen.iter().all(|&n| n > 100), "{kind:?}: {seen:?}");
         }
+    }
+
+    #[test]
+    fn stepping_through_the_entries_passed_finds_the_hits_of_whole_walks() {
+        let mut rng = Rng::new(13);
+        let objects = mixed_scene(&mut rng);
+        for kind in [AccelKind::Bvh, AccelKind::KdTree, AccelKind::Grid] {
+            let world = World::build(&objects, kind);
+            let opaque = world.opaque_entries(&[true, false]).unwrap();
+            // Crossed paths listed, those with two hits or more, those
+            // through the unbounded floor.
+            let mut seen = [0; 3];
+            for i in 0..3000 {
+                let from = 12.0 * rng.unit_vector() * rng.uniform();
+                // Lights above and below the floor at y = -11.
+                let y = if i % 2 == 0 { 20.0 } else { -20.0 };
+                let light = Vec3::new(3.0, y, -4.0) + 4.0 * rng.unit_vector();
+                let ray = Ray::segment(from, (light - from).normalize(), (light - from).length());
+                let ShadowPath::Crossed(passed) =
+                    world.shadow_path(&ray, &opaque, &mut ShadowHint::default())
+                else {
+                    continue;
+                };
+                let (_, whole) = walk(&world, &ray, |r| world.intersect(r));
+                let (_, listed) = walk(&world, &ray, |r| world.intersect_passed(r, &passed));
+                assert_eq!(listed, whole, "{kind:?} {ray:?}");
+                seen[0] += usize::from(passed.is_listed());
+                seen[1] += usize::from(whole.len() >= 2);
+                seen[2] += usize::from(whole.iter().any(|h| h.primitive.0 == 150));
+            }
+            assert!(seen.iter().all(|&n| n > 50), "{kind:?}: {seen:?}");
+        }
+    }
+
+    #[test]
+    fn a_ray_past_more_entries_than_a_list_holds_walks_the_whole_structure() {
+        let mut objects = Objects::default();
+        for i in 0..PASSED_CAPACITY + 4 {
+            let sphere = Sphere::new(Vec3::new(3.0 * i as f64, 0.0, 0.0), 1.0).unwrap();
+            objects.add_primitive(Shape::Sphere(sphere), MaterialId(1), Transform::IDENTITY);
+        }
+        let world = World::new(&objects);
+        let opaque = world.opaque_entries(&[true, false]).unwrap();
+        let span = 3.0 * PASSED_CAPACITY as f64;
+        let ray = |end: f64| Ray::segment(Vec3::new(-5.0, 0.0, 0.0), Vec3::X, end + 5.0);
+        let path = |ray: &Ray| world.shadow_path(ray, &opaque, &mut ShadowHint::default());
+        let ShadowPath::Crossed(short) = path(&ray(span - 3.0)) else {
+            panic!("the short ray crosses spheres");
+        };
+        assert!(short.is_listed());
+        let long = ray(span + 12.0);
+        let ShadowPath::Crossed(passed) = path(&long) else {
+            panic!("the long ray crosses spheres");
+        };
+        assert_eq!(passed, PassedEntries::UNLISTED);
+        let whole = walk(&world, &long, |r| world.intersect(r));
+        assert_eq!(whole.1.len(), 2 * (PASSED_CAPACITY + 4));
+        assert_eq!(
+            walk(&world, &long, |r| world.intersect_passed(r, &passed)),
+            whole
+        );
     }
 
     #[test]
@@ -234,10 +432,10 @@ mod tests {
         let world = World::new(&objects);
         let opaque = world.opaque_entries(&[false, false]).unwrap();
         let ray = Ray::segment(Vec3::new(0.0, -30.0, 0.0), Vec3::Y, 60.0);
-        assert_eq!(
+        assert!(matches!(
             world.shadow_path(&ray, &opaque, &mut ShadowHint::default()),
-            ShadowPath::Crossed
-        );
+            ShadowPath::Crossed(_)
+        ));
         let all = world.opaque_entries(&[true, true]).unwrap();
         assert_eq!(
             world.shadow_path(&ray, &all, &mut ShadowHint::default()),
