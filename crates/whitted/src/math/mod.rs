@@ -12,6 +12,7 @@
 //! scene scaled by 1e-3 or 1e4 renders the same picture.
 
 pub mod magnitude;
+pub mod prefetch;
 pub mod random;
 pub mod sampling;
 #[cfg(all(test, target_arch = "x86_64"))]

@@ -7,6 +7,7 @@
 //! render the same picture; only the memory differs. A zero-area triangle is
 //! kept (its index stays what the file says) and is never hit.
 
+use crate::math::prefetch::prefetch;
 use crate::math::{Aabb, DVec2, Ray, Vec3, gamma};
 use crate::shape::{LocalSurface, RayShear, ShapeHit, watertight};
 
@@ -173,6 +174,33 @@ impl TriangleMesh {
     pub fn intersect(&self, i: u32, ray: &Ray, shear: &RayShear) -> Option<ShapeHit> {
         let [p0, p1, p2] = self.corners(i);
         watertight(p0, p1, p2, ray, shear)
+    }
+
+    /// Starts loading the corner indices of triangle `i`, the first read
+    /// of [`TriangleMesh::surface`] (see [`TriangleMesh::prefetch_corners`]).
+    #[inline]
+    pub fn prefetch_indices(&self, i: u32) {
+        if let Some(t) = self.triangles.get(i as usize) {
+            prefetch(t);
+        }
+    }
+
+    /// Starts loading what [`TriangleMesh::surface`] reads of triangle
+    /// `i`'s corners: their positions and normals. Reads the indices, so
+    /// it pays after [`TriangleMesh::prefetch_indices`] has had time.
+    #[inline]
+    pub fn prefetch_corners(&self, i: u32) {
+        let Some(t) = self.triangles.get(i as usize) else {
+            return;
+        };
+        for &v in t {
+            if let Some(p) = self.positions.get(v as usize) {
+                prefetch(p);
+            }
+            if let Some(n) = self.normals.get(v as usize) {
+                prefetch(n);
+            }
+        }
     }
 
     /// The surface of triangle `i` at a hit `ray` made, interpolating vertex
@@ -424,5 +452,15 @@ mod tests {
             TriangleMesh::new(nan, vec![]),
             Err(MeshError::NotFinite { index: 1, .. })
         ));
+    }
+
+    #[test]
+    fn prefetching_reads_only_triangles_and_corners_that_exist() {
+        let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+        let mesh = TriangleMesh::new(positions, vec![[0, 1, 2], [0, 2, 3]]).unwrap();
+        for i in [0, 1, 2, u32::MAX] {
+            mesh.prefetch_indices(i);
+            mesh.prefetch_corners(i);
+        }
     }
 }

@@ -62,6 +62,10 @@ use sample_ray::{pixel_pattern, sample_differential, sample_position};
 /// Side of the square tiles the image is cut into, in pixels.
 const TILE_SIZE: u32 = 16;
 
+/// How many pixels ahead of the one it shades a row starts loading the
+/// surface of a camera ray's hit ([`World::prefetch_surface`]).
+const SURFACES_AHEAD: usize = 2;
+
 /// The world of `scene`, its structures of the kinds its settings ask for
 /// (shared by [`render`] and [`explain_pixel`], which must trace the same).
 fn build_world(scene: &Scene) -> World<'_> {
@@ -661,6 +665,9 @@ impl RowSamples {
             camera.rays(width, height, &self.positions[..count], &mut self.rays);
             if packets {
                 self.find_hits(world, selection, (row.clone(), y));
+                for hit in self.hits[..count].iter().flatten() {
+                    world.prefetch_surface_start(hit);
+                }
             }
             for (i, x) in row.clone().enumerate() {
                 if !selected(x) {
@@ -668,6 +675,9 @@ impl RowSamples {
                 }
                 let ray = &self.rays[i];
                 let hit = if packets {
+                    if let Some(Some(ahead)) = self.hits[..count].get(i + SURFACES_AHEAD) {
+                        world.prefetch_surface(ahead);
+                    }
                     self.hits[i]
                 } else {
                     world.intersect(ray)

@@ -738,6 +738,27 @@ impl<'a> World<'a> {
         occluded
     }
 
+    /// Starts loading the first data [`World::surface`] will read for
+    /// `hit`, where that is likely a cache miss (a mesh triangle's corner
+    /// indices); [`World::prefetch_surface`] goes on from there.
+    #[inline]
+    pub fn prefetch_surface_start(&self, hit: &Hit) {
+        if let PrimitiveRef::Triangle { instance, triangle } = self.primitive_ref(hit.primitive.0) {
+            let m = &self.objects.mesh_instances[instance as usize];
+            self.objects.meshes[m.mesh.0 as usize].prefetch_indices(triangle);
+        }
+    }
+
+    /// Starts loading the rest of what [`World::surface`] will read for
+    /// `hit` (a mesh triangle's corners).
+    #[inline]
+    pub fn prefetch_surface(&self, hit: &Hit) {
+        if let PrimitiveRef::Triangle { instance, triangle } = self.primitive_ref(hit.primitive.0) {
+            let m = &self.objects.mesh_instances[instance as usize];
+            self.objects.meshes[m.mesh.0 as usize].prefetch_corners(triangle);
+        }
+    }
+
     /// The world-space surface at a hit returned for `ray`.
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> Surface {
         self.surface_for(ray, hit, &[])
