@@ -23,9 +23,25 @@ const PASSED_CAPACITY: usize = 12;
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct OpaqueEntries {
     /// Per entry of the structure, in the world's entry order.
-    entries: Vec<bool>,
+    entries: Vec<Passage>,
     /// Per unbounded entry.
-    unbounded: Vec<bool>,
+    unbounded: Vec<Passage>,
+}
+
+/// What an entry does to a shadow ray that meets it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Passage {
+    /// Stops it: no light arrives.
+    Stops,
+    /// Lets light through, at a parameter its test finds by a closed
+    /// formula (the same whatever interval it is tested under): listed in
+    /// [`PassedEntries`].
+    Listed,
+    /// Lets light through, at a parameter a search finds (a Bézier patch,
+    /// CSG): which of two nearby roots it reports may depend on the
+    /// interval it is tested under, and so on the order of the tests, so
+    /// the steps walk the whole structure as the plain query does.
+    Searched,
 }
 
 /// What lies along a shadow ray's interval ([`World::shadow_path`]).
@@ -116,13 +132,24 @@ impl World<'_> {
         if self.instance_count != 0 {
             return None;
         }
-        let stops = |e: &Entry| {
-            self.entry_material(e)
-                .is_some_and(|m| opaque.get(m.0 as usize) == Some(&true))
+        let passage = |e: &Entry| {
+            let stops = self
+                .entry_material(e)
+                .is_some_and(|m| opaque.get(m.0 as usize) == Some(&true));
+            let closed_form = match e.kind {
+                EntryKind::Primitive => self.shapes[e.number as usize].shape.closed_form(),
+                EntryKind::Instance | EntryKind::Placed => false,
+                _ => true,
+            };
+            match (stops, closed_form) {
+                (true, _) => Passage::Stops,
+                (false, true) => Passage::Listed,
+                (false, false) => Passage::Searched,
+            }
         };
         Some(OpaqueEntries {
-            entries: self.entries.iter().map(stops).collect(),
-            unbounded: self.unbounded.iter().map(stops).collect(),
+            entries: self.entries.iter().map(passage).collect(),
+            unbounded: self.unbounded.iter().map(passage).collect(),
         })
     }
 
@@ -166,17 +193,20 @@ impl World<'_> {
         let query = Query::new(ray, self.has_triangles);
         // A hint left by another query may name any entry: only one that
         // stops light can answer for the walk.
-        if opaque.entries.get(hint.0 as usize) == Some(&true) && self.hint_blocks(*hint, &query) {
+        if opaque.entries.get(hint.0 as usize) == Some(&Passage::Stops)
+            && self.hint_blocks(*hint, &query)
+        {
             return ShadowPath::Blocked;
         }
         *hint = ShadowHint::NONE;
         let mut passed = PassedEntries::EMPTY;
-        for (i, (e, &stops)) in self.unbounded.iter().zip(&opaque.unbounded).enumerate() {
+        for (i, (e, &passage)) in self.unbounded.iter().zip(&opaque.unbounded).enumerate() {
             if self.shape_occludes(e.number, &query) {
-                if stops {
-                    return ShadowPath::Blocked;
+                match passage {
+                    Passage::Stops => return ShadowPath::Blocked,
+                    Passage::Listed => passed.push_unbounded(i),
+                    Passage::Searched => passed = PassedEntries::UNLISTED,
                 }
-                passed.push_unbounded(i);
             }
         }
         let mut ctx = QueryContext::default();
@@ -187,12 +217,16 @@ impl World<'_> {
                 &query,
                 self.wide,
                 |e| self.shape_occludes(e.number, &query),
-                |entry| {
-                    let stops = opaque.entries[entry as usize];
-                    if !stops {
+                |entry| match opaque.entries[entry as usize] {
+                    Passage::Stops => true,
+                    Passage::Listed => {
                         passed.push(entry);
+                        false
                     }
-                    stops
+                    Passage::Searched => {
+                        passed = PassedEntries::UNLISTED;
+                        false
+                    }
                 },
             );
             if let Some(entry) = blocker {
@@ -212,7 +246,9 @@ impl World<'_> {
     /// The closest hit in `ray`'s interval among the entries `passed`
     /// lists (a shadow ray's, found by [`World::shadow_path`] for a ray
     /// along the same line), each tested as the closest-hit walk tests it;
-    /// [`World::intersect`] when they are not listed.
+    /// [`World::intersect`] when they are not listed, or when two of them
+    /// are hit at the very same parameter: the walk then keeps the one it
+    /// visits first, which the list's order cannot tell.
     pub fn intersect_passed(&self, ray: &Ray, passed: &PassedEntries) -> Option<Hit> {
         if !passed.is_listed() {
             return self.intersect(ray);
@@ -220,33 +256,34 @@ impl World<'_> {
         let query = Query::new(ray, self.has_triangles);
         let mut inner = QueryContext::default();
         let mut best: Option<Hit> = None;
-        let mut t_max = ray.t_max;
-        let unbounded = (0..self.unbounded.len()).filter(|&i| passed.unbounded >> i & 1 == 1);
-        for i in unbounded {
-            let e = &self.unbounded[i];
-            if let Some((primitive, h)) =
-                self.intersect_other(&self.definitions, e, &query, t_max, &mut inner)
-            {
-                t_max = h.t;
-                best = Some(Hit {
-                    primitive: PrimitiveId(primitive),
-                    shape_hit: h,
-                });
-            }
-        }
-        for &entry in &passed.entries[..passed.len] {
-            let e = &self.entries[entry as usize];
+        let unbounded = (0..self.unbounded.len())
+            .filter(|&i| passed.unbounded >> i & 1 == 1)
+            .map(|i| &self.unbounded[i]);
+        let listed = passed.entries[..passed.len]
+            .iter()
+            .map(|&entry| &self.entries[entry as usize]);
+        for e in unbounded.chain(listed) {
+            // One step past the closest so far, to see a tie.
+            let t_max = best.map_or(ray.t_max, |b| b.shape_hit.t.next_up());
             let hit = match e.intersect_in_place(&query, t_max) {
                 Some(hit) => hit.map(|h| (e.number, h)),
                 None => self.intersect_other(&self.definitions, e, &query, t_max, &mut inner),
             };
-            if let Some((primitive, h)) = hit {
-                t_max = h.t;
-                best = Some(Hit {
-                    primitive: PrimitiveId(primitive),
-                    shape_hit: h,
-                });
+            let Some((primitive, shape_hit)) = hit else {
+                continue;
+            };
+            if let Some(b) = best
+                && shape_hit.t == b.shape_hit.t
+            {
+                if primitive == b.primitive.0 {
+                    continue;
+                }
+                return self.intersect(ray);
             }
+            best = Some(Hit {
+                primitive: PrimitiveId(primitive),
+                shape_hit,
+            });
         }
         best
     }
@@ -446,5 +483,57 @@ mod tests {
             world.shadow_path(&away, &all, &mut ShadowHint::default()),
             ShadowPath::Clear
         );
+    }
+
+    #[test]
+    fn two_entries_hit_at_the_same_parameter_are_told_apart_by_the_whole_walk() {
+        // Two clear triangles over each other, as two primitives.
+        let mut objects = Objects::default();
+        let corners = [
+            Vec3::new(-1.0, 0.0, -1.0),
+            Vec3::new(1.0, 0.0, -1.0),
+            Vec3::Z,
+        ];
+        for _ in 0..2 {
+            let triangle = crate::shape::Triangle::new(corners[0], corners[1], corners[2]).unwrap();
+            objects.add_primitive(
+                Shape::Triangle(triangle),
+                MaterialId(1),
+                Transform::IDENTITY,
+            );
+        }
+        let world = World::new(&objects);
+        let ray = Ray::segment(Vec3::new(0.1, -2.0, 0.0), Vec3::Y, 4.0);
+        let whole = world.intersect(&ray).unwrap();
+        // Both orders of the list: one of them is not the walk's.
+        for order in [[0, 1], [1, 0]] {
+            let mut passed = PassedEntries::EMPTY;
+            order.into_iter().for_each(|entry| passed.push(entry));
+            assert_eq!(world.intersect_passed(&ray, &passed), Some(whole));
+        }
+    }
+
+    #[test]
+    fn a_shape_found_by_a_search_leaves_the_entries_unlisted() {
+        let mut objects = Objects::default();
+        let torus = crate::shape::Torus::new(1.0, 0.3).unwrap();
+        objects.add_primitive(Shape::Torus(torus), MaterialId(1), Transform::IDENTITY);
+        let sphere = Sphere::new(Vec3::new(0.0, 3.0, 0.0), 0.5).unwrap();
+        objects.add_primitive(Shape::Sphere(sphere), MaterialId(1), Transform::IDENTITY);
+        let world = World::new(&objects);
+        let opaque = world.opaque_entries(&[true, false]).unwrap();
+        let path = |ray: &Ray| world.shadow_path(ray, &opaque, &mut ShadowHint::default());
+        // Through the torus's tube (around the y axis) and through the
+        // sphere alone.
+        let tube = Ray::segment(Vec3::new(1.0, -5.0, 0.0), Vec3::Y, 10.0);
+        let ShadowPath::Crossed(passed) = path(&tube) else {
+            panic!("the ray crosses the torus");
+        };
+        assert!(!passed.is_listed());
+        let sphere_only = Ray::segment(Vec3::new(0.0, 1.0, 0.0), Vec3::Y, 10.0);
+        let ShadowPath::Crossed(passed) = path(&sphere_only) else {
+            panic!("the ray crosses the sphere");
+        };
+        assert!(passed.is_listed());
     }
 }
