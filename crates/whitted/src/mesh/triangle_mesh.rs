@@ -186,8 +186,10 @@ impl TriangleMesh {
     }
 
     /// Starts loading what [`TriangleMesh::surface`] reads of triangle
-    /// `i`'s corners: their positions and normals. Reads the indices, so
-    /// it pays after [`TriangleMesh::prefetch_indices`] has had time.
+    /// `i`'s corners: their positions and normals (not texture
+    /// coordinates, which the meshes big enough to gain have not had).
+    /// Reads the indices, so it pays after
+    /// [`TriangleMesh::prefetch_indices`] has had time.
     #[inline]
     pub fn prefetch_corners(&self, i: u32) {
         let Some(t) = self.triangles.get(i as usize) else {
@@ -455,7 +457,7 @@ mod tests {
     }
 
     #[test]
-    fn prefetching_reads_only_triangles_and_corners_that_exist() {
+    fn prefetching_a_triangle_past_the_mesh_does_nothing() {
         let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
         let mesh = TriangleMesh::new(positions, vec![[0, 1, 2], [0, 2, 3]]).unwrap();
         for i in [0, 1, 2, u32::MAX] {

@@ -649,6 +649,8 @@ impl RowSamples {
         let spp = settings.samples_per_pixel;
         let world = integrator.world();
         let packets = settings.packets && world.walks_packets();
+        // The hits are this row's only where `find_hits` filled them.
+        let prefetch = packets && world.prefetches_surfaces() && selection.has_row(y);
         // The selection, asked once for the row rather than per pixel.
         let (row_selected, columns) = (selection.has_row(y), selection.columns());
         let selected = |x: u32| row_selected && columns.contains(&x);
@@ -665,6 +667,8 @@ impl RowSamples {
             camera.rays(width, height, &self.positions[..count], &mut self.rays);
             if packets {
                 self.find_hits(world, selection, (row.clone(), y));
+            }
+            if prefetch {
                 for hit in self.hits[..count].iter().flatten() {
                     world.prefetch_surface_start(hit);
                 }
@@ -674,10 +678,10 @@ impl RowSamples {
                     continue;
                 }
                 let ray = &self.rays[i];
+                if prefetch && let Some(Some(ahead)) = self.hits[..count].get(i + SURFACES_AHEAD) {
+                    world.prefetch_surface(ahead);
+                }
                 let hit = if packets {
-                    if let Some(Some(ahead)) = self.hits[..count].get(i + SURFACES_AHEAD) {
-                        world.prefetch_surface(ahead);
-                    }
                     self.hits[i]
                 } else {
                     world.intersect(ray)

@@ -18,8 +18,17 @@ use crate::world::{Hit, MaterialId, PrimitiveId, PrimitiveRef, ShadowHint, World
 /// takes whole-structure steps.
 const PASSED_CAPACITY: usize = 12;
 
+/// How near, relative to their parameter, two listed entries' hits must be
+/// for [`World::intersect_passed`] to leave the choice to the whole walk:
+/// a billionth, far above the few ulps by which the walk's box culls
+/// (node boxes, a grid's or kd-tree's primitive boxes and cell exits) can
+/// keep a hit that lies just outside its box and turn one just inside away.
+const NEAR_TIE: f64 = 1e-9;
+
 /// Which of a world's entries stop light: those every hit of which shows a
-/// material that lets nothing through ([`World::opaque_entries`]).
+/// material that lets nothing through; and, of the others, which the
+/// steps of a shadow ray may test alone ([`World::opaque_entries`],
+/// [`PassedEntries`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct OpaqueEntries {
     /// Per entry of the structure, in the world's entry order.
@@ -59,14 +68,17 @@ pub enum ShadowPath {
 
 /// The entries letting light through that a shadow ray's interval meets,
 /// as the any-hit walk of [`World::shadow_path`] found them (in its order),
-/// or [`PassedEntries::UNLISTED`] when they are not known.
+/// or [`PassedEntries::UNLISTED`] when they are not known: more than
+/// [`PASSED_CAPACITY`] of them, or one whose hit a search finds.
 ///
 /// The surface-to-surface walk that follows steps along the same line
 /// towards the same end, so its hits are on these entries: testing them
-/// alone answers as a walk of the whole structure would. The one exception
-/// is a step ray, which leaves each surface a few rounding errors off the
-/// line, grazing the edge of a shape that the line itself missed by less
-/// than that (the same uncertainty a ray's own rounding already has).
+/// alone answers as a walk of the whole structure would, where one hit is
+/// clearly the closest ([`World::intersect_passed`] leaves near ties to
+/// the walk). The one exception is a step ray, which leaves each surface a
+/// few rounding errors off the line, grazing the edge of a shape that the
+/// line itself missed by less than that (the same uncertainty a ray's own
+/// rounding already has).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PassedEntries {
     /// Positions in the world's entries.
@@ -98,9 +110,15 @@ impl PassedEntries {
         self.len <= PASSED_CAPACITY
     }
 
-    /// Adds the entry at position `entry`; past the capacity the list is
+    /// Adds the entry at position `entry`, of primitive `number`, unless
+    /// an entry of that primitive is listed (a kd-tree names a primitive
+    /// in every leaf it spans); past the capacity the list is
     /// [`PassedEntries::UNLISTED`].
-    fn push(&mut self, entry: u32) {
+    fn push(&mut self, entry: u32, number: u32, entries: &[Entry]) {
+        let listed = &self.entries[..self.len.min(PASSED_CAPACITY)];
+        if listed.iter().any(|&e| entries[e as usize].number == number) {
+            return;
+        }
         if self.len < PASSED_CAPACITY {
             self.entries[self.len] = entry;
             self.len += 1;
@@ -220,7 +238,8 @@ impl World<'_> {
                 |entry| match opaque.entries[entry as usize] {
                     Passage::Stops => true,
                     Passage::Listed => {
-                        passed.push(entry);
+                        let number = self.entries[entry as usize].number;
+                        passed.push(entry, number, &self.entries);
                         false
                     }
                     Passage::Searched => {
@@ -245,10 +264,11 @@ impl World<'_> {
 
     /// The closest hit in `ray`'s interval among the entries `passed`
     /// lists (a shadow ray's, found by [`World::shadow_path`] for a ray
-    /// along the same line), each tested as the closest-hit walk tests it;
-    /// [`World::intersect`] when they are not listed, or when two of them
-    /// are hit at the very same parameter: the walk then keeps the one it
-    /// visits first, which the list's order cannot tell.
+    /// along the same line), each with the closest-hit walk's own test of
+    /// the entry; [`World::intersect`] when they are not listed, or when
+    /// two primitives are hit within [`NEAR_TIE`] of each other: which of
+    /// those the walk keeps depends on the order it visits them and on its
+    /// box culls, which the list cannot tell.
     pub fn intersect_passed(&self, ray: &Ray, passed: &PassedEntries) -> Option<Hit> {
         if !passed.is_listed() {
             return self.intersect(ray);
@@ -256,15 +276,13 @@ impl World<'_> {
         let query = Query::new(ray, self.has_triangles);
         let mut inner = QueryContext::default();
         let mut best: Option<Hit> = None;
-        let unbounded = (0..self.unbounded.len())
-            .filter(|&i| passed.unbounded >> i & 1 == 1)
-            .map(|i| &self.unbounded[i]);
+        let unbounded = set_bits(passed.unbounded).map(|i| &self.unbounded[i]);
         let listed = passed.entries[..passed.len]
             .iter()
             .map(|&entry| &self.entries[entry as usize]);
         for e in unbounded.chain(listed) {
-            // One step past the closest so far, to see a tie.
-            let t_max = best.map_or(ray.t_max, |b| b.shape_hit.t.next_up());
+            // Past the closest so far by the tie window, to see a near tie.
+            let t_max = best.map_or(ray.t_max, |b| near_tie(b.shape_hit.t).1);
             let hit = match e.intersect_in_place(&query, t_max) {
                 Some(hit) => hit.map(|h| (e.number, h)),
                 None => self.intersect_other(&self.definitions, e, &query, t_max, &mut inner),
@@ -273,7 +291,7 @@ impl World<'_> {
                 continue;
             };
             if let Some(b) = best
-                && shape_hit.t == b.shape_hit.t
+                && shape_hit.t >= near_tie(b.shape_hit.t).0
             {
                 if primitive == b.primitive.0 {
                     continue;
@@ -289,6 +307,25 @@ impl World<'_> {
     }
 }
 
+/// The bounds of the window around a hit at parameter `t` (positive)
+/// within which another hit is a near tie ([`NEAR_TIE`]): from `lower` up
+/// to, not including, `upper`.
+fn near_tie(t: f64) -> (f64, f64) {
+    let slack = NEAR_TIE * t;
+    ((t - slack).min(t), (t + slack).max(t.next_up()))
+}
+
+/// The positions of the bits set in `bits`, lowest first.
+fn set_bits(mut bits: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (bits != 0).then(|| {
+            let i = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            i
+        })
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -296,7 +333,7 @@ mod tests {
     use crate::math::random::Rng;
     use crate::math::{Transform, Vec3};
     use crate::mesh::TriangleMesh;
-    use crate::shape::{Plane, Sphere};
+    use crate::shape::{Cylinder, Plane, Polygon, Sphere};
     use crate::world::Objects;
 
     /// Spheres of two materials (0 opaque, 1 clear), a mesh of scattered
@@ -325,6 +362,30 @@ mod tests {
             let triangles = (0..200).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
             let mesh = objects.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
             objects.add_mesh_instance(mesh, MaterialId(material), Transform::IDENTITY);
+        }
+        // Polygons (tested in place and through the tables) and moved
+        // cylinders (through the tables), of both materials.
+        for i in 0..60 {
+            let centre = 10.0 * (rng.unit_vector() * rng.uniform());
+            let (a, b) = rng.unit_vector().any_orthonormal_pair();
+            let quad = vec![
+                centre - a - b,
+                centre + a - b,
+                centre + a + b,
+                centre - a + b,
+            ];
+            objects.add_primitive(
+                Shape::Polygon(Polygon::new(quad).unwrap()),
+                MaterialId(i % 2),
+                Transform::IDENTITY,
+            );
+            let cylinder = Cylinder::new(0.3 + 0.3 * rng.uniform(), 1.5, i % 4 < 2).unwrap();
+            let moved = 10.0 * (rng.unit_vector() * rng.uniform());
+            objects.add_primitive(
+                Shape::Cylinder(cylinder),
+                MaterialId(i % 2),
+                Transform::translate(moved).unwrap(),
+            );
         }
         let floor = Plane::new(Vec3::new(0.0, -11.0, 0.0), Vec3::Y).unwrap();
         objects.add_primitive(Shape::Plane(floor), MaterialId(1), Transform::IDENTITY);
@@ -409,8 +470,9 @@ mod tests {
             let world = World::build(&objects, kind);
             let opaque = world.opaque_entries(&[true, false]).unwrap();
             // Crossed paths listed, those with two hits or more, those
-            // through the unbounded floor.
-            let mut seen = [0; 3];
+            // through the unbounded floor, those through a polygon or a
+            // cylinder.
+            let mut seen = [0; 4];
             for i in 0..3000 {
                 let from = 12.0 * rng.unit_vector() * rng.uniform();
                 // Lights above and below the floor at y = -11.
@@ -427,7 +489,8 @@ mod tests {
                 assert_eq!(listed, whole, "{kind:?} {ray:?}");
                 seen[0] += usize::from(passed.is_listed());
                 seen[1] += usize::from(whole.len() >= 2);
-                seen[2] += usize::from(whole.iter().any(|h| h.primitive.0 == 150));
+                seen[2] += usize::from(whole.iter().any(|h| h.primitive.0 == 270));
+                seen[3] += usize::from(whole.iter().any(|h| (150..270).contains(&h.primitive.0)));
             }
             assert!(seen.iter().all(|&n| n > 50), "{kind:?}: {seen:?}");
         }
@@ -508,7 +571,9 @@ mod tests {
         // Both orders of the list: one of them is not the walk's.
         for order in [[0, 1], [1, 0]] {
             let mut passed = PassedEntries::EMPTY;
-            order.into_iter().for_each(|entry| passed.push(entry));
+            for entry in order {
+                passed.push(entry, world.entries[entry as usize].number, &world.entries);
+            }
             assert_eq!(world.intersect_passed(&ray, &passed), Some(whole));
         }
     }
@@ -535,5 +600,47 @@ mod tests {
             panic!("the ray crosses the sphere");
         };
         assert!(passed.is_listed());
+    }
+
+    #[test]
+    fn near_ties_span_a_billionth_and_at_least_one_step() {
+        let (lower, upper) = near_tie(1.0);
+        assert!(lower < 1.0 && 1.0 - lower <= 1.01e-9, "{lower}");
+        assert!(upper > 1.0 && upper - 1.0 <= 1.01e-9, "{upper}");
+        // Where the billionth rounds to nothing, one step up.
+        let tiny = f64::from_bits(1);
+        assert_eq!(near_tie(tiny), (tiny, tiny.next_up()));
+        let bits = set_bits(1 | 1 << 5 | 1 << 31).collect::<Vec<_>>();
+        assert_eq!(bits, [0, 5, 31]);
+    }
+
+    #[test]
+    fn more_unbounded_entries_met_than_bits_leave_the_list_unknown() {
+        // 34 clear planes across the ray's way: beyond the 32 bits.
+        let mut objects = Objects::default();
+        for i in 0..34 {
+            let plane = Plane::new(Vec3::new(0.0, i as f64, 0.0), Vec3::Y).unwrap();
+            objects.add_primitive(Shape::Plane(plane), MaterialId(1), Transform::IDENTITY);
+        }
+        let world = World::new(&objects);
+        let opaque = world.opaque_entries(&[true, false]).unwrap();
+        let path = |end: f64| {
+            let ray = Ray::segment(Vec3::new(0.0, -0.5, 0.0), Vec3::Y, end);
+            (
+                ray,
+                world.shadow_path(&ray, &opaque, &mut ShadowHint::default()),
+            )
+        };
+        for (end, listed) in [(3.0, true), (40.0, false)] {
+            let (ray, ShadowPath::Crossed(passed)) = path(end) else {
+                panic!("the ray crosses planes");
+            };
+            assert_eq!(passed.is_listed(), listed, "{end}");
+            let whole = walk(&world, &ray, |r| world.intersect(r));
+            assert_eq!(
+                walk(&world, &ray, |r| world.intersect_passed(r, &passed)),
+                whole
+            );
+        }
     }
 }
