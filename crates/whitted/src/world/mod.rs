@@ -33,6 +33,7 @@ mod hit;
 mod instance;
 mod objects;
 mod packet;
+mod prefetch;
 mod shadow_hint;
 mod shadow_path;
 
@@ -52,6 +53,7 @@ use crate::math::{Aabb, Ray, Transform, Vec3};
 use crate::shape::{Shape, ShapeHit, clipped_triangle_bounds};
 use entry::{Entry, EntryKind, Query, leaf_hit, leaf_occludes};
 use instance::MeshStructure;
+use prefetch::BIG_MESHES;
 use rayon::prelude::*;
 
 /// Triangles per parallel task when preparing meshes: fewer are prepared
@@ -152,12 +154,6 @@ pub struct World<'a> {
     /// surfaces' reads to miss the caches ([`World::prefetches_surfaces`]).
     big_meshes: bool,
 }
-
-/// Triangles placed directly from which [`World::prefetches_surfaces`]:
-/// about 8 MB of corner indices, positions and normals, beyond the caches
-/// of the machines measured (the dragon's 871k gain 1.09x; the bunny's 69k
-/// and the small SPD meshes lose 1 to 3% to the prefetch's own work).
-const BIG_MESHES: usize = 200_000;
 
 /// The entry of primitive `number`, a cylinder or a cone whose canonical
 /// shape has `bounds` (its points within `bounds.max.x` of the z axis
@@ -746,34 +742,6 @@ impl<'a> World<'a> {
         });
         ctx.counters += inner.counters;
         occluded
-    }
-
-    /// Whether prefetching the surfaces of hits pays
-    /// ([`World::prefetch_surface_start`]): only with meshes too big for
-    /// the caches.
-    pub fn prefetches_surfaces(&self) -> bool {
-        self.big_meshes
-    }
-
-    /// Starts loading the first data [`World::surface`] will read for
-    /// `hit`, where that is likely a cache miss (a mesh triangle's corner
-    /// indices); [`World::prefetch_surface`] goes on from there.
-    #[inline]
-    pub fn prefetch_surface_start(&self, hit: &Hit) {
-        if let PrimitiveRef::Triangle { instance, triangle } = self.primitive_ref(hit.primitive.0) {
-            let m = &self.objects.mesh_instances[instance as usize];
-            self.objects.meshes[m.mesh.0 as usize].prefetch_indices(triangle);
-        }
-    }
-
-    /// Starts loading the rest of what [`World::surface`] will read for
-    /// `hit` (a mesh triangle's corners).
-    #[inline]
-    pub fn prefetch_surface(&self, hit: &Hit) {
-        if let PrimitiveRef::Triangle { instance, triangle } = self.primitive_ref(hit.primitive.0) {
-            let m = &self.objects.mesh_instances[instance as usize];
-            self.objects.meshes[m.mesh.0 as usize].prefetch_corners(triangle);
-        }
     }
 
     /// The world-space surface at a hit returned for `ray`.

@@ -110,11 +110,17 @@ impl PassedEntries {
         self.len <= PASSED_CAPACITY
     }
 
-    /// Adds the entry at position `entry`, of primitive `number`, unless
-    /// an entry of that primitive is listed (a kd-tree names a primitive
-    /// in every leaf it spans); past the capacity the list is
+    /// Whether no entry was met.
+    fn is_empty(&self) -> bool {
+        self.len == 0 && self.unbounded == 0
+    }
+
+    /// Adds the entry at position `entry` of `entries`, unless an entry of
+    /// the same primitive is listed (a kd-tree names a primitive in every
+    /// leaf it spans); past the capacity the list is
     /// [`PassedEntries::UNLISTED`].
-    fn push(&mut self, entry: u32, number: u32, entries: &[Entry]) {
+    fn push(&mut self, entry: u32, entries: &[Entry]) {
+        let number = entries[entry as usize].number;
         let listed = &self.entries[..self.len.min(PASSED_CAPACITY)];
         if listed.iter().any(|&e| entries[e as usize].number == number) {
             return;
@@ -238,8 +244,7 @@ impl World<'_> {
                 |entry| match opaque.entries[entry as usize] {
                     Passage::Stops => true,
                     Passage::Listed => {
-                        let number = self.entries[entry as usize].number;
-                        passed.push(entry, number, &self.entries);
+                        passed.push(entry, &self.entries);
                         false
                     }
                     Passage::Searched => {
@@ -255,7 +260,7 @@ impl World<'_> {
         });
         if blocked {
             ShadowPath::Blocked
-        } else if passed.len != 0 || passed.unbounded != 0 {
+        } else if !passed.is_empty() {
             ShadowPath::Crossed(passed)
         } else {
             ShadowPath::Clear
@@ -572,7 +577,7 @@ mod tests {
         for order in [[0, 1], [1, 0]] {
             let mut passed = PassedEntries::EMPTY;
             for entry in order {
-                passed.push(entry, world.entries[entry as usize].number, &world.entries);
+                passed.push(entry, &world.entries);
             }
             assert_eq!(world.intersect_passed(&ray, &passed), Some(whole));
         }
