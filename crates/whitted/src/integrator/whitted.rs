@@ -36,7 +36,10 @@ use crate::shading::{
     Color, Crossing, Light, Lobes, Material, MediumStack, RayDifferential, Weights, direct_samples,
     phong, shading_normal,
 };
-use crate::world::{Hit, MaterialId, OpaqueEntries, PassedEntries, ShadowPath, Surface, World};
+use crate::world::{
+    Hit, Interiors, MaterialId, OpaqueEntries, PassedEntries, PrimitiveId, ShadowPath, Surface,
+    World,
+};
 
 /// Longest chain of transmissive surfaces one shadow ray passes through.
 const MAX_SHADOW_CROSSINGS: usize = 64;
@@ -81,6 +84,9 @@ pub struct Whitted<'a> {
     /// ([`World::shadow_path`]); `None` without such surfaces, or for a
     /// world with instances.
     opaque: Option<OpaqueEntries>,
+    /// What a ray starting inside a sphere that lets light in can meet
+    /// first ([`World::interiors`]).
+    interiors: Interiors,
     caustics: Option<&'a CausticMap>,
     /// Per material, whether shading reads (u, v) ([`Material::reads_uv`]).
     reads_uv: Vec<bool>,
@@ -100,6 +106,7 @@ impl<'a> Whitted<'a> {
             limits,
             any_transmissive,
             opaque: opaque_entries(world, shading.materials, None),
+            interiors: world.interiors(|m| shading.materials[m.0 as usize].is_transmissive()),
             caustics: None,
             reads_uv: shading.materials.iter().map(Material::reads_uv).collect(),
         }
@@ -184,7 +191,16 @@ impl<'a> Whitted<'a> {
                 };
                 let differential = differential.as_ref();
                 let media = &MediumStack::default();
-                let color = self.shade(ray, differential, &surface, 0, 1.0, media, &mut tally);
+                let color = self.shade(
+                    ray,
+                    differential,
+                    &surface,
+                    hit.primitive,
+                    0,
+                    1.0,
+                    media,
+                    &mut tally,
+                );
                 tally.observer.ray_end(color);
                 PrimarySample {
                     color,
@@ -201,17 +217,21 @@ impl<'a> Whitted<'a> {
         self.world.surface_for(ray, hit, reads_uv)
     }
 
-    /// The colour seen along a secondary ray (unit direction).
+    /// The colour seen along a secondary ray (unit direction) leaving
+    /// primitive `from` (a ray into a glass sphere is tested against what
+    /// lies inside it alone: [`World::intersect_from`]).
+    #[allow(clippy::too_many_arguments)]
     fn trace<O: RayObserver>(
         &self,
         ray: &Ray,
+        from: PrimitiveId,
         differential: Option<&RayDifferential>,
         depth: u32,
         weight: f64,
         media: &MediumStack,
         tally: &mut SampleTally<'_, O>,
     ) -> Color {
-        match self.world.intersect(ray) {
+        match self.world.intersect_from(ray, from, &self.interiors) {
             None => {
                 tally.observer.ray_hit(ray, None);
                 self.shading.background
@@ -219,7 +239,16 @@ impl<'a> Whitted<'a> {
             Some(hit) => {
                 let surface = self.surface::<O>(ray, &hit);
                 tally.observer.ray_hit(ray, Some((&hit, &surface)));
-                self.shade(ray, differential, &surface, depth, weight, media, tally)
+                self.shade(
+                    ray,
+                    differential,
+                    &surface,
+                    hit.primitive,
+                    depth,
+                    weight,
+                    media,
+                    tally,
+                )
             }
         }
     }
@@ -232,6 +261,7 @@ impl<'a> Whitted<'a> {
         ray: &Ray,
         differential: Option<&RayDifferential>,
         s: &Surface,
+        primitive: PrimitiveId,
         depth: u32,
         weight: f64,
         media: &MediumStack,
@@ -356,7 +386,15 @@ impl<'a> Whitted<'a> {
                 .ray_start(kind, &reflected, reflected_weight, child);
             let differential = bend.map(|b| b.reflected());
             let differential = differential.as_ref();
-            let c = self.trace(&reflected, differential, depth + 1, child, media, tally);
+            let c = self.trace(
+                &reflected,
+                primitive,
+                differential,
+                depth + 1,
+                child,
+                media,
+                tally,
+            );
             tally.observer.ray_end(c);
             color += reflected_weight * c;
         } else if reflected_weight != Color::ZERO {
@@ -376,7 +414,15 @@ impl<'a> Whitted<'a> {
                 let differential = bend.map(|b| b.refracted(dir, n_from / n_to));
                 let differential = differential.as_ref();
                 let media = &crossing.after();
-                let c = self.trace(&refracted, differential, depth + 1, child, media, tally);
+                let c = self.trace(
+                    &refracted,
+                    primitive,
+                    differential,
+                    depth + 1,
+                    child,
+                    media,
+                    tally,
+                );
                 tally.observer.ray_end(c);
                 color += transmitted_weight * c;
             } else {

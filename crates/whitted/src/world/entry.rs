@@ -220,7 +220,7 @@ impl Entry {
 
     /// The sphere a [`EntryKind::Sphere`] entry holds.
     #[inline(always)]
-    fn as_sphere(&self) -> Sphere {
+    pub(super) fn as_sphere(&self) -> Sphere {
         Sphere::from_accepted(self.corners[0], self.corners[1].x)
     }
 }

@@ -31,6 +31,7 @@
 mod entry;
 mod hit;
 mod instance;
+mod interiors;
 mod objects;
 mod packet;
 mod prefetch;
@@ -38,6 +39,7 @@ mod shadow_hint;
 mod shadow_path;
 
 pub use hit::{Hit, Surface};
+pub use interiors::Interiors;
 pub use objects::{
     DefinitionId, Instance, InstanceError, MAX_INSTANCE_DEPTH, MaterialId, MeshId, MeshInstance,
     Objects, Primitive, PrimitiveId, TransformId,
@@ -496,6 +498,37 @@ impl<'a> World<'a> {
 
     fn transform(&self, id: Option<TransformId>) -> Option<&'a Transform> {
         self.objects.transform(id)
+    }
+
+    /// The world-space box of bounded entry `e`: the one its slot of the
+    /// structure was built with.
+    fn entry_bounds(&self, e: &Entry) -> Aabb {
+        let to_world = |transform: Option<TransformId>, local: Aabb| match self.transform(transform)
+        {
+            Some(t) => t.bounds_to_world(&local),
+            None => local,
+        };
+        match e.kind {
+            EntryKind::Triangle => Aabb::from_points(e.corners),
+            EntryKind::Sphere => e.as_sphere().bounds(),
+            EntryKind::Polygon | EntryKind::Axial | EntryKind::Primitive => {
+                let p = &self.shapes[e.number as usize];
+                to_world(p.transform, p.shape.bounds())
+            }
+            EntryKind::Instance => {
+                let m = &self.objects.mesh_instances[e.number as usize];
+                let structure = self.mesh_structures[m.mesh.0 as usize].as_ref();
+                to_world(
+                    m.transform,
+                    structure.map_or(Aabb::EMPTY, MeshStructure::bounds),
+                )
+            }
+            EntryKind::Placed => {
+                let i = &self.objects.instances[e.number as usize];
+                let definition = &self.definitions[i.definition.0 as usize];
+                to_world(i.transform, definition.bounds)
+            }
+        }
     }
 
     /// Shape `index` hit by the query's ray, closer than `t_max`.

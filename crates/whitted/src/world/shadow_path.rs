@@ -19,7 +19,8 @@ use crate::world::{Hit, MaterialId, PrimitiveId, PrimitiveRef, ShadowHint, World
 const PASSED_CAPACITY: usize = 12;
 
 /// How near, relative to their parameter, two listed entries' hits must be
-/// for [`World::intersect_passed`] to leave the choice to the whole walk:
+/// for [`World::intersect_passed`] (and [`World::intersect_from`]) to
+/// leave the choice to the whole walk:
 /// a billionth, far above the few ulps by which the walk's box culls
 /// (node boxes, a grid's or kd-tree's primitive boxes and cell exits) can
 /// keep a hit that lies just outside its box and turn one just inside away.
@@ -87,7 +88,7 @@ pub struct PassedEntries {
     /// list is not known.
     len: usize,
     /// The unbounded entries met, bit `i` for entry `i`.
-    unbounded: u32,
+    pub(super) unbounded: u32,
 }
 
 impl PassedEntries {
@@ -99,7 +100,7 @@ impl PassedEntries {
     };
 
     /// No entry yet.
-    const EMPTY: Self = Self {
+    pub(super) const EMPTY: Self = Self {
         entries: [0; PASSED_CAPACITY],
         len: 0,
         unbounded: 0,
@@ -110,8 +111,15 @@ impl PassedEntries {
         self.len <= PASSED_CAPACITY
     }
 
+    /// The listed entries' positions.
+    pub(super) fn entries(&self) -> impl Iterator<Item = u32> + '_ {
+        self.entries[..self.len.min(PASSED_CAPACITY)]
+            .iter()
+            .copied()
+    }
+
     /// Whether no entry was met.
-    fn is_empty(&self) -> bool {
+    pub(super) fn is_empty(&self) -> bool {
         self.len == 0 && self.unbounded == 0
     }
 
@@ -119,7 +127,7 @@ impl PassedEntries {
     /// the same primitive is listed (a kd-tree names a primitive in every
     /// leaf it spans); past the capacity the list is
     /// [`PassedEntries::UNLISTED`].
-    fn push(&mut self, entry: u32, entries: &[Entry]) {
+    pub(super) fn push(&mut self, entry: u32, entries: &[Entry]) {
         let number = entries[entry as usize].number;
         let listed = &self.entries[..self.len.min(PASSED_CAPACITY)];
         if listed.iter().any(|&e| entries[e as usize].number == number) {
@@ -135,7 +143,7 @@ impl PassedEntries {
 
     /// Adds unbounded entry `i`; one past the bits makes the list
     /// [`PassedEntries::UNLISTED`].
-    fn push_unbounded(&mut self, i: usize) {
+    pub(super) fn push_unbounded(&mut self, i: usize) {
         if i < u32::BITS as usize {
             self.unbounded |= 1 << i;
         } else {
@@ -160,12 +168,7 @@ impl World<'_> {
             let stops = self
                 .entry_material(e)
                 .is_some_and(|m| opaque.get(m.0 as usize) == Some(&true));
-            let closed_form = match e.kind {
-                EntryKind::Primitive => self.shapes[e.number as usize].shape.closed_form(),
-                EntryKind::Instance | EntryKind::Placed => false,
-                _ => true,
-            };
-            match (stops, closed_form) {
+            match (stops, self.closed_form(e)) {
                 (true, _) => Passage::Stops,
                 (false, true) => Passage::Listed,
                 (false, false) => Passage::Searched,
@@ -175,6 +178,17 @@ impl World<'_> {
             entries: self.entries.iter().map(passage).collect(),
             unbounded: self.unbounded.iter().map(passage).collect(),
         })
+    }
+
+    /// True when entry `e`'s hits come from a closed formula
+    /// ([`Shape::closed_form`]): not an instance, whose walk may stop at
+    /// either of two tied hits depending on the interval.
+    pub(super) fn closed_form(&self, e: &Entry) -> bool {
+        match e.kind {
+            EntryKind::Primitive => self.shapes[e.number as usize].shape.closed_form(),
+            EntryKind::Instance | EntryKind::Placed => false,
+            _ => true,
+        }
     }
 
     /// The one material every hit on entry `e` shows, if there is one.
@@ -278,14 +292,30 @@ impl World<'_> {
         if !passed.is_listed() {
             return self.intersect(ray);
         }
-        let query = Query::new(ray, self.has_triangles);
+        self.closest_listed(ray, passed, self.has_triangles)
+            .unwrap_or_else(|NearTie| self.intersect(ray))
+    }
+
+    /// The closest hit in `ray`'s interval among the entries `listed`
+    /// lists (which it does), each tested as the closest-hit walk tests
+    /// it, in the list's order; [`NearTie`] when two primitives are hit
+    /// within [`NEAR_TIE`] of each other. The triangle tests' shear of the
+    /// ray is made once up front if `triangles`, else for each.
+    #[inline]
+    pub(super) fn closest_listed(
+        &self,
+        ray: &Ray,
+        listed: &PassedEntries,
+        triangles: bool,
+    ) -> Result<Option<Hit>, NearTie> {
+        let query = Query::new(ray, triangles);
         let mut inner = QueryContext::default();
         let mut best: Option<Hit> = None;
-        let unbounded = set_bits(passed.unbounded).map(|i| &self.unbounded[i]);
-        let listed = passed.entries[..passed.len]
+        let unbounded = set_bits(listed.unbounded).map(|i| &self.unbounded[i]);
+        let entries = listed.entries[..listed.len]
             .iter()
             .map(|&entry| &self.entries[entry as usize]);
-        for e in unbounded.chain(listed) {
+        for e in unbounded.chain(entries) {
             // Past the closest so far by the tie window, to see a near tie.
             let t_max = best.map_or(ray.t_max, |b| near_tie(b.shape_hit.t).1);
             let hit = match e.intersect_in_place(&query, t_max) {
@@ -301,21 +331,26 @@ impl World<'_> {
                 if primitive == b.primitive.0 {
                     continue;
                 }
-                return self.intersect(ray);
+                return Err(NearTie);
             }
             best = Some(Hit {
                 primitive: PrimitiveId(primitive),
                 shape_hit,
             });
         }
-        best
+        Ok(best)
     }
 }
+
+/// Two listed primitives hit within [`NEAR_TIE`] of each other: the walk
+/// decides between them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct NearTie;
 
 /// The bounds of the window around a hit at parameter `t` (positive)
 /// within which another hit is a near tie ([`NEAR_TIE`]): from `lower` up
 /// to, not including, `upper`.
-fn near_tie(t: f64) -> (f64, f64) {
+pub(super) fn near_tie(t: f64) -> (f64, f64) {
     let slack = NEAR_TIE * t;
     ((t - slack).min(t), (t + slack).max(t.next_up()))
 }
