@@ -11,10 +11,13 @@
 //! on its triangle, in its box, or on its plane; those that do not come
 //! within [`INTERIOR_MARGIN`] of the ball, far more than any rounding,
 //! cannot be hit before the sphere. The rest are listed and tested as the
-//! walk tests them, with its ties left to it
+//! walk's leaves test them, with its ties left to it
 //! ([`World::intersect_passed`]'s rules); and when the sphere's own test
 //! finds nothing (a ray grazing it from inside, where rounding decides),
-//! the walk decides too.
+//! the walk decides too. The exception is the one the shadow steps have: a
+//! structure that culls each primitive by its box (the grid, the kd-tree's
+//! loose list) could turn away a hit rounded an ulp outside it, which the
+//! list keeps.
 
 use rayon::prelude::*;
 
@@ -24,9 +27,10 @@ use super::{Hit, MaterialId, Primitive, PrimitiveId, World};
 use crate::math::{Aabb, Ray, Vec3};
 use crate::shape::{Shape, Sphere};
 
-/// How far, relative to the sphere's size and distance from the origin,
-/// an entry must stay from a sphere's ball not to be listed: far above
-/// the rounding of any hit point (a few times 1e-16 of the coordinates).
+/// How far an entry must stay from a sphere's ball not to be listed,
+/// relative to the size of the coordinates of the sphere or of the entry,
+/// whichever is larger: far above the rounding of any hit point (a few
+/// times 1e-16 of its coordinates).
 const INTERIOR_MARGIN: f64 = 1e-9;
 
 /// Entries measured against the spheres per parallel task.
@@ -81,24 +85,34 @@ struct Ball {
 }
 
 impl Ball {
+    /// How near the ball an entry of coordinates up to `scale` in size
+    /// must come to be listed: the radius and the larger of the two sizes'
+    /// margins (a hit's rounding grows with its own coordinates).
+    fn reach(&self, scale: f64) -> f64 {
+        self.radius + self.margin.max(INTERIOR_MARGIN * scale)
+    }
+
     /// True when `bounds` comes within the margin of the ball.
     fn reaches_box(&self, bounds: &Aabb) -> bool {
         let below = (bounds.min - self.center).max(Vec3::ZERO);
         let above = (self.center - bounds.max).max(Vec3::ZERO);
-        let reach = self.radius + self.margin;
+        let reach = self.reach(scale_of(bounds));
         (below + above).length_squared() <= reach * reach
     }
 
-    /// True when the triangle of `corners` comes within the margin of the
-    /// ball.
-    fn reaches_triangle(&self, corners: &[Vec3; 3]) -> bool {
-        let reach = self.radius + self.margin;
-        triangle_distance_squared(self.center, corners) <= reach * reach
+    /// True when the triangle of `corners`, within `bounds`, comes within
+    /// the margin of the ball (a degenerate one whose distance is not a
+    /// number does).
+    fn reaches_triangle(&self, corners: &[Vec3; 3], bounds: &Aabb) -> bool {
+        let reach = self.reach(scale_of(bounds));
+        let distance = triangle_distance_squared(self.center, corners);
+        distance.is_nan() || distance <= reach * reach
     }
 
     /// True when `sphere` comes within the margin of the ball.
     fn reaches_sphere(&self, sphere: &Sphere) -> bool {
-        let reach = self.radius + sphere.radius() + self.margin;
+        let scale = sphere.center().abs().max_element() + sphere.radius();
+        let reach = self.reach(scale) + sphere.radius();
         (sphere.center() - self.center).length_squared() <= reach * reach
     }
 
@@ -107,6 +121,11 @@ impl Ball {
     fn low_x(&self) -> f64 {
         self.center.x - self.radius - self.margin
     }
+}
+
+/// The size of the coordinates in `bounds`: the largest in magnitude.
+fn scale_of(bounds: &Aabb) -> f64 {
+    bounds.min.abs().max(bounds.max.abs()).max_element()
 }
 
 impl<'a> World<'a> {
@@ -236,16 +255,18 @@ impl<'a> World<'a> {
         widest: f64,
     ) -> impl Iterator<Item = usize> + 'b {
         let bounds = self.entry_bounds(e);
-        // A ball can meet the box only if its x range does.
-        let first = balls.partition_point(|b| b.low_x() < bounds.min.x - widest);
-        let last = balls.partition_point(|b| b.low_x() <= bounds.max.x);
+        // A ball can meet the box only if its x range does, widened by the
+        // entry's own margin where that is the larger.
+        let margin = INTERIOR_MARGIN * scale_of(&bounds);
+        let first = balls.partition_point(|b| b.low_x() < bounds.min.x - widest - margin);
+        let last = balls.partition_point(|b| b.low_x() <= bounds.max.x + margin);
         let sphere = (e.kind == EntryKind::Sphere).then(|| e.as_sphere());
         (first..last).filter(move |&k| {
             let ball = &balls[k];
             match (sphere, e.corners()) {
                 (Some(s), _) => ball.reaches_sphere(&s),
                 (None, Some(corners)) => {
-                    ball.reaches_box(&bounds) && ball.reaches_triangle(corners)
+                    ball.reaches_box(&bounds) && ball.reaches_triangle(corners, &bounds)
                 }
                 (None, None) => ball.reaches_box(&bounds),
             }
@@ -301,16 +322,25 @@ impl<'a> World<'a> {
         else {
             return false;
         };
-        (ball.center - plane.point()).dot(plane.normal()).abs() > ball.radius + ball.margin
+        let scale = plane.point().abs().max_element();
+        (ball.center - plane.point()).dot(plane.normal()).abs() > ball.reach(scale)
     }
 }
 
 /// The squared distance from `p` to the triangle of `corners` (its closest
 /// point found by the triangle's Voronoi regions: Ericson, *Real-Time
-/// Collision Detection*, 5.1.5). A degenerate triangle gives the distance
-/// to its segment or point.
+/// Collision Detection*, 5.1.5). A degenerate triangle (no area) gives the
+/// distance to its segment or point.
 fn triangle_distance_squared(p: Vec3, [a, b, c]: &[Vec3; 3]) -> f64 {
     let (ab, ac, ap) = (*b - *a, *c - *a, p - *a);
+    if ab.cross(ac).length_squared() == 0.0 {
+        // Degenerate (the regions below divide by an edge's length and by
+        // the area): the nearest of its three edges.
+        return [(*a, *b), (*b, *c), (*c, *a)]
+            .iter()
+            .map(|&(s, t)| segment_distance_squared(p, s, t))
+            .fold(f64::INFINITY, f64::min);
+    }
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));
     if d1 <= 0.0 && d2 <= 0.0 {
         return ap.length_squared();
@@ -341,13 +371,6 @@ fn triangle_distance_squared(p: Vec3, [a, b, c]: &[Vec3; 3]) -> f64 {
         return (bp - w * (*c - *b)).length_squared();
     }
     let denom = va + vb + vc;
-    if denom == 0.0 || !denom.is_finite() {
-        // Degenerate: the nearest of its three edges.
-        return [(*a, *b), (*b, *c), (*c, *a)]
-            .iter()
-            .map(|&(s, t)| segment_distance_squared(p, s, t))
-            .fold(f64::INFINITY, f64::min);
-    }
     let (v, w) = (vb / denom, vc / denom);
     (ap - v * ab - w * ac).length_squared()
 }
@@ -371,7 +394,7 @@ mod tests {
     use crate::math::random::Rng;
     use crate::math::{Transform, offset_ray_origin};
     use crate::mesh::TriangleMesh;
-    use crate::shape::{Plane, Torus};
+    use crate::shape::{Cylinder, Plane, Polygon, Torus};
     use crate::world::Objects;
     use std::f64::consts::SQRT_2;
 
@@ -396,7 +419,7 @@ mod tests {
             .map(|p| world.entries[p as usize].number)
             .collect();
         numbers.sort_unstable();
-        Some((numbers, inside.others.unbounded))
+        Some((numbers, inside.others.unbounded_bits()))
     }
 
     #[test]
@@ -406,12 +429,15 @@ mod tests {
         for case in 0..300 {
             let a = rng.unit_vector();
             let (b, c) = match case % 10 {
-                // A segment and a point.
-                0 => (a + rng.unit_vector(), a + 0.5 * (rng.unit_vector())),
-                1 => (a, a),
+                // A segment, a segment with two corners the same, a point.
+                0 => {
+                    let b = a + rng.unit_vector();
+                    (b, a + 0.5 * (b - a))
+                }
+                1 => (a, a + rng.unit_vector()),
+                2 => (a, a),
                 _ => (a + rng.unit_vector(), a + rng.unit_vector()),
             };
-            let c = if case % 10 == 0 { a + 0.5 * (b - a) } else { c };
             let p = 2.0 * rng.unit_vector() * rng.uniform();
             let exact = triangle_distance_squared(p, &[a, b, c]).sqrt();
             let mut sampled = f64::INFINITY;
@@ -492,13 +518,24 @@ mod tests {
             let centre = Vec3::new(10.0, 0.0, 0.0) + rng.unit_vector();
             sphere(&mut objects, centre, 0.1, MaterialId(0));
         }
+        // A mesh moved, so kept as an instance, through a third.
+        sphere(&mut objects, Vec3::new(20.0, 0.0, 0.0), 1.0, GLASS);
+        let corners = vec![
+            Vec3::new(-1.0, 0.0, -1.0),
+            Vec3::new(1.0, 0.0, -1.0),
+            Vec3::Z,
+        ];
+        let mesh = objects.add_mesh(TriangleMesh::new(corners, vec![[0, 1, 2]]).unwrap());
+        let moved = Transform::translate(Vec3::new(20.0, 0.0, 0.0)).unwrap();
+        objects.add_mesh_instance(mesh, MaterialId(0), moved);
         let world = World::build(&objects, AccelKind::Bvh);
         assert!(world.interiors(glass).is_empty());
         assert!(world.interiors(|_| false).is_empty());
     }
 
-    /// Glass spheres crowded together with opaque ones, triangles cutting
-    /// through some, and a floor plane cutting others.
+    /// Glass spheres crowded together with opaque ones, triangles, polygons
+    /// and moved cylinders cutting through some, and a floor plane cutting
+    /// others.
     fn crowded_scene(rng: &mut Rng) -> Objects {
         let mut objects = Objects::default();
         for i in 0..80 {
@@ -518,9 +555,58 @@ mod tests {
         let triangles = (0..60).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
         let mesh = objects.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
         objects.add_mesh_instance(mesh, MaterialId(0), Transform::IDENTITY);
+        for _ in 0..20 {
+            let centre = 6.0 * rng.unit_vector() * rng.uniform();
+            let (a, b) = rng.unit_vector().any_orthonormal_pair();
+            let quad = vec![
+                centre - a - b,
+                centre + a - b,
+                centre + a + b,
+                centre - a + b,
+            ];
+            let polygon = Polygon::new(quad).unwrap();
+            objects.add_primitive(Shape::Polygon(polygon), MaterialId(0), Transform::IDENTITY);
+            let cylinder = Cylinder::new(0.2 + 0.3 * rng.uniform(), 1.5, true).unwrap();
+            let moved = Transform::translate(6.0 * rng.unit_vector() * rng.uniform()).unwrap();
+            objects.add_primitive(Shape::Cylinder(cylinder), MaterialId(0), moved);
+        }
         let floor = Plane::new(Vec3::new(0.0, -4.0, 0.0), Vec3::Y).unwrap();
         objects.add_primitive(Shape::Plane(floor), MaterialId(0), Transform::IDENTITY);
         objects
+    }
+
+    /// The hits of rays leaving sphere `number` of `objects` from random
+    /// points of its surface, inwards and outwards, found by
+    /// [`World::intersect_from`] and by the walk.
+    fn from_sphere(
+        world: &World,
+        objects: &Objects,
+        interiors: &Interiors,
+        number: u32,
+        rng: &mut Rng,
+    ) -> Option<(Ray, Option<Hit>, Option<Hit>)> {
+        let Shape::Sphere(s) = &objects.primitives[number as usize].shape else {
+            unreachable!()
+        };
+        // A point on the sphere as a hit finds it, and a ray leaving it as
+        // the integrator makes one.
+        let towards = rng.unit_vector();
+        let probe = Ray::new(s.center() + 3.0 * towards, -towards);
+        let hit = Hit {
+            primitive: PrimitiveId(number),
+            shape_hit: Shape::Sphere(*s).intersect(&probe)?,
+        };
+        let surface = world.surface(&probe, &hit);
+        let dir = rng.unit_vector();
+        let origin = offset_ray_origin(surface.point, surface.point_error, surface.normal, dir);
+        let ray = Ray::new(origin, dir);
+        let found = world.intersect_from(&ray, PrimitiveId(number), interiors);
+        Some((ray, found, world.intersect(&ray)))
+    }
+
+    /// A hit's primitive and the bits of its parameter.
+    fn bits(hit: Option<Hit>) -> Option<(PrimitiveId, u64)> {
+        hit.map(|h| (h.primitive, h.shape_hit.t.to_bits()))
     }
 
     #[test]
@@ -531,46 +617,62 @@ mod tests {
             let world = World::build(&objects, kind);
             let interiors = world.interiors(glass);
             assert!(interiors.len() > 40, "{kind:?}: {}", interiors.len());
-            // Rays whose hit is another entry listed, rays leaving the
-            // sphere itself, rays from outside.
+            // Rays from inside whose hit is another entry listed, rays from
+            // inside leaving through the sphere, rays from outside.
             let mut seen = [0; 3];
             for i in 0..6000 {
                 let number = (i % 80) as u32;
+                let Some((ray, found, expected)) =
+                    from_sphere(&world, &objects, &interiors, number, &mut rng)
+                else {
+                    continue;
+                };
+                assert_eq!(
+                    bits(found),
+                    bits(expected),
+                    "{kind:?} sphere {number} {ray:?}"
+                );
                 let Shape::Sphere(s) = &objects.primitives[number as usize].shape else {
                     unreachable!()
                 };
-                // A point on the sphere as a hit finds it, and a ray leaving
-                // it inwards or outwards as the integrator makes one.
-                let towards = rng.unit_vector();
-                let probe = Ray::new(s.center() + 3.0 * towards, -towards);
-                let Some(shape_hit) = Shape::Sphere(*s).intersect(&probe) else {
-                    continue;
-                };
-                let hit = Hit {
-                    primitive: PrimitiveId(number),
-                    shape_hit,
-                };
-                let surface = world.surface(&probe, &hit);
-                let dir = rng.unit_vector();
-                let origin =
-                    offset_ray_origin(surface.point, surface.point_error, surface.normal, dir);
-                let ray = Ray::new(origin, dir);
-                let expected = world.intersect(&ray);
-                let found = world.intersect_from(&ray, PrimitiveId(number), &interiors);
-                assert_eq!(
-                    found.map(|h| (h.primitive, h.shape_hit.t.to_bits())),
-                    expected.map(|h| (h.primitive, h.shape_hit.t.to_bits())),
-                    "{kind:?} sphere {number} {ray:?}"
-                );
-                if dir.dot(surface.normal) > 0.0 {
-                    seen[2] += 1;
-                } else if expected.is_some_and(|h| h.primitive.0 != number) {
-                    seen[0] += 1;
-                } else {
-                    seen[1] += 1;
+                let inside = (ray.origin - s.center()).length() < s.radius();
+                match expected {
+                    _ if !inside => seen[2] += 1,
+                    Some(h) if h.primitive.0 != number => seen[0] += 1,
+                    _ => seen[1] += 1,
                 }
             }
             assert!(seen.iter().all(|&n| n > 100), "{kind:?}: {seen:?}");
+        }
+    }
+    #[test]
+    fn two_spheres_in_one_place_leave_the_choice_to_the_walk() {
+        let mut objects = Objects::default();
+        let mut rng = Rng::new(23);
+        for _ in 0..2 {
+            sphere(&mut objects, Vec3::new(0.5, -0.25, 2.0), 1.5, GLASS);
+        }
+        sphere(&mut objects, Vec3::new(3.0, 0.0, 2.0), 1.0, MaterialId(0));
+        for kind in [AccelKind::Bvh, AccelKind::KdTree, AccelKind::Grid] {
+            let world = World::build(&objects, kind);
+            let interiors = world.interiors(glass);
+            assert_eq!(interiors.len(), 2, "{kind:?}");
+            let mut inside = 0;
+            for i in 0..400 {
+                let number = i % 2;
+                let Some((ray, found, expected)) =
+                    from_sphere(&world, &objects, &interiors, number, &mut rng)
+                else {
+                    continue;
+                };
+                assert_eq!(
+                    bits(found),
+                    bits(expected),
+                    "{kind:?} sphere {number} {ray:?}"
+                );
+                inside += usize::from(expected.is_some_and(|h| h.primitive.0 < 2));
+            }
+            assert!(inside > 100, "{kind:?}: {inside}");
         }
     }
 }

@@ -72,6 +72,9 @@ pub enum ShadowPath {
 /// or [`PassedEntries::UNLISTED`] when they are not known: more than
 /// [`PASSED_CAPACITY`] of them, or one whose hit a search finds.
 ///
+/// The same list holds what reaches into a glass sphere
+/// ([`crate::world::Interiors`]).
+///
 /// The surface-to-surface walk that follows steps along the same line
 /// towards the same end, so its hits are on these entries: testing them
 /// alone answers as a walk of the whole structure would, where one hit is
@@ -88,7 +91,7 @@ pub struct PassedEntries {
     /// list is not known.
     len: usize,
     /// The unbounded entries met, bit `i` for entry `i`.
-    pub(super) unbounded: u32,
+    unbounded: u32,
 }
 
 impl PassedEntries {
@@ -116,6 +119,12 @@ impl PassedEntries {
         self.entries[..self.len.min(PASSED_CAPACITY)]
             .iter()
             .copied()
+    }
+
+    /// The unbounded entries listed, bit `i` for entry `i`.
+    #[cfg(test)]
+    pub(super) fn unbounded_bits(&self) -> u32 {
+        self.unbounded
     }
 
     /// Whether no entry was met.
@@ -312,9 +321,7 @@ impl World<'_> {
         let mut inner = QueryContext::default();
         let mut best: Option<Hit> = None;
         let unbounded = set_bits(listed.unbounded).map(|i| &self.unbounded[i]);
-        let entries = listed.entries[..listed.len]
-            .iter()
-            .map(|&entry| &self.entries[entry as usize]);
+        let entries = listed.entries().map(|entry| &self.entries[entry as usize]);
         for e in unbounded.chain(entries) {
             // Past the closest so far by the tie window, to see a near tie.
             let t_max = best.map_or(ray.t_max, |b| near_tie(b.shape_hit.t).1);
