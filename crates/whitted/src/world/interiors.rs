@@ -395,7 +395,7 @@ mod tests {
     use crate::math::{Transform, offset_ray_origin};
     use crate::mesh::TriangleMesh;
     use crate::shape::{Cylinder, Plane, Polygon, Torus};
-    use crate::world::Objects;
+    use crate::world::{Objects, scattered_triangles};
     use std::f64::consts::SQRT_2;
 
     const GLASS: MaterialId = MaterialId(1);
@@ -543,17 +543,7 @@ mod tests {
             let material = if i % 4 == 0 { MaterialId(0) } else { GLASS };
             sphere(&mut objects, centre, 0.4 + 0.6 * rng.uniform(), material);
         }
-        let mut positions = Vec::new();
-        for _ in 0..60 {
-            let corner = 6.0 * rng.unit_vector() * rng.uniform();
-            positions.extend([
-                corner,
-                corner + rng.unit_vector(),
-                corner + rng.unit_vector(),
-            ]);
-        }
-        let triangles = (0..60).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
-        let mesh = objects.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
+        let mesh = objects.add_mesh(scattered_triangles(rng, 60, 6.0));
         objects.add_mesh_instance(mesh, MaterialId(0), Transform::IDENTITY);
         for _ in 0..20 {
             let centre = 6.0 * rng.unit_vector() * rng.uniform();

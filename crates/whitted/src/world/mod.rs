@@ -256,11 +256,7 @@ impl<'a> World<'a> {
         bottom: AccelKind,
         definitions: &[World<'a>],
     ) -> Self {
-        let to_world =
-            |transform: Option<TransformId>, local: Aabb| match objects.transform(transform) {
-                Some(t) => t.bounds_to_world(&local),
-                None => local,
-            };
+        let to_world = |transform, local| objects.bounds_to_world(transform, local);
         let mesh_len = |m: &MeshInstance| objects.meshes[m.mesh.0 as usize].len() as u32;
         let shapes = objects.primitives.len() as u32;
         let mut instance_first = Vec::with_capacity(objects.mesh_instances.len());
@@ -503,11 +499,7 @@ impl<'a> World<'a> {
     /// The world-space box of bounded entry `e`: the one its slot of the
     /// structure was built with.
     fn entry_bounds(&self, e: &Entry) -> Aabb {
-        let to_world = |transform: Option<TransformId>, local: Aabb| match self.transform(transform)
-        {
-            Some(t) => t.bounds_to_world(&local),
-            None => local,
-        };
+        let to_world = |transform, local| self.objects.bounds_to_world(transform, local);
         match e.kind {
             EntryKind::Triangle => Aabb::from_points(e.corners),
             EntryKind::Sphere => e.as_sphere().bounds(),
@@ -865,6 +857,27 @@ impl<'a> World<'a> {
             None => s(),
         }
     }
+}
+
+/// `count` triangles of unit-sized sides scattered in the ball of
+/// `radius` around the origin, unconnected: a mesh for the world's tests.
+#[cfg(test)]
+fn scattered_triangles(
+    rng: &mut crate::math::random::Rng,
+    count: u32,
+    radius: f64,
+) -> crate::mesh::TriangleMesh {
+    let mut positions = Vec::new();
+    for _ in 0..count {
+        let corner = radius * (rng.unit_vector() * rng.uniform());
+        positions.extend([
+            corner,
+            corner + rng.unit_vector(),
+            corner + rng.unit_vector(),
+        ]);
+    }
+    let triangles = (0..count).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+    crate::mesh::TriangleMesh::new(positions, triangles).unwrap()
 }
 
 #[cfg(test)]

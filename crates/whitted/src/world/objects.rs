@@ -10,7 +10,7 @@
 //! definition `d` may only name a definition before `d`, so there can be no
 //! cycle; instances nest at most [`MAX_INSTANCE_DEPTH`] deep.
 
-use crate::math::Transform;
+use crate::math::{Aabb, Transform};
 use crate::mesh::TriangleMesh;
 use crate::shape::Shape;
 
@@ -199,6 +199,13 @@ impl Objects {
     /// The transform `id` names, `None` for none.
     pub fn transform(&self, id: Option<TransformId>) -> Option<&Transform> {
         id.map(|id| &self.transforms[id.0 as usize])
+    }
+
+    /// The world-space box around `local`, a box in the space that
+    /// transform `id` places (`None`: the world's own).
+    pub fn bounds_to_world(&self, id: Option<TransformId>, local: Aabb) -> Aabb {
+        self.transform(id)
+            .map_or(local, |t| t.bounds_to_world(&local))
     }
 
     /// Stores a transform, or nothing for the identity.

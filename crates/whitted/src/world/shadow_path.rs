@@ -379,9 +379,9 @@ mod tests {
     use crate::accel::AccelKind;
     use crate::math::random::Rng;
     use crate::math::{Transform, Vec3};
-    use crate::mesh::TriangleMesh;
     use crate::shape::{Cylinder, Plane, Polygon, Sphere};
     use crate::world::Objects;
+    use crate::world::scattered_triangles;
 
     /// Spheres of two materials (0 opaque, 1 clear), a mesh of scattered
     /// triangles of each, and a plane of the clear one.
@@ -397,17 +397,7 @@ mod tests {
             );
         }
         for material in 0..2 {
-            let mut positions = Vec::new();
-            for _ in 0..200 {
-                let corner = 10.0 * (rng.unit_vector() * rng.uniform());
-                positions.extend([
-                    corner,
-                    corner + rng.unit_vector(),
-                    corner + rng.unit_vector(),
-                ]);
-            }
-            let triangles = (0..200).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
-            let mesh = objects.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
+            let mesh = objects.add_mesh(scattered_triangles(rng, 200, 10.0));
             objects.add_mesh_instance(mesh, MaterialId(material), Transform::IDENTITY);
         }
         // Polygons (tested in place and through the tables) and moved

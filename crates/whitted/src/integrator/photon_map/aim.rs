@@ -31,10 +31,7 @@ pub(super) fn caustic_bounds(objects: &Objects, materials: &[Material], scene: A
     let mut bounds = Aabb::EMPTY;
     for p in objects.primitives.iter().filter(|p| starts(p.material)) {
         let local = p.shape.bounds();
-        let world = match objects.transform(p.transform) {
-            Some(t) => t.bounds_to_world(&local),
-            None => local,
-        };
+        let world = objects.bounds_to_world(p.transform, local);
         if !world.is_finite() {
             return scene;
         }
@@ -43,10 +40,7 @@ pub(super) fn caustic_bounds(objects: &Objects, materials: &[Material], scene: A
     for m in objects.mesh_instances.iter().filter(|m| starts(m.material)) {
         let mesh = &objects.meshes[m.mesh.0 as usize];
         let local = Aabb::from_points(mesh.positions().iter().copied());
-        let world = match objects.transform(m.transform) {
-            Some(t) => t.bounds_to_world(&local),
-            None => local,
-        };
+        let world = objects.bounds_to_world(m.transform, local);
         bounds = bounds.union(&world);
     }
     bounds
