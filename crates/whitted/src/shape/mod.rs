@@ -67,7 +67,7 @@ pub use torus::Torus;
 pub use triangle::{RayShear, Triangle, watertight};
 pub(crate) use triangle_clip::clipped_triangle_bounds;
 #[cfg(target_arch = "x86_64")]
-pub(crate) use watertight_avx::{Hits4, LANES, watertight4};
+pub(crate) use watertight_avx::{Hits4, LANES, RayLanes4, watertight_rays4, watertight4};
 
 use crate::math::magnitude::{self, MagnitudeError};
 use crate::math::{Aabb, DVec2, Ray, Vec3};

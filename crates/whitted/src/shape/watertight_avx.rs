@@ -146,6 +146,20 @@ fn permuted<const KX: usize, const KY: usize, const KZ: usize>(
     let a = corner::<KX, KY, KZ>(&triangles, 0, ray.origin, sx, sy);
     let b = corner::<KX, KY, KZ>(&triangles, 1, ray.origin, sx, sy);
     let c = corner::<KX, KY, KZ>(&triangles, 2, ray.origin, sx, sy);
+    test_corners(
+        [a, b, c],
+        sz,
+        _mm256_set1_pd(ray.t_min),
+        _mm256_set1_pd(t_max),
+    )
+}
+
+/// The test of [`watertight`](super::watertight) from each lane's
+/// corners in its ray's sheared space (z not yet scaled by `sz`), with
+/// each lane's interval from `t_min` to `t_max`.
+#[target_feature(enable = "avx")]
+#[inline]
+fn test_corners([a, b, c]: [Corner; 3], sz: __m256d, t_min: __m256d, t_max: __m256d) -> Hits4 {
     let cross = |p: __m256d, q: __m256d, r: __m256d, s: __m256d| {
         _mm256_sub_pd(_mm256_mul_pd(p, q), _mm256_mul_pd(r, s))
     };
@@ -181,8 +195,8 @@ fn permuted<const KX: usize, const KY: usize, const KZ: usize>(
     );
     let t = _mm256_div_pd(scaled, det);
     let inside = _mm256_movemask_pd(_mm256_and_pd(
-        _mm256_cmp_pd::<_CMP_GT_OQ>(t, _mm256_set1_pd(ray.t_min)),
-        _mm256_cmp_pd::<_CMP_LT_OQ>(t, _mm256_set1_pd(t_max)),
+        _mm256_cmp_pd::<_CMP_GT_OQ>(t, t_min),
+        _mm256_cmp_pd::<_CMP_LT_OQ>(t, t_max),
     )) as u32;
     let candidates = inside & !mixed & !det_zero;
     if candidates == 0 {
@@ -238,6 +252,94 @@ fn permuted<const KX: usize, const KY: usize, const KZ: usize>(
     }
 }
 
+/// Up to four rays in the lanes of AVX registers, with their shears, for
+/// [`watertight_rays4`]: their shears must permute the axes alike (the
+/// same largest direction component), as neighbouring camera rays' do.
+#[derive(Clone, Copy)]
+pub struct RayLanes4 {
+    /// The origins, by axis.
+    origin: [__m256d; 3],
+    /// The shear factors.
+    sx: __m256d,
+    sy: __m256d,
+    sz: __m256d,
+    /// The intervals' starts.
+    t_min: __m256d,
+    /// The axis every lane's shear makes z.
+    kz: usize,
+}
+
+impl RayLanes4 {
+    /// The rays `rays` with their shears `shears` (the same ray in several
+    /// lanes is fine); `None` when the shears do not all make the same
+    /// axis z.
+    ///
+    /// # Safety
+    ///
+    /// Call it only where the processor has AVX.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    pub fn new(rays: [&Ray; LANES], shears: [&RayShear; LANES]) -> Option<Self> {
+        let kz = shears[0].kz();
+        if shears.iter().any(|s| s.kz() != kz) {
+            return None;
+        }
+        let each = |f: &dyn Fn(usize) -> f64| _mm256_setr_pd(f(0), f(1), f(2), f(3));
+        Some(Self {
+            origin: [0, 1, 2].map(|axis| each(&|lane| rays[lane].origin[axis])),
+            sx: each(&|lane| shears[lane].factors().x),
+            sy: each(&|lane| shears[lane].factors().y),
+            sz: each(&|lane| shears[lane].factors().z),
+            t_min: each(&|lane| rays[lane].t_min),
+            kz,
+        })
+    }
+}
+
+/// The triangle `corners` tested against each of the four rays of `rays`,
+/// lane `i`'s interval ending at `t_max[i]`: lane by lane what
+/// [`watertight`](super::watertight) returns for that ray.
+///
+/// # Safety
+///
+/// Call it only where the processor has AVX.
+#[target_feature(enable = "avx")]
+#[inline]
+pub fn watertight_rays4(corners: &[Vec3; 3], rays: &RayLanes4, t_max: [f64; LANES]) -> Hits4 {
+    match rays.kz {
+        0 => rays_permuted::<1, 2, 0>(corners, rays, t_max),
+        1 => rays_permuted::<2, 0, 1>(corners, rays, t_max),
+        _ => rays_permuted::<0, 1, 2>(corners, rays, t_max),
+    }
+}
+
+/// [`watertight_rays4`] with the shears' axis permutation given as `KX`,
+/// `KY`, `KZ`.
+#[target_feature(enable = "avx")]
+#[inline]
+fn rays_permuted<const KX: usize, const KY: usize, const KZ: usize>(
+    corners: &[Vec3; 3],
+    rays: &RayLanes4,
+    t_max: [f64; LANES],
+) -> Hits4 {
+    let corner = |p: Vec3| {
+        let q = |axis: usize| _mm256_sub_pd(_mm256_set1_pd(p[axis]), rays.origin[axis]);
+        let (x, y, z) = (q(KX), q(KY), q(KZ));
+        Corner {
+            x: _mm256_add_pd(x, _mm256_mul_pd(rays.sx, z)),
+            y: _mm256_add_pd(y, _mm256_mul_pd(rays.sy, z)),
+            z,
+        }
+    };
+    let [t0, t1, t2, t3] = t_max;
+    test_corners(
+        corners.map(corner),
+        rays.sz,
+        rays.t_min,
+        _mm256_setr_pd(t0, t1, t2, t3),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -290,6 +392,129 @@ mod tests {
             }
         }
         assert!(hits > 20_000, "{hits} hits");
+    }
+
+    /// Each of four rays' answers for `corners` against the one-triangle
+    /// test's, bit for bit; `None` when their shears differ in axis. The
+    /// caller has checked for AVX.
+    fn assert_rays_same(
+        corners: &[Vec3; 3],
+        rays: [&Ray; LANES],
+        t_max: [f64; LANES],
+    ) -> Option<usize> {
+        let shears = rays.map(RayShear::new);
+        // SAFETY: the callers return early without AVX.
+        let lanes = unsafe { RayLanes4::new(rays, shears.each_ref()) }?;
+        // SAFETY: as above.
+        let hits = unsafe { watertight_rays4(corners, &lanes, t_max) };
+        let bits = |h: Option<ShapeHit>| h.map(|h| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits()));
+        let [p0, p1, p2] = *corners;
+        for lane in 0..LANES {
+            let mut bounded = *rays[lane];
+            bounded.t_max = t_max[lane];
+            let one = watertight(p0, p1, p2, &bounded, &shears[lane]);
+            let four = (hits.mask & 1 << lane != 0).then(|| ShapeHit {
+                t: hits.t[lane],
+                u: hits.u[lane],
+                v: hits.v[lane],
+                part: 0,
+            });
+            assert_eq!(
+                bits(four),
+                bits(one),
+                "lane {lane} {corners:?} {:?}",
+                rays[lane]
+            );
+        }
+        Some(hits.mask.count_ones() as usize)
+    }
+
+    #[test]
+    fn four_rays_against_one_triangle_match_the_one_triangle_test_bit_for_bit() {
+        if !crate::math::test_support::has_avx_or_skip_allowed() {
+            return;
+        }
+        let mut rng = Rng::new(8);
+        let (mut hits, mut refused) = (0, 0);
+        for scale in [1e-30, 1e-6, 1.0, 1e6, 1e30] {
+            for _ in 0..10_000 {
+                let centre = scale * rng.point_in(Vec3::splat(-1.0), Vec3::ONE);
+                let corners =
+                    [0; 3].map(|_| centre + scale * rng.point_in(Vec3::splat(-1.0), Vec3::ONE));
+                // Four rays from near one point, as a packet's are, some
+                // from elsewhere, each with its own interval.
+                let from = centre + 3.0 * scale * rng.unit_vector();
+                let rays = [0; LANES].map(|_| {
+                    let origin = if rng.uniform() < 0.8 {
+                        from
+                    } else {
+                        centre + 3.0 * scale * rng.unit_vector()
+                    };
+                    let mut ray =
+                        Ray::new(origin, centre - origin + 0.7 * scale * rng.unit_vector());
+                    ray.t_min = if rng.uniform() < 0.2 {
+                        rng.range(0.0, 1.0)
+                    } else {
+                        0.0
+                    };
+                    ray
+                });
+                let t_max = [0; LANES].map(|_| {
+                    if rng.uniform() < 0.5 {
+                        f64::INFINITY
+                    } else {
+                        rng.range(0.0, 4.0)
+                    }
+                });
+                match assert_rays_same(&corners, rays.each_ref(), t_max) {
+                    Some(n) => hits += n,
+                    None => refused += 1,
+                }
+            }
+        }
+        assert!(hits > 4_000, "{hits} hits");
+        assert!(refused > 1_000, "{refused} sets of rays sheared apart");
+    }
+
+    #[test]
+    fn four_rays_on_vertices_edges_and_planes_match_too() {
+        if !crate::math::test_support::has_avx_or_skip_allowed() {
+            return;
+        }
+        let unit = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let neighbour = [Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+        let needle = [Vec3::ZERO, Vec3::X, 2.0 * Vec3::X];
+        let point = [Vec3::ONE; 3];
+        let nan = [Vec3::splat(f64::NAN), Vec3::X, Vec3::Y];
+        let huge = [Vec3::splat(-1e300), Vec3::new(1e300, 0.0, 0.0), Vec3::Y];
+        let from = Vec3::new(0.1, 0.2, 1.0);
+        let rays: Vec<Ray> = [
+            Vec3::ZERO,
+            Vec3::X,
+            Vec3::new(0.5, 0.5, 0.0),
+            Vec3::new(0.25, 0.0, 0.0),
+            Vec3::new(2.0, 2.0, 0.0),
+            Vec3::new(0.3, 0.3, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.5, 0.0),
+        ]
+        .into_iter()
+        .map(|target| Ray::new(from, target - from))
+        .chain([Ray::new(
+            Vec3::new(0.2, 0.2, 0.0),
+            Vec3::new(0.0, 0.0, -1.0),
+        )])
+        .collect();
+        let mut hits = 0;
+        for corners in [unit, neighbour, needle, point, nan, huge] {
+            for first in 0..rays.len() {
+                let four = [0, 1, 2, 3].map(|i| &rays[(first + i) % rays.len()]);
+                for t_max in [[f64::INFINITY; LANES], [1.0, 0.0, 2.0, 0.5]] {
+                    hits += assert_rays_same(&corners, four, t_max).unwrap_or(0);
+                }
+            }
+        }
+        assert!(hits > 20, "{hits} hits");
     }
 
     #[test]

@@ -11,10 +11,20 @@
 //! by their order) or another structure walks a packet's rays one at a
 //! time, as do packets the walk cannot take together and the lanes where
 //! it saw two primitives hit at the same parameter.
+//!
+//! A leaf of triangles alone that several lanes reach is tested across
+//! them, four lanes at once ([`watertight_rays4`]): each lane sees the
+//! triangles in the leaf's order with its own interval, ended at each hit
+//! as [`leaf_hit`] ends it, so each gets what its own loop would get.
+
+#[cfg(target_arch = "x86_64")]
+use std::ops::Range;
 
 use crate::accel::bvh::PACKET_LANES;
 use crate::accel::{Accelerator, Bvh, QueryContext};
 use crate::math::Ray;
+#[cfg(target_arch = "x86_64")]
+use crate::shape::{LANES, RayLanes4, RayShear, ShapeHit, watertight_rays4};
 
 use super::entry::{EntryKind, Query, leaf_hit};
 use super::{Hit, PrimitiveId, World};
@@ -111,15 +121,39 @@ impl<'a> World<'a> {
             }
             &clipped[..rays.len()]
         };
-        let tied =
-            bvh.intersect_packet_in_leaf_order(rays, &mut ctx.counters, |lane, range, t_max| {
+        // Leaves of triangles alone are tested across the lanes, once all
+        // the packet's rays are sheared alike (`None` until a leaf needs
+        // them, `Some(None)` when they are not).
+        #[cfg(target_arch = "x86_64")]
+        let mut across: Option<Option<[RayLanes4; 2]>> = None;
+        let tied = bvh.intersect_packet_by_leaf(rays, &mut ctx.counters, |lanes, range, t_max| {
+            #[cfg(target_arch = "x86_64")]
+            if lanes.count_ones() > 1 && self.all_triangles(range.clone()) {
+                let across = across.get_or_insert_with(|| {
+                    for (lane, ray) in rays.iter().enumerate() {
+                        queries[lane].get_or_insert_with(|| Query::new(ray, self.has_triangles));
+                    }
+                    // SAFETY: packets are walked together only where the
+                    // processor has AVX (`packets_allowed`).
+                    unsafe { ray_lanes(rays, &queries) }
+                });
+                if let Some(across) = across {
+                    // SAFETY: as above.
+                    return unsafe { self.triangles_across(range, lanes, t_max, across, hits) };
+                }
+            }
+            let mut found = [None; PACKET_SIZE];
+            let mut bits = lanes;
+            while bits != 0 {
+                let lane = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
                 let query = queries[lane]
                     .get_or_insert_with(|| Query::new(&rays[lane], self.has_triangles));
-                leaf_hit(
+                found[lane] = leaf_hit(
                     &self.entries,
-                    range,
+                    range.clone(),
                     query,
-                    t_max,
+                    t_max[lane],
                     self.wide,
                     |e, t_max| self.intersect_other(definitions, e, query, t_max, &mut inner),
                     |primitive, shape_hit| {
@@ -128,11 +162,98 @@ impl<'a> World<'a> {
                             shape_hit,
                         })
                     },
-                )
-            });
+                );
+            }
+            found
+        });
         ctx.counters += inner.counters;
         tied.unwrap_or(all)
     }
+
+    /// Whether the entries `range` are all triangles.
+    #[cfg(target_arch = "x86_64")]
+    #[inline]
+    fn all_triangles(&self, range: Range<u32>) -> bool {
+        self.entries[range.start as usize..range.end as usize]
+            .iter()
+            .all(|e| e.kind == EntryKind::Triangle)
+    }
+
+    /// The leaf `range` of triangles tested for the `lanes` of a packet
+    /// whose rays are `across`, each lane's interval ending at
+    /// `t_max[lane]`: per lane, the triangles in order, each hit closer
+    /// than the last written to `hits` and ending the interval, as
+    /// [`leaf_hit`] does for one ray; the closest `t` per lane.
+    ///
+    /// # Safety
+    ///
+    /// Call it only where the processor has AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn triangles_across(
+        &self,
+        range: Range<u32>,
+        lanes: u32,
+        t_max: &[f64; PACKET_SIZE],
+        across: &[RayLanes4; 2],
+        hits: &mut [Option<Hit>],
+    ) -> [Option<f64>; PACKET_SIZE] {
+        let mut t_max = *t_max;
+        let mut found = [None; PACKET_SIZE];
+        for e in &self.entries[range.start as usize..range.end as usize] {
+            for (half, rays) in across.iter().enumerate() {
+                let first = half * LANES;
+                let mut mask = (lanes >> first) & 0b1111;
+                if mask == 0 {
+                    continue;
+                }
+                let ends = [0, 1, 2, 3].map(|i| t_max[first + i]);
+                let h = watertight_rays4(&e.corners, rays, ends);
+                mask &= h.mask;
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let lane = first + i;
+                    t_max[lane] = h.t[i];
+                    found[lane] = Some(h.t[i]);
+                    hits[lane] = Some(Hit {
+                        primitive: PrimitiveId(e.number),
+                        shape_hit: ShapeHit {
+                            t: h.t[i],
+                            u: h.u[i],
+                            v: h.v[i],
+                            part: 0,
+                        },
+                    });
+                }
+            }
+        }
+        found
+    }
+}
+
+/// The packet's rays in two sets of four lanes (the last ray repeated past
+/// the packet's end), with their queries' shears; `None` when the shears
+/// do not all make the same axis z.
+///
+/// # Safety
+///
+/// Call it only where the processor has AVX.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+fn ray_lanes(rays: &[Ray], queries: &[Option<Query>; PACKET_SIZE]) -> Option<[RayLanes4; 2]> {
+    let last = rays.len() - 1;
+    let shears: [RayShear; PACKET_SIZE] = std::array::from_fn(|lane| {
+        queries[lane.min(last)].map_or_else(|| RayShear::new(&rays[lane.min(last)]), |q| q.shear())
+    });
+    let half = |first: usize| {
+        let lane = |i: usize| (first + i).min(last);
+        RayLanes4::new(
+            [0, 1, 2, 3].map(|i| &rays[lane(i)]),
+            [0, 1, 2, 3].map(|i| &shears[first + i]),
+        )
+    };
+    Some([half(0)?, half(LANES)?])
 }
 
 #[cfg(test)]
@@ -336,6 +457,73 @@ mod tests {
                 assert!(given_back > 100 && given_back < lanes - 100, "{given_back}");
             }
         }
+    }
+
+    /// A closed sphere of `rings × rings` quads split into triangles that
+    /// share their corners, and scattered triangles: a world whose leaves
+    /// all hold triangles alone.
+    fn triangles_only(rng: &mut Rng, rings: u32) -> Objects {
+        let mut positions = Vec::new();
+        for i in 0..=rings {
+            let theta = std::f64::consts::PI * f64::from(i) / f64::from(rings);
+            for j in 0..rings {
+                let phi = std::f64::consts::TAU * f64::from(j) / f64::from(rings);
+                let (s, c) = (theta.sin(), theta.cos());
+                positions.push(2.0 * Vec3::new(s * phi.cos(), c, s * phi.sin()));
+            }
+        }
+        let corner = |i: u32, j: u32| i * rings + j % rings;
+        let mut triangles = Vec::new();
+        for i in 0..rings {
+            for j in 0..rings {
+                let (a, b) = (corner(i, j), corner(i, j + 1));
+                let (c, d) = (corner(i + 1, j), corner(i + 1, j + 1));
+                triangles.extend([[a, c, b], [b, c, d]]);
+            }
+        }
+        let mut objects = Objects::default();
+        let sphere = objects.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
+        objects.add_mesh_instance(sphere, MaterialId(0), Transform::IDENTITY);
+        let soup = objects.add_mesh(crate::world::scattered_triangles(rng, 300, 4.0));
+        objects.add_mesh_instance(soup, MaterialId(0), Transform::IDENTITY);
+        objects
+    }
+
+    #[test]
+    fn leaves_of_triangles_tested_across_the_lanes_get_the_single_walks_hits() {
+        let mut rng = Rng::new(9);
+        let objects = triangles_only(&mut rng, 48);
+        let world = World::new(&objects);
+        assert!(world.entries.iter().all(|e| e.kind == EntryKind::Triangle));
+        let mut packets = camera_packets(&mut rng, 600, 0.002);
+        packets.extend(camera_packets(&mut rng, 300, 0.05));
+        // Rays along the axes' diagonals, where the largest component of
+        // neighbouring directions differs, so the lanes are not sheared
+        // alike.
+        for _ in 0..100 {
+            let origin = rng.point_in(Vec3::splat(5.0), Vec3::splat(6.0));
+            packets.push(
+                (0..PACKET_SIZE)
+                    .map(|_| Ray::new(origin, -Vec3::ONE + 1e-3 * rng.unit_vector()))
+                    .collect(),
+            );
+        }
+        let (together, hits) = assert_packets_agree(&objects, &packets);
+        if has_avx() {
+            assert!(together > 800, "{together}");
+            #[cfg(target_arch = "x86_64")]
+            {
+                let sheared_alike = |rays: &Vec<Ray>| {
+                    let queries =
+                        std::array::from_fn(|lane| rays.get(lane).map(|ray| Query::new(ray, true)));
+                    // SAFETY: the processor has AVX.
+                    unsafe { ray_lanes(rays, &queries) }.is_some()
+                };
+                let alike = packets.iter().filter(|rays| sheared_alike(rays)).count();
+                assert!(alike > 800 && alike < packets.len(), "{alike}");
+            }
+        }
+        assert!(hits > 2000, "{hits}");
     }
 
     #[test]

@@ -59,7 +59,30 @@ impl Bvh {
         &self,
         rays: &[Ray],
         counters: &mut TraversalCounters,
-        hit: impl FnMut(usize, Range<u32>, f64) -> Option<f64>,
+        mut hit: impl FnMut(usize, Range<u32>, f64) -> Option<f64>,
+    ) -> Option<u32> {
+        self.intersect_packet_by_leaf(rays, counters, |lanes, range, t_max| {
+            let mut found = [None; PACKET_LANES];
+            let mut bits = lanes;
+            while bits != 0 {
+                let lane = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                found[lane] = hit(lane, range.clone(), t_max[lane]);
+            }
+            found
+        })
+    }
+
+    /// [`Self::intersect_packet_in_leaf_order`] with each leaf tested for
+    /// all the lanes that reach it at once: `hit(lanes, entries, t_max)`
+    /// gives, for each lane whose bit is set in `lanes`, what `hit` of
+    /// that method gives for it with `t_max[lane]`, so that a leaf's test
+    /// may run across the lanes.
+    pub fn intersect_packet_by_leaf(
+        &self,
+        rays: &[Ray],
+        counters: &mut TraversalCounters,
+        hit: impl FnMut(u32, Range<u32>, &[f64; PACKET_LANES]) -> [Option<f64>; PACKET_LANES],
     ) -> Option<u32> {
         if rays.is_empty() || rays.len() > PACKET_LANES || self.nodes.is_empty() {
             return None;
@@ -93,7 +116,7 @@ impl Bvh {
         lanes: &avx::Lanes,
         rays: &[Ray],
         counters: &mut TraversalCounters,
-        mut hit: impl FnMut(usize, Range<u32>, f64) -> Option<f64>,
+        mut hit: impl FnMut(u32, Range<u32>, &[f64; PACKET_LANES]) -> [Option<f64>; PACKET_LANES],
     ) -> u32 {
         use crate::accel::stack::Stack;
         use avx::PacketEntry;
@@ -114,12 +137,20 @@ impl Bvh {
             work.nodes += 1;
             if current.count > 0 {
                 let range = current.child..current.child + current.count;
+                let mut t_max = [0.0; PACKET_LANES];
                 let mut bits = current.lanes;
                 while bits != 0 {
                     let lane = bits.trailing_zeros() as usize;
                     bits &= bits - 1;
-                    work.primitives += u64::from(current.count);
-                    if let Some(t) = hit(lane, range.clone(), closest[lane].next_up()) {
+                    t_max[lane] = closest[lane].next_up();
+                }
+                work.primitives += u64::from(current.count * current.lanes.count_ones());
+                let found = hit(current.lanes, range, &t_max);
+                let mut bits = current.lanes;
+                while bits != 0 {
+                    let lane = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    if let Some(t) = found[lane] {
                         if t < closest[lane] {
                             closest[lane] = t;
                             far[lane] = super::node::round_up(t);
