@@ -1,6 +1,6 @@
 //! Rays that travel together, as one query: up to [`PACKET_SIZE`] rays
 //! (a tile row's camera rays) whose closest hits are found by one walk of
-//! the BVH ([`Bvh::intersect_packet_in_leaf_order`]), with exactly the
+//! the BVH ([`Bvh::intersect_packet_by_leaf`]), with exactly the
 //! answers each ray's own walk gives.
 //!
 //! The packet walk tests a primitive with other intervals than the single
@@ -12,10 +12,13 @@
 //! time, as do packets the walk cannot take together and the lanes where
 //! it saw two primitives hit at the same parameter.
 //!
-//! A leaf of triangles alone that several lanes reach is tested across
-//! them, four lanes at once ([`watertight_rays4`]): each lane sees the
-//! triangles in the leaf's order with its own interval, ended at each hit
-//! as [`leaf_hit`] ends it, so each gets what its own loop would get.
+//! A leaf of triangles alone that several lanes of a set of four reach is
+//! tested across them, four lanes at once (`watertight_rays4`): each lane
+//! sees the triangles in the leaf's order with its own interval, ended at
+//! each hit as [`leaf_hit`] ends it, so each gets what its own loop would
+//! get. Not in worlds of meshes of 200k triangles or more, whose
+//! triangles, under a pixel, seldom meet several lanes: the test across
+//! them was slower there (docs/performance.md).
 
 #[cfg(target_arch = "x86_64")]
 use std::ops::Range;
@@ -31,6 +34,11 @@ use super::{Hit, PrimitiveId, World};
 
 /// The most rays a packet holds.
 pub const PACKET_SIZE: usize = PACKET_LANES;
+
+/// How many lanes of a set of four must reach a leaf of triangles for the
+/// set to be tested across its lanes.
+#[cfg(target_arch = "x86_64")]
+const ACROSS_FROM: u32 = 2;
 
 impl<'a> World<'a> {
     /// True when [`Self::intersect_packet`] walks packets together (else
@@ -96,7 +104,8 @@ impl<'a> World<'a> {
         let all = (1u32 << rays.len()) - 1;
         let definitions = &self.definitions;
         // A lane's query (its triangle shear) is made when the lane first
-        // reaches an entry: most of a packet's lanes that miss never do.
+        // reaches an entry (most of a packet's lanes that miss never do),
+        // or when a leaf is first tested across the lanes.
         let mut queries: [Option<Query>; PACKET_SIZE] = [None; PACKET_SIZE];
         let mut inner = QueryContext::new(ctx.coherence);
         hits.fill(None);
@@ -121,14 +130,17 @@ impl<'a> World<'a> {
             }
             &clipped[..rays.len()]
         };
-        // Leaves of triangles alone are tested across the lanes, once all
-        // the packet's rays are sheared alike (`None` until a leaf needs
-        // them, `Some(None)` when they are not).
+        // Leaves of triangles alone are tested across the lanes where each
+        // set of four lanes is sheared alike (`None` until a leaf needs
+        // them, `Some(None)` when a set is not).
         #[cfg(target_arch = "x86_64")]
         let mut across: Option<Option<[RayLanes4; 2]>> = None;
         let tied = bvh.intersect_packet_by_leaf(rays, &mut ctx.counters, |lanes, range, t_max| {
+            let mut found = 0;
+            // The lanes left to test one by one.
+            let mut alone = lanes;
             #[cfg(target_arch = "x86_64")]
-            if lanes.count_ones() > 1 && self.all_triangles(range.clone()) {
+            if !self.big_meshes && crowded_halves(lanes) != 0 && self.all_triangles(range.clone()) {
                 let across = across.get_or_insert_with(|| {
                     for (lane, ray) in rays.iter().enumerate() {
                         queries[lane].get_or_insert_with(|| Query::new(ray, self.has_triangles));
@@ -138,18 +150,21 @@ impl<'a> World<'a> {
                     unsafe { ray_lanes(rays, &queries) }
                 });
                 if let Some(across) = across {
+                    let together = lanes & crowded_halves(lanes);
                     // SAFETY: as above.
-                    return unsafe { self.triangles_across(range, lanes, t_max, across, hits) };
+                    found = unsafe {
+                        self.triangles_across(range.clone(), together, t_max, across, hits)
+                    };
+                    alone &= !together;
                 }
             }
-            let mut found = [None; PACKET_SIZE];
-            let mut bits = lanes;
+            let mut bits = alone;
             while bits != 0 {
                 let lane = bits.trailing_zeros() as usize;
                 bits &= bits - 1;
                 let query = queries[lane]
                     .get_or_insert_with(|| Query::new(&rays[lane], self.has_triangles));
-                found[lane] = leaf_hit(
+                let closest = leaf_hit(
                     &self.entries,
                     range.clone(),
                     query,
@@ -163,6 +178,10 @@ impl<'a> World<'a> {
                         })
                     },
                 );
+                if let Some(t) = closest {
+                    t_max[lane] = t;
+                    found |= 1 << lane;
+                }
             }
             found
         });
@@ -183,23 +202,24 @@ impl<'a> World<'a> {
     /// whose rays are `across`, each lane's interval ending at
     /// `t_max[lane]`: per lane, the triangles in order, each hit closer
     /// than the last written to `hits` and ending the interval, as
-    /// [`leaf_hit`] does for one ray; the closest `t` per lane.
+    /// [`leaf_hit`] does for one ray. Returns the lanes that hit, with
+    /// their closest `t` left in `t_max`.
     ///
     /// # Safety
     ///
     /// Call it only where the processor has AVX.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
+    #[inline(never)]
     fn triangles_across(
         &self,
         range: Range<u32>,
         lanes: u32,
-        t_max: &[f64; PACKET_SIZE],
+        t_max: &mut [f64; PACKET_SIZE],
         across: &[RayLanes4; 2],
         hits: &mut [Option<Hit>],
-    ) -> [Option<f64>; PACKET_SIZE] {
-        let mut t_max = *t_max;
-        let mut found = [None; PACKET_SIZE];
+    ) -> u32 {
+        let mut found = 0;
         for e in &self.entries[range.start as usize..range.end as usize] {
             for (half, rays) in across.iter().enumerate() {
                 let first = half * LANES;
@@ -210,12 +230,12 @@ impl<'a> World<'a> {
                 let ends = [0, 1, 2, 3].map(|i| t_max[first + i]);
                 let h = watertight_rays4(&e.corners, rays, ends);
                 mask &= h.mask;
+                found |= mask << first;
                 while mask != 0 {
                     let i = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
                     let lane = first + i;
                     t_max[lane] = h.t[i];
-                    found[lane] = Some(h.t[i]);
                     hits[lane] = Some(Hit {
                         primitive: PrimitiveId(e.number),
                         shape_hit: ShapeHit {
@@ -232,9 +252,26 @@ impl<'a> World<'a> {
     }
 }
 
+/// The lanes of the sets of four (lanes 0 to 3, 4 to 7) of which at least
+/// [`ACROSS_FROM`] are in `lanes`: the sets worth testing across (one
+/// lane alone is tested faster by itself, with its early outs).
+#[cfg(target_arch = "x86_64")]
+#[inline]
+fn crowded_halves(lanes: u32) -> u32 {
+    let crowded = |first: usize| {
+        let half = 0b1111 << first;
+        if (lanes & half).count_ones() >= ACROSS_FROM {
+            half
+        } else {
+            0
+        }
+    };
+    crowded(0) | crowded(LANES)
+}
+
 /// The packet's rays in two sets of four lanes (the last ray repeated past
 /// the packet's end), with their queries' shears; `None` when the shears
-/// do not all make the same axis z.
+/// of one of the sets do not all make the same axis z.
 ///
 /// # Safety
 ///
@@ -524,6 +561,73 @@ mod tests {
             }
         }
         assert!(hits > 2000, "{hits}");
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn each_lane_tested_across_gets_its_own_loops_hits_and_no_other_lane_changes() {
+        if !has_avx() {
+            return;
+        }
+        let mut rng = Rng::new(10);
+        let objects = triangles_only(&mut rng, 32);
+        let world = World::new(&objects);
+        let Accelerator::Bvh(bvh) = &world.accel else {
+            panic!("the default structure is a BVH");
+        };
+        let (mut leaves, mut lanes_hit) = (0, 0);
+        for rays in camera_packets(&mut rng, 300, 0.01) {
+            let queries = std::array::from_fn(|lane| rays.get(lane).map(|r| Query::new(r, true)));
+            // SAFETY: the processor has AVX.
+            let Some(across) = (unsafe { ray_lanes(&rays, &queries) }) else {
+                continue;
+            };
+            let mut counters = crate::accel::TraversalCounters::default();
+            // Every leaf the packet reaches, tested across a random subset
+            // of its lanes with random interval ends, against each lane's
+            // own loop.
+            bvh.intersect_packet_by_leaf(&rays, &mut counters, |lanes, range, _| {
+                let chosen = lanes & rng.below(256);
+                let ends: [f64; PACKET_SIZE] = std::array::from_fn(|_| rng.range(0.0, 20.0));
+                let mut t_max = ends;
+                let mut hits = [None; PACKET_SIZE];
+                // SAFETY: as above.
+                let found = unsafe {
+                    world.triangles_across(range.clone(), chosen, &mut t_max, &across, &mut hits)
+                };
+                for lane in 0..PACKET_SIZE {
+                    let mut own = None;
+                    let mut closest = None;
+                    if chosen & 1 << lane != 0 {
+                        closest = leaf_hit(
+                            &world.entries,
+                            range.clone(),
+                            queries[lane].as_ref().unwrap(),
+                            ends[lane],
+                            false,
+                            |_, _| unreachable!("triangles only"),
+                            |primitive, shape_hit| {
+                                own = Some(Hit {
+                                    primitive: PrimitiveId(primitive),
+                                    shape_hit,
+                                })
+                            },
+                        );
+                    }
+                    assert_eq!(found & 1 << lane != 0, closest.is_some(), "lane {lane}");
+                    assert_eq!(hits[lane], own, "lane {lane}");
+                    let end = closest.unwrap_or(ends[lane]);
+                    assert_eq!(t_max[lane].to_bits(), end.to_bits(), "lane {lane}");
+                    lanes_hit += usize::from(closest.is_some());
+                }
+                leaves += 1;
+                0
+            });
+        }
+        assert!(
+            leaves > 500 && lanes_hit > 200,
+            "{leaves} leaves, {lanes_hit} hits"
+        );
     }
 
     #[test]

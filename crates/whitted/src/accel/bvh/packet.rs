@@ -62,27 +62,31 @@ impl Bvh {
         mut hit: impl FnMut(usize, Range<u32>, f64) -> Option<f64>,
     ) -> Option<u32> {
         self.intersect_packet_by_leaf(rays, counters, |lanes, range, t_max| {
-            let mut found = [None; PACKET_LANES];
+            let mut found = 0;
             let mut bits = lanes;
             while bits != 0 {
                 let lane = bits.trailing_zeros() as usize;
                 bits &= bits - 1;
-                found[lane] = hit(lane, range.clone(), t_max[lane]);
+                if let Some(t) = hit(lane, range.clone(), t_max[lane]) {
+                    t_max[lane] = t;
+                    found |= 1 << lane;
+                }
             }
             found
         })
     }
 
     /// [`Self::intersect_packet_in_leaf_order`] with each leaf tested for
-    /// all the lanes that reach it at once: `hit(lanes, entries, t_max)`
-    /// gives, for each lane whose bit is set in `lanes`, what `hit` of
-    /// that method gives for it with `t_max[lane]`, so that a leaf's test
-    /// may run across the lanes.
+    /// all the lanes that reach it at once, so that its test may run
+    /// across them: `hit(lanes, entries, t_max)` does for each lane whose
+    /// bit is set in `lanes` what `hit` of that method does with
+    /// `t_max[lane]`, and where that finds a hit, sets the lane's bit in
+    /// the mask it returns and leaves the hit's `t` in `t_max[lane]`.
     pub fn intersect_packet_by_leaf(
         &self,
         rays: &[Ray],
         counters: &mut TraversalCounters,
-        hit: impl FnMut(u32, Range<u32>, &[f64; PACKET_LANES]) -> [Option<f64>; PACKET_LANES],
+        hit: impl FnMut(u32, Range<u32>, &mut [f64; PACKET_LANES]) -> u32,
     ) -> Option<u32> {
         if rays.is_empty() || rays.len() > PACKET_LANES || self.nodes.is_empty() {
             return None;
@@ -107,7 +111,7 @@ impl Bvh {
         None
     }
 
-    /// The walk of [`Self::intersect_packet_in_leaf_order`] with a stack of
+    /// The walk of [`Self::intersect_packet_by_leaf`] with a stack of
     /// `N` entries.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
@@ -116,7 +120,7 @@ impl Bvh {
         lanes: &avx::Lanes,
         rays: &[Ray],
         counters: &mut TraversalCounters,
-        mut hit: impl FnMut(u32, Range<u32>, &[f64; PACKET_LANES]) -> [Option<f64>; PACKET_LANES],
+        mut hit: impl FnMut(u32, Range<u32>, &mut [f64; PACKET_LANES]) -> u32,
     ) -> u32 {
         use crate::accel::stack::Stack;
         use avx::PacketEntry;
@@ -145,18 +149,16 @@ impl Bvh {
                     t_max[lane] = closest[lane].next_up();
                 }
                 work.primitives += u64::from(current.count * current.lanes.count_ones());
-                let found = hit(current.lanes, range, &t_max);
-                let mut bits = current.lanes;
-                while bits != 0 {
-                    let lane = bits.trailing_zeros() as usize;
-                    bits &= bits - 1;
-                    if let Some(t) = found[lane] {
-                        if t < closest[lane] {
-                            closest[lane] = t;
-                            far[lane] = super::node::round_up(t);
-                        } else {
-                            tied |= 1 << lane;
-                        }
+                let mut found = hit(current.lanes, range, &mut t_max) & current.lanes;
+                while found != 0 {
+                    let lane = found.trailing_zeros() as usize;
+                    found &= found - 1;
+                    let t = t_max[lane];
+                    if t < closest[lane] {
+                        closest[lane] = t;
+                        far[lane] = super::node::round_up(t);
+                    } else {
+                        tied |= 1 << lane;
                     }
                 }
                 far_most = far.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b));
