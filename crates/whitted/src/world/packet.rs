@@ -130,9 +130,9 @@ impl<'a> World<'a> {
             }
             &clipped[..rays.len()]
         };
-        // Leaves of triangles alone are tested across the lanes where each
-        // set of four lanes is sheared alike (`None` until a leaf needs
-        // them, `Some(None)` when a set is not).
+        // Leaves of triangles alone are tested across the lanes when each
+        // of the two sets of four lanes is sheared alike (`None` until a
+        // leaf needs them, `Some(None)` when a set is not).
         #[cfg(target_arch = "x86_64")]
         let mut across: Option<Option<[RayLanes4; 2]>> = None;
         let tied = bvh.intersect_packet_by_leaf(rays, &mut ctx.counters, |lanes, range, t_max| {
