@@ -399,6 +399,20 @@ mod tests {
         assert!(hits > 20_000, "{hits} hits");
     }
 
+    /// The unit triangle in z = 0, its neighbour across the diagonal, a
+    /// needle and a point (no area), one with a NaN corner and one with
+    /// corners near the largest `f64`.
+    fn awkward_triangles() -> [[Vec3; 3]; 6] {
+        [
+            [Vec3::ZERO, Vec3::X, Vec3::Y],
+            [Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
+            [Vec3::ZERO, Vec3::X, 2.0 * Vec3::X],
+            [Vec3::ONE; 3],
+            [Vec3::splat(f64::NAN), Vec3::X, Vec3::Y],
+            [Vec3::splat(-1e300), Vec3::new(1e300, 0.0, 0.0), Vec3::Y],
+        ]
+    }
+
     /// Each of four rays' answers for `corners` against the one-triangle
     /// test's, bit for bit; `None` when their shears differ in axis. The
     /// caller has checked for AVX.
@@ -486,12 +500,6 @@ mod tests {
         if !crate::math::test_support::has_avx_or_skip_allowed() {
             return;
         }
-        let unit = [Vec3::ZERO, Vec3::X, Vec3::Y];
-        let neighbour = [Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
-        let needle = [Vec3::ZERO, Vec3::X, 2.0 * Vec3::X];
-        let point = [Vec3::ONE; 3];
-        let nan = [Vec3::splat(f64::NAN), Vec3::X, Vec3::Y];
-        let huge = [Vec3::splat(-1e300), Vec3::new(1e300, 0.0, 0.0), Vec3::Y];
         let from = Vec3::new(0.1, 0.2, 1.0);
         let rays: Vec<Ray> = [
             Vec3::ZERO,
@@ -512,7 +520,7 @@ mod tests {
         ])
         .collect();
         let mut hits = 0;
-        for corners in [unit, neighbour, needle, point, nan, huge] {
+        for corners in awkward_triangles() {
             for first in 0..rays.len() {
                 let four = [0, 1, 2, 3].map(|i| &rays[(first + i) % rays.len()]);
                 for t_max in [[f64::INFINITY; LANES], [1.0, 0.0, 2.0, 0.5]] {
@@ -528,13 +536,7 @@ mod tests {
         if !crate::math::test_support::has_avx_or_skip_allowed() {
             return;
         }
-        let unit = [Vec3::ZERO, Vec3::X, Vec3::Y];
-        let neighbour = [Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
-        let needle = [Vec3::ZERO, Vec3::X, 2.0 * Vec3::X];
-        let point = [Vec3::ONE; 3];
-        let nan = [Vec3::splat(f64::NAN), Vec3::X, Vec3::Y];
-        let huge = [Vec3::splat(-1e300), Vec3::new(1e300, 0.0, 0.0), Vec3::Y];
-        let shapes = [unit, neighbour, needle, point, nan, huge];
+        let shapes = awkward_triangles();
         let mut rays = Vec::new();
         for target in [
             Vec3::ZERO,
