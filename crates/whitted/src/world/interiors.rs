@@ -394,8 +394,8 @@ mod tests {
     use crate::math::random::Rng;
     use crate::math::{Transform, offset_ray_origin};
     use crate::mesh::TriangleMesh;
-    use crate::shape::{Cylinder, Plane, Polygon, Torus};
-    use crate::world::{Objects, scattered_triangles};
+    use crate::shape::{Cylinder, Plane, Torus};
+    use crate::world::{Objects, scattered_triangles, turned_square};
     use std::f64::consts::SQRT_2;
 
     const GLASS: MaterialId = MaterialId(1);
@@ -547,14 +547,7 @@ mod tests {
         objects.add_mesh_instance(mesh, MaterialId(0), Transform::IDENTITY);
         for _ in 0..20 {
             let centre = 6.0 * rng.unit_vector() * rng.uniform();
-            let (a, b) = rng.unit_vector().any_orthonormal_pair();
-            let quad = vec![
-                centre - a - b,
-                centre + a - b,
-                centre + a + b,
-                centre - a + b,
-            ];
-            let polygon = Polygon::new(quad).unwrap();
+            let polygon = turned_square(rng, centre);
             objects.add_primitive(Shape::Polygon(polygon), MaterialId(0), Transform::IDENTITY);
             let cylinder = Cylinder::new(0.2 + 0.3 * rng.uniform(), 1.5, true).unwrap();
             let moved = Transform::translate(6.0 * rng.unit_vector() * rng.uniform()).unwrap();

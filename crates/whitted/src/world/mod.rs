@@ -859,6 +859,20 @@ impl<'a> World<'a> {
     }
 }
 
+/// A square of side 2 around `centre`, turned at random: a polygon for the
+/// world's tests.
+#[cfg(test)]
+fn turned_square(rng: &mut crate::math::random::Rng, centre: Vec3) -> crate::shape::Polygon {
+    let (a, b) = rng.unit_vector().any_orthonormal_pair();
+    let square = vec![
+        centre - a - b,
+        centre + a - b,
+        centre + a + b,
+        centre - a + b,
+    ];
+    crate::shape::Polygon::new(square).expect("a square is a polygon")
+}
+
 /// `count` triangles of unit-sized sides scattered in the ball of
 /// `radius` around the origin, unconnected: a mesh for the world's tests.
 #[cfg(test)]

@@ -379,9 +379,9 @@ mod tests {
     use crate::accel::AccelKind;
     use crate::math::random::Rng;
     use crate::math::{Transform, Vec3};
-    use crate::shape::{Cylinder, Plane, Polygon, Sphere};
+    use crate::shape::{Cylinder, Plane, Sphere};
     use crate::world::Objects;
-    use crate::world::scattered_triangles;
+    use crate::world::{scattered_triangles, turned_square};
 
     /// Spheres of two materials (0 opaque, 1 clear), a mesh of scattered
     /// triangles of each, and a plane of the clear one.
@@ -404,15 +404,8 @@ mod tests {
         // cylinders (through the tables), of both materials.
         for i in 0..60 {
             let centre = 10.0 * (rng.unit_vector() * rng.uniform());
-            let (a, b) = rng.unit_vector().any_orthonormal_pair();
-            let quad = vec![
-                centre - a - b,
-                centre + a - b,
-                centre + a + b,
-                centre - a + b,
-            ];
             objects.add_primitive(
-                Shape::Polygon(Polygon::new(quad).unwrap()),
+                Shape::Polygon(turned_square(rng, centre)),
                 MaterialId(i % 2),
                 Transform::IDENTITY,
             );
