@@ -78,10 +78,9 @@ pub struct BenchArgs {
     #[arg(long, value_name = "SIZE", value_parser = whitted::limits::parse_size)]
     max_memory: Option<u64>,
 
-    /// Walk the closest-hit rays (primary, diffuse) in packets of 8
-    /// consecutive rays, as the renderer walks a tile row's camera rays
-    /// (together where the scene allows it; shadow rays stay single), to
-    /// compare with the single-ray walk.
+    /// Walk the rays in packets of 8 consecutive rays, as the renderer
+    /// walks a tile row's camera rays (together where the scene allows
+    /// it), to compare with the single-ray walk.
     #[arg(long)]
     packets: bool,
 
@@ -320,7 +319,7 @@ fn table(args: &BenchArgs, primitives: usize, threads: usize, reports: &[AccelRe
         ));
         if args.packets {
             lines.push(if r.packets {
-                "        closest hits in packets of 8 rays".to_string()
+                "        rays in packets of 8".to_string()
             } else {
                 "        rays one at a time: this structure or scene walks no packets".to_string()
             });

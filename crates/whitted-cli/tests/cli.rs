@@ -336,7 +336,7 @@ fn bench_walks_closest_hits_in_packets_when_asked() {
     let avx = false;
     let table = run(&["--accel", "bvh", "--packets"]);
     let line = if avx {
-        "closest hits in packets of 8 rays"
+        "rays in packets of 8"
     } else {
         "rays one at a time"
     };

@@ -20,9 +20,9 @@ pub enum Walk {
     #[default]
     Single,
     /// [`PACKET_SIZE`] consecutive rays at a time
-    /// ([`World::intersect_packet`]: together where the world and the rays
-    /// allow it, one at a time otherwise). Any-hit sets walk one ray at a
-    /// time either way.
+    /// ([`World::intersect_packet`] and [`World::occluded_packet`]:
+    /// together where the world and the rays allow it, one at a time
+    /// otherwise).
     Packets,
 }
 
@@ -49,6 +49,26 @@ fn closest_hits(
     }
 }
 
+/// The any-hit answers of `rays` (one thread's chunk), walked as `walk`
+/// says, each passed to `found` in order.
+fn any_hits(
+    world: &World,
+    rays: &[Ray],
+    walk: Walk,
+    ctx: &mut QueryContext,
+    mut found: impl FnMut(bool),
+) {
+    match walk {
+        Walk::Single => rays.iter().for_each(|r| found(world.occluded_with(r, ctx))),
+        Walk::Packets => {
+            for packet in rays.chunks(PACKET_SIZE) {
+                let occluded = world.occluded_packet(packet, ctx);
+                (0..packet.len()).for_each(|lane| found(occluded & 1 << lane != 0));
+            }
+        }
+    }
+}
+
 /// What a ray set's rays hit.
 #[derive(Clone, Debug, PartialEq)]
 pub enum TraceResults {
@@ -64,12 +84,9 @@ pub enum TraceResults {
 pub fn trace_all(world: &World, set: &RaySet, walk: Walk) -> (TraceResults, TraversalCounters) {
     let mut ctx = QueryContext::new(set.kind.coherence());
     let results = if set.kind.is_any_hit() {
-        TraceResults::Occluded(
-            set.rays
-                .iter()
-                .map(|r| world.occluded_with(r, &mut ctx))
-                .collect(),
-        )
+        let mut occluded = Vec::with_capacity(set.rays.len());
+        any_hits(world, &set.rays, walk, &mut ctx, |o| occluded.push(o));
+        TraceResults::Occluded(occluded)
     } else {
         let mut hits = Vec::with_capacity(set.rays.len());
         closest_hits(world, &set.rays, walk, &mut ctx, |h| {
@@ -100,10 +117,11 @@ pub fn time_set(
     let chunks: Vec<&[Ray]> = set.rays.chunks(CHUNK).collect();
     let next = AtomicUsize::new(0);
     let trace = |chunk: &[Ray], ctx: &mut QueryContext| {
-        if set.kind.is_any_hit() {
-            return chunk.iter().filter(|r| world.occluded_with(r, ctx)).count();
-        }
         let mut count = 0;
+        if set.kind.is_any_hit() {
+            any_hits(world, chunk, walk, ctx, |o| count += usize::from(o));
+            return count;
+        }
         closest_hits(world, chunk, walk, ctx, |h| {
             count += usize::from(h.is_some())
         });

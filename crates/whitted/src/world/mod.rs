@@ -34,6 +34,7 @@ mod instance;
 mod interiors;
 mod objects;
 mod packet;
+mod packet_any;
 mod prefetch;
 mod shadow_hint;
 mod shadow_path;

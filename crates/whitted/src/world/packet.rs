@@ -294,7 +294,7 @@ fn ray_lanes(rays: &[Ray], queries: &[Option<Query>; PACKET_SIZE]) -> Option<[Ra
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::accel::AccelKind;
     use crate::math::random::Rng;
@@ -304,7 +304,7 @@ mod tests {
     use crate::world::{MaterialId, Objects};
 
     /// Whether the processor has AVX, which the packet walk needs.
-    fn has_avx() -> bool {
+    pub(in crate::world) fn has_avx() -> bool {
         #[cfg(target_arch = "x86_64")]
         return is_x86_feature_detected!("avx");
         #[cfg(not(target_arch = "x86_64"))]
@@ -313,7 +313,7 @@ mod tests {
 
     /// Spheres, a triangle soup placed once, polygons, capped cylinders
     /// (some moved) and, if `floor`, an infinite plane.
-    fn closed_form_scene(rng: &mut Rng, floor: bool) -> Objects {
+    pub(in crate::world) fn closed_form_scene(rng: &mut Rng, floor: bool) -> Objects {
         let mut objects = Objects::default();
         let m = MaterialId(0);
         for _ in 0..80 {
@@ -499,7 +499,7 @@ mod tests {
     /// A closed sphere of `rings × rings` quads split into triangles that
     /// share their corners, and scattered triangles: a world whose leaves
     /// all hold triangles alone.
-    fn triangles_only(rng: &mut Rng, rings: u32) -> Objects {
+    pub(in crate::world) fn triangles_only(rng: &mut Rng, rings: u32) -> Objects {
         let mut positions = Vec::new();
         for i in 0..=rings {
             let theta = std::f64::consts::PI * f64::from(i) / f64::from(rings);

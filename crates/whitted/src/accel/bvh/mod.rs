@@ -22,6 +22,7 @@ mod collapse;
 mod fbox;
 mod node;
 mod packet;
+mod packet_any;
 mod prims;
 mod slabs;
 #[cfg(target_arch = "x86_64")]
