@@ -28,7 +28,7 @@ impl World<'_> {
         assert!(rays.len() <= PACKET_SIZE, "{} rays in a packet", rays.len());
         let together = match &self.accel {
             Accelerator::Bvh(bvh) if self.packet_walk && !rays.is_empty() => {
-                self.any_packet(bvh, rays, ctx)
+                self.occluded_together(bvh, rays, ctx)
             }
             _ => None,
         };
@@ -43,7 +43,7 @@ impl World<'_> {
     /// The packet walk of [`Self::occluded_packet`] over `bvh`, this
     /// world's structure, or `None` when the packet cannot be walked
     /// together.
-    fn any_packet(&self, bvh: &Bvh, rays: &[Ray], ctx: &mut QueryContext) -> Option<u32> {
+    fn occluded_together(&self, bvh: &Bvh, rays: &[Ray], ctx: &mut QueryContext) -> Option<u32> {
         let all = (1u32 << rays.len()) - 1;
         // A lane's query (its triangle shear) is made when the lane first
         // reaches an entry.
@@ -85,8 +85,11 @@ impl World<'_> {
                 found
             },
         );
+        // A packet not walked together is answered ray by ray, planes and
+        // all, and counted then.
+        let walked = walked?;
         ctx.counters += inner.counters;
-        Some(occluded | walked?)
+        Some(occluded | walked)
     }
 }
 
@@ -130,7 +133,7 @@ mod tests {
             let mut ctx = QueryContext::default();
             let occluded = world.occluded_packet(rays, &mut ctx);
             if let Accelerator::Bvh(bvh) = &world.accel {
-                counts[0] += usize::from(world.any_packet(bvh, rays, &mut ctx).is_some());
+                counts[0] += usize::from(world.occluded_together(bvh, rays, &mut ctx).is_some());
             }
             assert_eq!(occluded >> rays.len(), 0);
             for (lane, ray) in rays.iter().enumerate() {

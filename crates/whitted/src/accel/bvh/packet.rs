@@ -502,7 +502,7 @@ pub(super) mod avx {
         /// The lanes whose `near` is not beyond their `far`.
         #[target_feature(enable = "avx")]
         #[inline]
-        pub(in crate::accel::bvh) fn before(&self, near: &[f32; 8], far: &[f32; 8]) -> u32 {
+        pub(super) fn before(&self, near: &[f32; 8], far: &[f32; 8]) -> u32 {
             _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(load(near), load(far))) as u32
         }
 

@@ -27,6 +27,8 @@ impl Bvh {
     /// one of the leaf's entries (as [`Self::occluded_in_leaf_order`]'s
     /// test tells it for one ray): the mask of the occluded lanes, or
     /// `None` when the packet cannot be walked together (see `packet`).
+    /// With no lane asked for, or an empty hierarchy, that is `Some(0)`
+    /// whatever the rays.
     pub fn occluded_packet_by_leaf(
         &self,
         rays: &[Ray],
@@ -49,15 +51,15 @@ impl Bvh {
             // SAFETY: the processor has AVX.
             return Some(unsafe {
                 if self.max_depth <= SHALLOW {
-                    self.any_packet::<{ stack_size(SHALLOW) }>(
+                    self.occluded_walk::<{ stack_size(SHALLOW) }>(
                         &packet, rays, lanes, counters, occludes,
                     )
                 } else if self.max_depth <= MIDDLE {
-                    self.any_packet::<{ stack_size(MIDDLE) }>(
+                    self.occluded_walk::<{ stack_size(MIDDLE) }>(
                         &packet, rays, lanes, counters, occludes,
                     )
                 } else {
-                    self.any_packet::<{ stack_size(super::MAX_DEPTH) }>(
+                    self.occluded_walk::<{ stack_size(super::MAX_DEPTH) }>(
                         &packet, rays, lanes, counters, occludes,
                     )
                 }
@@ -71,7 +73,7 @@ impl Bvh {
     /// entries.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    fn any_packet<const N: usize>(
+    fn occluded_walk<const N: usize>(
         &self,
         packet: &super::packet::avx::Lanes,
         rays: &[Ray],
@@ -128,12 +130,15 @@ impl Bvh {
                 }
             }
             // Resume with a pending child that a lane not yet occluded may
-            // still meet.
+            // still meet. A lane's interval does not change until it is
+            // occluded, so its own test when the child was pushed still
+            // holds (testing `near` again against the unwidened `far` would
+            // drop children the single walk enters).
             let next = loop {
                 let Some(next) = stack.pop() else {
                     break None;
                 };
-                let still = next.lanes & !occluded & packet.before(&next.near, &far);
+                let still = next.lanes & !occluded;
                 if still != 0 {
                     let mut next = next;
                     next.lanes = still;
@@ -174,7 +179,9 @@ mod tests {
     }
 
     /// Packets of up to eight shadow rays: from points scattered over a
-    /// patch of side `spread` towards one light, each ending at it.
+    /// patch of side `spread` towards one light, each ending at it; some
+    /// start past their origin, some run on to infinity, some end where
+    /// they start.
     fn shadow_packets(rng: &mut Rng, count: usize, spread: f64) -> Vec<Vec<Ray>> {
         (0..count)
             .map(|_| {
@@ -185,7 +192,14 @@ mod tests {
                     .map(|_| {
                         let from = centre + rng.point_in(Vec3::splat(-spread), Vec3::splat(spread));
                         let to = light - from;
-                        Ray::segment(from, to.normalize(), to.length())
+                        let mut ray = Ray::segment(from, to.normalize(), to.length());
+                        match rng.below(8) {
+                            0 => ray.t_min = rng.range(0.0, ray.t_max),
+                            1 => ray.t_max = f64::INFINITY,
+                            2 => ray.t_max = ray.t_min,
+                            _ => {}
+                        }
+                        ray
                     })
                     .collect()
             })
@@ -203,7 +217,8 @@ mod tests {
         let (mut together, mut occluded, mut clear) = (0, 0, 0);
         for spread in [0.01, 0.3, 4.0] {
             for rays in shadow_packets(&mut rng, 400, spread) {
-                let lanes = rng.below(1 << rays.len()) | 1;
+                // Bits past the packet's rays are asked for too, and ignored.
+                let lanes = rng.below(1 << PACKET_LANES) | 1;
                 let mut counters = TraversalCounters::default();
                 let mut done = 0;
                 let found =
@@ -247,6 +262,50 @@ mod tests {
             together > 1000 && occluded > 500 && clear > 500,
             "{together} {occluded} {clear}"
         );
+    }
+
+    #[test]
+    fn a_lane_ending_just_short_of_a_box_enters_it_as_its_single_walk_does() {
+        if !crate::math::test_support::has_avx_or_skip_allowed() {
+            return;
+        }
+        // Unit cubes in a row, each its own leaf's; rays along the row end
+        // just short of a cube's face, where the slab test's widening still
+        // keeps the cube: the single walk enters that leaf, and so must
+        // each lane, however the packet's walk orders its children.
+        let cubes: Vec<Aabb> = (0..256)
+            .map(|i| {
+                let x = 2.0 * f64::from(i);
+                Aabb::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x + 1.0, 1.0, 1.0))
+            })
+            .collect();
+        let bvh = Bvh::build(&cubes);
+        let dir = Vec3::new(1.0, 1e-3, 1e-3).normalize();
+        let origin = Vec3::new(-5.0, 0.5, 0.5);
+        let mut entered = 0;
+        for k in (1..256).step_by(7) {
+            let entry = (2.0 * f64::from(k) + 5.0) / dir.x;
+            let rays: Vec<Ray> = (10..18)
+                .map(|c| Ray::segment(origin, dir, entry / (1.0 + f64::from(c) * 2f64.powi(-24))))
+                .collect();
+            // "Occluded" when the leaf holds cube k: a test the leaf's
+            // being entered alone decides.
+            let holds = |range: Range<u32>| range.into_iter().any(|e| bvh.indices[e as usize] == k);
+            let mut counters = TraversalCounters::default();
+            let found = bvh.occluded_packet_by_leaf(&rays, 0xff, &mut counters, |asked, range| {
+                if holds(range) { asked } else { 0 }
+            });
+            let Some(found) = found else { continue };
+            for (lane, ray) in rays.iter().enumerate() {
+                let single =
+                    bvh.occluded_in_leaf_order(ray, &mut QueryContext::default(), |range| {
+                        holds(range)
+                    });
+                assert_eq!(found >> lane & 1 == 1, single, "cube {k}, lane {lane}");
+                entered += usize::from(single);
+            }
+        }
+        assert!(entered > 100, "{entered}");
     }
 
     #[test]
