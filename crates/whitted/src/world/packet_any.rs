@@ -1,5 +1,6 @@
 //! Shadow rays that travel together, as one query: up to [`PACKET_SIZE`]
-//! rays (those from a tile row's camera hits towards one light) whose
+//! rays (shadow rays from neighbouring hits towards one light, as
+//! `whitted bench --packets` walks them; the renderer's stay single) whose
 //! any-hit answers are found by one walk of the BVH
 //! ([`Bvh::occluded_packet_by_leaf`]), each the answer its own walk gives.
 //!

@@ -1,5 +1,6 @@
 //! The any-hit query for a packet of up to [`PACKET_LANES`] coherent rays
-//! (the shadow rays from a tile row's camera hits towards one light),
+//! (shadow rays from neighbouring hits towards one light, as
+//! `whitted bench --packets` walks them; the renderer's stay single),
 //! walked together with the closest-hit packet's node tests (see
 //! `packet`): the packet culls a node's children at once, and the lanes
 //! that remain test each child as their own single walk does.
