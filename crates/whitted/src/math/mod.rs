@@ -11,6 +11,7 @@
 //! surface normal. The offset is relative to the magnitudes involved, so a
 //! scene scaled by 1e-3 or 1e4 renders the same picture.
 
+pub mod apart;
 pub mod magnitude;
 pub mod prefetch;
 pub mod random;

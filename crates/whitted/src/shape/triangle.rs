@@ -16,6 +16,7 @@
 //! the surface is never taken to hit it again.
 
 use super::{LocalSurface, ShapeError, ShapeHit, finite, not_tiny};
+use crate::math::apart::coordinates_apart;
 use crate::math::{Aabb, DVec2, Ray, Vec3, gamma, magnitude};
 
 /// Vertices count as collinear when the sine of the angle at `p0` is below
@@ -117,7 +118,8 @@ pub struct RayShear {
 impl RayShear {
     /// The shear for `ray`.
     pub fn new(ray: &Ray) -> Self {
-        let kz = ray.dir.abs().max_position();
+        let [x, y, z] = coordinates_apart(&ray.dir);
+        let kz = Vec3::new(x.abs(), y.abs(), z.abs()).max_position();
         let kx = (kz + 1) % 3;
         let ky = (kx + 1) % 3;
         let d = Vec3::new(ray.dir[kx], ray.dir[ky], ray.dir[kz]);

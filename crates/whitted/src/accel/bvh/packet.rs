@@ -577,8 +577,8 @@ mod tests {
     use super::avx::Lanes;
     use super::*;
     use crate::accel::QueryContext;
+    use crate::accel::bvh::slabs::SlabTest;
     use crate::accel::bvh::slabs::tests::random_cases;
-    use crate::accel::bvh::slabs::{Planes, SlabTest};
     use crate::accel::bvh::slabs_avx::Avx;
     use crate::math::random::Rng;
     use crate::math::{Aabb, Vec3};
@@ -725,7 +725,7 @@ mod tests {
             // SAFETY: the processor has AVX.
             let (kept, packet_near) = unsafe { lanes.interval(&node, far_most) };
             for (lane, ray) in rays.iter().enumerate() {
-                let (mask, near) = Avx::new(&Planes::new(ray)).test(&node, far[lane]);
+                let (mask, near) = Avx::new(ray).test(&node, far[lane]);
                 assert_eq!(mask & !kept, 0, "lane {lane}");
                 for slot in (0..8).filter(|s| mask >> s & 1 == 1) {
                     assert!(packet_near[slot] <= near[slot]);

@@ -70,8 +70,8 @@ impl Planes {
 
 /// A way to run the slab test of a node's children for one ray.
 pub(super) trait SlabTest {
-    /// Prepares the test for the ray with these planes.
-    fn new(planes: &Planes) -> Self;
+    /// Prepares the test for `ray` (its [`Planes`]).
+    fn new(ray: &Ray) -> Self;
 
     /// Which of the node's children the ray may meet within
     /// `(t_min, t_max]` (bit `i` for slot `i`), and lower bounds on where
@@ -132,7 +132,8 @@ impl Halves {
 
 impl SlabTest for Halves {
     #[inline(always)]
-    fn new(planes: &Planes) -> Self {
+    fn new(ray: &Ray) -> Self {
+        let planes = Planes::new(ray);
         Self {
             entry_origin: planes.entry_origin.map(Vec4::splat),
             exit_origin: planes.exit_origin.map(Vec4::splat),
@@ -195,7 +196,7 @@ pub(super) mod tests {
     #[test]
     fn a_box_the_ray_meets_is_never_culled() {
         for (node, ray, t_max) in random_cases(3) {
-            let (mask, near) = Halves::new(&Planes::new(&ray)).test(&node, t_max);
+            let (mask, near) = Halves::new(&ray).test(&node, t_max);
             let mut bounded = ray;
             bounded.t_max = f64::from(t_max);
             for (slot, near) in near.iter().enumerate().filter(|&(s, _)| node.is_used(s)) {

@@ -5,12 +5,19 @@
 //! the first is NaN, as `maxps`/`minps` do).
 
 use std::arch::x86_64::{
-    __m256, _CMP_LE_OQ, _mm256_cmp_ps, _mm256_loadu_ps, _mm256_max_ps, _mm256_min_ps,
-    _mm256_movemask_ps, _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps,
+    __m128, __m256, __m256d, _CMP_GT_OQ, _CMP_LE_OQ, _CMP_LT_OQ, _mm_add_epi32, _mm_blendv_ps,
+    _mm_castps_si128, _mm_castsi128_ps, _mm_cmplt_ps, _mm_movemask_ps, _mm_set1_epi32, _mm_set1_ps,
+    _mm_setzero_ps, _mm_shuffle_ps, _mm_srai_epi32, _mm_sub_epi32, _mm256_and_pd, _mm256_andnot_pd,
+    _mm256_castpd_ps, _mm256_castps128_ps256, _mm256_castps256_ps128, _mm256_cmp_pd, _mm256_cmp_ps,
+    _mm256_cvtpd_ps, _mm256_cvtps_pd, _mm256_extractf128_ps, _mm256_insertf128_ps, _mm256_loadu_ps,
+    _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_permute_ps,
+    _mm256_set_pd, _mm256_set1_pd, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps,
 };
 
-use super::node::{BvhNode, WIDTH};
-use super::slabs::{GROW, Planes, SHRINK, SlabTest};
+use super::node::{BvhNode, WIDTH, round_down};
+use super::slabs::{GROW, NEVER_CULLS, SHRINK, SlabTest};
+use crate::math::apart::coordinates_apart;
+use crate::math::{Ray, Vec3};
 
 /// The test on one AVX register.
 pub(super) struct Avx {
@@ -29,21 +36,101 @@ fn load(row: &[f32; WIDTH]) -> __m256 {
     unsafe { _mm256_loadu_ps(row.as_ptr()) }
 }
 
+/// The low 32 bits of each of the four 64-bit lanes of a comparison's mask,
+/// as a four-lane mask.
+#[target_feature(enable = "avx")]
+#[inline]
+fn narrow(mask: __m256d) -> __m128 {
+    let mask = _mm256_castpd_ps(mask);
+    let (low, high) = (
+        _mm256_castps256_ps128(mask),
+        _mm256_extractf128_ps::<1>(mask),
+    );
+    _mm_shuffle_ps::<0b10_00_10_00>(low, high)
+}
+
+/// `v`'s coordinates and `w` in one register, read one by one
+/// ([`coordinates_apart`]).
+#[target_feature(enable = "avx")]
+#[inline]
+fn coordinates(v: &Vec3, w: f64) -> __m256d {
+    let [x, y, z] = coordinates_apart(v);
+    _mm256_set_pd(w, z, y, x)
+}
+
+/// The rows of `BvhNode::bounds` a ray enters and leaves through on `axis`:
+/// the max face first where bit `axis` of `max_first` is set.
+#[inline(always)]
+fn rows(max_first: i32, axis: usize) -> (usize, usize) {
+    if max_first >> axis & 1 == 1 {
+        (axis + 3, axis)
+    } else {
+        (axis, axis + 3)
+    }
+}
+
+/// Each of the first three lanes of `v` in a register of its own.
+#[target_feature(enable = "avx")]
+#[inline]
+fn spread(v: __m128) -> [__m256; 3] {
+    let both = _mm256_insertf128_ps::<1>(_mm256_castps128_ps256(v), v);
+    [
+        _mm256_permute_ps::<0x00>(both),
+        _mm256_permute_ps::<0x55>(both),
+        _mm256_permute_ps::<0xaa>(both),
+    ]
+}
+
 impl Avx {
+    /// The test for `ray`: the values of [`Planes::new`](super::slabs::Planes)
+    /// bit for bit, computed for the three axes at once and left in
+    /// registers. Built in a `Planes` first, they went through the stack,
+    /// and a wide load of them waited on the narrow stores that wrote them
+    /// (store forwarding failed), as a wide load of the ray would
+    /// ([`coordinates_apart`]).
     #[target_feature(enable = "avx")]
     #[inline]
-    fn prepare(planes: &Planes) -> Self {
-        // Written out: closures (as for `array::map`) are compiled without
-        // AVX and were not inlined.
-        let [e0, e1, e2] = planes.entry_origin;
-        let [x0, x1, x2] = planes.exit_origin;
-        let [i0, i1, i2] = planes.inv_dir;
+    fn prepare(ray: &Ray) -> Self {
+        let origin = coordinates(&ray.origin, 0.0);
+        let inv = coordinates(&ray.inv_dir, 1.0);
+        // `round_down` and `round_up` of each coordinate (see `node`): the
+        // nearest `f32`, stepped one unit of its bits where it lies on the
+        // wrong side.
+        let nearest = _mm256_cvtpd_ps(origin);
+        let back = _mm256_cvtps_pd(nearest);
+        let too_high = narrow(_mm256_cmp_pd::<_CMP_GT_OQ>(back, origin));
+        let too_low = narrow(_mm256_cmp_pd::<_CMP_LT_OQ>(back, origin));
+        let bits = _mm_castps_si128(nearest);
+        let sign = _mm_srai_epi32::<31>(bits);
+        // One unit towards +∞ in bits: +1 for a positive value, −1 for a
+        // negative one.
+        let step = _mm_add_epi32(_mm_set1_epi32(1), _mm_add_epi32(sign, sign));
+        let below = _mm_castsi128_ps(_mm_sub_epi32(bits, step));
+        let above = _mm_castsi128_ps(_mm_add_epi32(bits, step));
+        let down = _mm_blendv_ps(nearest, below, too_high);
+        let up = _mm_blendv_ps(nearest, above, too_low);
+        // The inverse direction in `f32` keeps the sign of the `f64` one,
+        // which picks the entry and exit planes (`blendv` reads the sign).
+        let inv_f32 = _mm256_cvtpd_ps(inv);
+        let mut entry = _mm_blendv_ps(up, down, inv_f32);
+        let mut exit = _mm_blendv_ps(down, up, inv_f32);
+        // Finite but beyond `f32`: an axis that culls only the empty box.
+        let magnitude = _mm256_andnot_pd(_mm256_set1_pd(-0.0), inv);
+        let beyond = narrow(_mm256_and_pd(
+            _mm256_cmp_pd::<_CMP_GT_OQ>(magnitude, _mm256_set1_pd(f64::from(f32::MAX))),
+            _mm256_cmp_pd::<_CMP_LT_OQ>(magnitude, _mm256_set1_pd(f64::INFINITY)),
+        ));
+        entry = _mm_blendv_ps(entry, _mm_set1_ps(f32::MAX), beyond);
+        exit = _mm_blendv_ps(exit, _mm_set1_ps(-f32::MAX), beyond);
+        let inv = _mm_blendv_ps(inv_f32, _mm_set1_ps(NEVER_CULLS), beyond);
+        let max_first = _mm_movemask_ps(_mm_cmplt_ps(inv, _mm_setzero_ps()));
+        let rows = [rows(max_first, 0), rows(max_first, 1), rows(max_first, 2)];
         Self {
-            entry_origin: [_mm256_set1_ps(e0), _mm256_set1_ps(e1), _mm256_set1_ps(e2)],
-            exit_origin: [_mm256_set1_ps(x0), _mm256_set1_ps(x1), _mm256_set1_ps(x2)],
-            inv_dir: [_mm256_set1_ps(i0), _mm256_set1_ps(i1), _mm256_set1_ps(i2)],
-            rows: planes.rows,
-            t_min: _mm256_set1_ps(planes.t_min),
+            entry_origin: spread(entry),
+            exit_origin: spread(exit),
+            inv_dir: spread(inv),
+            rows,
+            t_min: _mm256_set1_ps(round_down(ray.t_min)),
         }
     }
 
@@ -79,10 +166,10 @@ impl Avx {
 
 impl SlabTest for Avx {
     #[inline(always)]
-    fn new(planes: &Planes) -> Self {
+    fn new(ray: &Ray) -> Self {
         // SAFETY: an `Avx` is made only by walks entered after
         // `is_x86_feature_detected!("avx")` (see `traverse`).
-        unsafe { Self::prepare(planes) }
+        unsafe { Self::prepare(ray) }
     }
 
     #[inline(always)]
@@ -95,8 +182,10 @@ impl SlabTest for Avx {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::bvh::slabs::Halves;
+    use crate::accel::bvh::node::round_up;
     use crate::accel::bvh::slabs::tests::random_cases;
+    use crate::accel::bvh::slabs::{Halves, Planes};
+    use crate::math::random::Rng;
 
     #[test]
     fn agrees_with_the_two_halves_bit_for_bit() {
@@ -104,11 +193,85 @@ mod tests {
             return;
         }
         for (node, ray, t_max) in random_cases(9) {
-            let planes = Planes::new(&ray);
-            let (mask, near) = Avx::new(&planes).test(&node, t_max);
-            let (expected_mask, expected_near) = Halves::new(&planes).test(&node, t_max);
+            let (mask, near) = Avx::new(&ray).test(&node, t_max);
+            let (expected_mask, expected_near) = Halves::new(&ray).test(&node, t_max);
             assert_eq!(mask, expected_mask, "{ray:?}");
             assert_eq!(near.map(f32::to_bits), expected_near.map(f32::to_bits));
         }
+    }
+
+    /// Lane 0 of each of three registers (the others are equal to it).
+    fn first_lanes(registers: &[__m256; 3]) -> [u32; 3] {
+        registers.map(|r| {
+            let mut lanes = [0.0f32; WIDTH];
+            // SAFETY: `lanes` is eight writable `f32`s; the store is unaligned.
+            unsafe { _mm256_storeu_ps(lanes.as_mut_ptr(), r) };
+            assert!(lanes.iter().all(|l| l.to_bits() == lanes[0].to_bits()));
+            lanes[0].to_bits()
+        })
+    }
+
+    /// A coordinate of one of the kinds `Planes::new` treats apart: exact
+    /// `f32`s and values between two, both signs and zeros, values beyond
+    /// the `f32` range, infinities.
+    fn awkward(rng: &mut Rng) -> f64 {
+        let magnitude = match rng.below(10) {
+            0 => 0.0,
+            1 => f64::from(rng.range(0.0, 100.0) as f32),
+            2 => f64::from(f32::MAX) * rng.range(0.5, 4.0),
+            3 => f64::INFINITY,
+            4 => f64::from(f32::MIN_POSITIVE) * rng.range(0.0, 2.0),
+            5 => 1e-300,
+            6 => 1e300,
+            _ => rng.range(0.0, 100.0),
+        };
+        if rng.below(2) == 0 {
+            magnitude
+        } else {
+            -magnitude
+        }
+    }
+
+    #[test]
+    fn the_set_up_in_registers_is_the_planes_bit_for_bit() {
+        if !crate::math::test_support::has_avx_or_skip_allowed() {
+            return;
+        }
+        let mut rng = Rng::new(31);
+        let mut kinds = [0; 4];
+        for _ in 0..20_000 {
+            let mut ray = crate::math::Ray::new(Vec3::ZERO, Vec3::X);
+            ray.origin = Vec3::new(awkward(&mut rng), awkward(&mut rng), awkward(&mut rng));
+            ray.inv_dir = Vec3::new(awkward(&mut rng), awkward(&mut rng), awkward(&mut rng));
+            ray.t_min = awkward(&mut rng).abs();
+            let planes = Planes::new(&ray);
+            let avx = Avx::new(&ray);
+            assert_eq!(
+                first_lanes(&avx.entry_origin),
+                planes.entry_origin.map(f32::to_bits),
+                "{ray:?}"
+            );
+            assert_eq!(
+                first_lanes(&avx.exit_origin),
+                planes.exit_origin.map(f32::to_bits),
+                "{ray:?}"
+            );
+            assert_eq!(
+                first_lanes(&avx.inv_dir),
+                planes.inv_dir.map(f32::to_bits),
+                "{ray:?}"
+            );
+            assert_eq!(avx.rows, planes.rows, "{ray:?}");
+            assert_eq!(first_lanes(&[avx.t_min; 3])[0], planes.t_min.to_bits());
+            for axis in 0..3 {
+                let o = ray.origin[axis];
+                kinds[0] += usize::from(round_up(o) != round_down(o));
+                kinds[1] += usize::from(planes.inv_dir[axis] == NEVER_CULLS);
+                kinds[2] += usize::from(planes.rows[axis].0 == axis + 3);
+                kinds[3] += usize::from(ray.inv_dir[axis].is_infinite());
+            }
+        }
+        // Every branch of `Planes::new` was taken often.
+        assert!(kinds.iter().all(|&k| k > 1000), "{kinds:?}");
     }
 }

@@ -83,7 +83,7 @@
 use std::ops::Range;
 
 use super::node::{BvhNode, WIDTH, round_up};
-use super::slabs::{Halves, Planes, SlabTest};
+use super::slabs::{Halves, SlabTest};
 #[cfg(target_arch = "x86_64")]
 use super::slabs_avx::Avx;
 use super::{Bvh, MAX_DEPTH};
@@ -225,7 +225,7 @@ impl Bvh {
         counters: &mut TraversalCounters,
         mut hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
     ) -> Option<f64> {
-        let slabs = S::new(&Planes::new(ray));
+        let slabs = S::new(ray);
         let mut closest = ray.t_max;
         let mut far = round_up(closest);
         let mut found = None;
@@ -355,7 +355,7 @@ impl Bvh {
         counters: &mut TraversalCounters,
         mut occludes: impl FnMut(Range<u32>) -> bool,
     ) -> bool {
-        let slabs = S::new(&Planes::new(ray));
+        let slabs = S::new(ray);
         let far = round_up(ray.t_max);
         let mut work = TraversalCounters::default();
         let mut stack = Stack::<Entry, N>::new();
