@@ -38,8 +38,13 @@ def main():
     if len(sys.argv) != 3:
         sys.exit(__doc__)
     source, target = sys.argv[1], sys.argv[2]
-    lines = open(source).read().splitlines()
-    tokens = [t for line in lines if not line.lstrip().startswith("#") for t in line.split()]
+    tokens = []
+    for line in open(source).read().splitlines():
+        words = line.split()
+        if not words or words[0].startswith("#"):
+            continue
+        # A light's colour, if given, is not needed.
+        tokens += words[:4] if words[0] == "l" else words
     view = {}
     light = None
     polygons = []

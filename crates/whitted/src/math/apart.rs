@@ -4,10 +4,10 @@
 //! A ray is mostly written just before it is traced. Where the compiler
 //! merged the reads of two or three coordinates into one wide load, that
 //! load could not take its bytes from the narrower stores still waiting to
-//! be written (store forwarding fails) and waited for them: a tenth of the
-//! closest-hit walk's time on small meshes (docs/performance.md). A load of
-//! one coordinate is forwarded from the store that wrote it, whatever its
-//! width.
+//! be written (store forwarding fails) and waited for them (the BVH walk's
+//! set-up and the triangles' shear on small meshes: docs/performance.md).
+//! A load of one coordinate is forwarded from the store that wrote it,
+//! whatever its width.
 
 use super::Vec3;
 

@@ -118,6 +118,7 @@ pub struct RayShear {
 impl RayShear {
     /// The shear for `ray`.
     pub fn new(ray: &Ray) -> Self {
+        // Read apart: the ray is mostly written just before.
         let [x, y, z] = coordinates_apart(&ray.dir);
         let kz = Vec3::new(x.abs(), y.abs(), z.abs()).max_position();
         let kx = (kz + 1) % 3;

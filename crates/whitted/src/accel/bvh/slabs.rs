@@ -2,8 +2,9 @@
 //! `f32` SIMD: two four-lane halves with glam's `Vec4` (SSE on x86-64,
 //! NEON or scalar elsewhere), or one eight-lane AVX register where the
 //! processor has AVX (`slabs_avx`). Both compute the same operations in
-//! the same order, so they agree bit for bit; the argument that the test is
-//! conservative is in the documentation of `traverse`.
+//! the same order, so they agree bit for bit (the AVX set-up computes the
+//! [`Planes`] its own way, tested against [`Planes::new`]); the argument
+//! that the test is conservative is in the documentation of `traverse`.
 
 use glam::Vec4;
 

@@ -2,7 +2,9 @@
 //! that have AVX (checked at run time by the walk's caller): the same
 //! operations in the same order as [`Halves`](super::slabs::Halves), so the
 //! two agree bit for bit (`vmaxps`/`vminps` keep the second operand when
-//! the first is NaN, as `maxps`/`minps` do).
+//! the first is NaN, as `maxps`/`minps` do). Its set-up computes the ray's
+//! [`Planes`](super::slabs::Planes) its own way, for the three axes at
+//! once; a test checks it against `Planes::new` bit for bit.
 
 use std::arch::x86_64::{
     __m128, __m256, __m256d, _CMP_GT_OQ, _CMP_LE_OQ, _CMP_LT_OQ, _mm_add_epi32, _mm_blendv_ps,
@@ -82,12 +84,11 @@ fn spread(v: __m128) -> [__m256; 3] {
 }
 
 impl Avx {
-    /// The test for `ray`: the values of [`Planes::new`](super::slabs::Planes)
-    /// bit for bit, computed for the three axes at once and left in
-    /// registers. Built in a `Planes` first, they went through the stack,
-    /// and a wide load of them waited on the narrow stores that wrote them
-    /// (store forwarding failed), as a wide load of the ray would
-    /// ([`coordinates_apart`]).
+    /// The test for `ray`: the values of
+    /// [`Planes::new`](super::slabs::Planes::new) bit for bit, computed for
+    /// the three axes at once and kept in registers, so that no wide load
+    /// reads them back from narrower stores ([`coordinates_apart`]; through
+    /// a `Planes`: slower, see docs/performance.md).
     #[target_feature(enable = "avx")]
     #[inline]
     fn prepare(ray: &Ray) -> Self {
@@ -211,12 +212,42 @@ mod tests {
         })
     }
 
+    /// Values at the edges of what `Planes::new` treats apart: both zeros,
+    /// NaNs (with and without a payload), `f32::MAX` exactly and the values
+    /// that round to it or just past it, the tie between it and `+∞`,
+    /// `f32` subnormals and the ties between them, infinities.
+    fn edges() -> Vec<f64> {
+        let max = f64::from(f32::MAX);
+        let tie = max + 2f64.powi(103);
+        let tiny = f64::from(f32::from_bits(1));
+        let magnitudes = [
+            0.0,
+            f64::NAN,
+            f64::from_bits(0x7ff8_0000_0000_1234),
+            max,
+            max * (1.0 + 2f64.powi(-30)),
+            tie,
+            tie.next_down(),
+            tie.next_up(),
+            tiny,
+            tiny * 0.5,
+            tiny * 1.5,
+            f64::from(f32::MIN_POSITIVE) * 0.75,
+            1e-300,
+            1e300,
+            1.0 + 2f64.powi(-30),
+            16_777_217.0,
+            f64::INFINITY,
+        ];
+        magnitudes.iter().flat_map(|&m| [m, -m]).collect()
+    }
+
     /// A coordinate of one of the kinds `Planes::new` treats apart: exact
     /// `f32`s and values between two, both signs and zeros, values beyond
-    /// the `f32` range, infinities.
-    fn awkward(rng: &mut Rng) -> f64 {
+    /// the `f32` range, infinities, and the edge values above.
+    fn awkward(rng: &mut Rng, edges: &[f64]) -> f64 {
         let magnitude = match rng.below(10) {
-            0 => 0.0,
+            0 => return edges[rng.below(edges.len() as u32) as usize],
             1 => f64::from(rng.range(0.0, 100.0) as f32),
             2 => f64::from(f32::MAX) * rng.range(0.5, 4.0),
             3 => f64::INFINITY,
@@ -232,37 +263,64 @@ mod tests {
         }
     }
 
+    /// Whether the set-up in registers is `Planes::new` for `ray`, bit for
+    /// bit.
+    fn assert_same_planes(ray: &crate::math::Ray) {
+        let planes = Planes::new(ray);
+        let avx = Avx::new(ray);
+        assert_eq!(
+            first_lanes(&avx.entry_origin),
+            planes.entry_origin.map(f32::to_bits),
+            "{ray:?}"
+        );
+        assert_eq!(
+            first_lanes(&avx.exit_origin),
+            planes.exit_origin.map(f32::to_bits),
+            "{ray:?}"
+        );
+        assert_eq!(
+            first_lanes(&avx.inv_dir),
+            planes.inv_dir.map(f32::to_bits),
+            "{ray:?}"
+        );
+        assert_eq!(avx.rows, planes.rows, "{ray:?}");
+        assert_eq!(first_lanes(&[avx.t_min; 3])[0], planes.t_min.to_bits());
+    }
+
+    #[test]
+    fn the_set_up_in_registers_is_the_planes_at_the_edges() {
+        if !crate::math::test_support::has_avx_or_skip_allowed() {
+            return;
+        }
+        let edges = edges();
+        let mut ray = crate::math::Ray::new(Vec3::ZERO, Vec3::X);
+        for &a in &edges {
+            for &b in &edges {
+                // Each axis, and t_min, meets every pair of edge values.
+                ray.origin = Vec3::new(a, b, a);
+                ray.inv_dir = Vec3::new(b, a, -b);
+                ray.t_min = a;
+                assert_same_planes(&ray);
+            }
+        }
+    }
+
     #[test]
     fn the_set_up_in_registers_is_the_planes_bit_for_bit() {
         if !crate::math::test_support::has_avx_or_skip_allowed() {
             return;
         }
+        let edges = edges();
         let mut rng = Rng::new(31);
         let mut kinds = [0; 4];
         for _ in 0..20_000 {
             let mut ray = crate::math::Ray::new(Vec3::ZERO, Vec3::X);
-            ray.origin = Vec3::new(awkward(&mut rng), awkward(&mut rng), awkward(&mut rng));
-            ray.inv_dir = Vec3::new(awkward(&mut rng), awkward(&mut rng), awkward(&mut rng));
-            ray.t_min = awkward(&mut rng).abs();
+            let mut awkward = || awkward(&mut rng, &edges);
+            ray.origin = Vec3::new(awkward(), awkward(), awkward());
+            ray.inv_dir = Vec3::new(awkward(), awkward(), awkward());
+            ray.t_min = awkward().abs();
+            assert_same_planes(&ray);
             let planes = Planes::new(&ray);
-            let avx = Avx::new(&ray);
-            assert_eq!(
-                first_lanes(&avx.entry_origin),
-                planes.entry_origin.map(f32::to_bits),
-                "{ray:?}"
-            );
-            assert_eq!(
-                first_lanes(&avx.exit_origin),
-                planes.exit_origin.map(f32::to_bits),
-                "{ray:?}"
-            );
-            assert_eq!(
-                first_lanes(&avx.inv_dir),
-                planes.inv_dir.map(f32::to_bits),
-                "{ray:?}"
-            );
-            assert_eq!(avx.rows, planes.rows, "{ray:?}");
-            assert_eq!(first_lanes(&[avx.t_min; 3])[0], planes.t_min.to_bits());
             for axis in 0..3 {
                 let o = ray.origin[axis];
                 kinds[0] += usize::from(round_up(o) != round_down(o));
