@@ -28,6 +28,9 @@ pub(super) struct Avx {
     inv_dir: [__m256; 3],
     rows: [(usize, usize); 3],
     t_min: __m256,
+    /// The interval starts at or after zero (`-0` included), so every
+    /// lane's `near` is too (see `run`).
+    from_zero: bool,
 }
 
 /// One row of eight `f32`s in a register.
@@ -132,6 +135,7 @@ impl Avx {
             inv_dir: spread(inv),
             rows,
             t_min: _mm256_set1_ps(round_down(ray.t_min)),
+            from_zero: round_down(ray.t_min) >= 0.0,
         }
     }
 
@@ -155,8 +159,19 @@ impl Avx {
         }
         let shrink = _mm256_set1_ps(SHRINK);
         let grow = _mm256_set1_ps(GROW);
-        let near = _mm256_min_ps(_mm256_mul_ps(near, shrink), _mm256_mul_ps(near, grow));
-        let far = _mm256_max_ps(_mm256_mul_ps(far, shrink), _mm256_mul_ps(far, grow));
+        let (near, far) = if self.from_zero {
+            // The same bits and mask as below, one step shorter: `near` is
+            // at least `t_min`, so not below zero, and shrinking is the
+            // smaller product. Where `far` is not below zero growing is the
+            // larger; where it is below zero either product is, and the
+            // lane fails the test either way.
+            (_mm256_mul_ps(near, shrink), _mm256_mul_ps(far, grow))
+        } else {
+            (
+                _mm256_min_ps(_mm256_mul_ps(near, shrink), _mm256_mul_ps(near, grow)),
+                _mm256_max_ps(_mm256_mul_ps(far, shrink), _mm256_mul_ps(far, grow)),
+            )
+        };
         let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32;
         let mut lanes = [0.0; WIDTH];
         // SAFETY: `lanes` is eight writable `f32`s; the store is unaligned.
@@ -193,12 +208,22 @@ mod tests {
         if !crate::math::test_support::has_avx_or_skip_allowed() {
             return;
         }
-        for (node, ray, t_max) in random_cases(9) {
+        // Intervals that start before zero take the test's general form,
+        // the others its short one; boxes behind the ray and negative
+        // `t_max` make lanes whose `far` is below zero.
+        let starts = [0.0, -0.0, 1e-30, 0.5, 3.0, -1e-30, -0.5, -6.0];
+        let mut widened = [0usize; 2];
+        for (case, (node, mut ray, t_max)) in random_cases(9).into_iter().enumerate() {
+            ray.t_min = starts[case % starts.len()];
+            let t_max = if case % 7 == 0 { -t_max } else { t_max };
             let (mask, near) = Avx::new(&ray).test(&node, t_max);
             let (expected_mask, expected_near) = Halves::new(&ray).test(&node, t_max);
             assert_eq!(mask, expected_mask, "{ray:?}");
             assert_eq!(near.map(f32::to_bits), expected_near.map(f32::to_bits));
+            widened[usize::from(Avx::new(&ray).from_zero)] += mask.count_ones() as usize;
         }
+        // Both forms kept many boxes.
+        assert!(widened.iter().all(|&k| k > 20), "{widened:?}");
     }
 
     /// Lane 0 of each of three registers (the others are equal to it).
