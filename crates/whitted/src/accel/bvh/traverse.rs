@@ -28,7 +28,9 @@
 //!   three axes are combined with `t_min` and `t_max` (by comparisons, which
 //!   are exact), the entry is multiplied by `1 ∓ 8u` and the exit by
 //!   `1 ± 8u` (the sign chosen to move away from the interval, so negative
-//!   parameters are widened too). That product rounds once more: `k = 8`
+//!   parameters are widened too; where `t_min` is not below zero the entry
+//!   is not either, and the AVX test multiplies each end by its one factor).
+//!   That product rounds once more: `k = 8`
 //!   covers the `4u` (plus under `2⁻⁴⁹`) needed with room to spare, and both
 //!   factors are exact in `f32`. `t_min` is rounded down and `t_max` up.
 //!   Every rounding is monotone, so a plane beyond the `f32` range rounds to
