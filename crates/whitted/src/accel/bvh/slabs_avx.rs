@@ -129,13 +129,14 @@ impl Avx {
         let inv = _mm_blendv_ps(inv_f32, _mm_set1_ps(NEVER_CULLS), beyond);
         let max_first = _mm_movemask_ps(_mm_cmplt_ps(inv, _mm_setzero_ps()));
         let rows = [rows(max_first, 0), rows(max_first, 1), rows(max_first, 2)];
+        let t_min = round_down(ray.t_min);
         Self {
             entry_origin: spread(entry),
             exit_origin: spread(exit),
             inv_dir: spread(inv),
             rows,
-            t_min: _mm256_set1_ps(round_down(ray.t_min)),
-            from_zero: round_down(ray.t_min) >= 0.0,
+            t_min: _mm256_set1_ps(t_min),
+            from_zero: t_min >= 0.0,
         }
     }
 
@@ -216,11 +217,12 @@ mod tests {
         for (case, (node, mut ray, t_max)) in random_cases(9).into_iter().enumerate() {
             ray.t_min = starts[case % starts.len()];
             let t_max = if case % 7 == 0 { -t_max } else { t_max };
-            let (mask, near) = Avx::new(&ray).test(&node, t_max);
+            let avx = Avx::new(&ray);
+            let (mask, near) = avx.test(&node, t_max);
             let (expected_mask, expected_near) = Halves::new(&ray).test(&node, t_max);
             assert_eq!(mask, expected_mask, "{ray:?}");
             assert_eq!(near.map(f32::to_bits), expected_near.map(f32::to_bits));
-            widened[usize::from(Avx::new(&ray).from_zero)] += mask.count_ones() as usize;
+            widened[usize::from(avx.from_zero)] += mask.count_ones() as usize;
         }
         // Both forms kept many boxes.
         assert!(widened.iter().all(|&k| k > 20), "{widened:?}");
