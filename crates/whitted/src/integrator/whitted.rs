@@ -160,7 +160,11 @@ impl<'a> Whitted<'a> {
 
     /// [`Whitted::trace_primary_observed`] for a camera ray whose closest
     /// hit `hit` is already found (by a packet of camera rays walked
-    /// together, see [`World::intersect_packet`]).
+    /// together, see [`World::intersect_packet`]). A miss is answered
+    /// inline, so that its colour reaches the caller in registers (a
+    /// result returned through memory field by field and read back whole
+    /// waited on failed store forwarding, see docs/performance.md).
+    #[inline]
     pub fn shade_camera_hit<O: RayObserver>(
         &self,
         ray: &Ray,
@@ -180,33 +184,43 @@ impl<'a> Whitted<'a> {
                     cut_at: None,
                 }
             }
-            Some(hit) => {
-                let surface = self.surface::<O>(ray, &hit);
-                observer.ray_hit(ray, Some((&hit, &surface)));
-                let mut tally = SampleTally {
-                    counts,
-                    observer,
-                    rays_left: self.limits.ray_budget,
-                    cut_at: None,
-                };
-                let differential = differential.as_ref();
-                let media = &MediumStack::default();
-                let color = self.shade(
-                    ray,
-                    differential,
-                    &surface,
-                    hit.primitive,
-                    0,
-                    1.0,
-                    media,
-                    &mut tally,
-                );
-                tally.observer.ray_end(color);
-                PrimarySample {
-                    color,
-                    cut_at: tally.cut_at.map(|(material, _)| material),
-                }
-            }
+            Some(hit) => self.shade_camera_ray(ray, &hit, differential.as_ref(), counts, observer),
+        }
+    }
+
+    /// The colour of a camera ray that hits `hit` (counted and started by
+    /// the caller).
+    fn shade_camera_ray<O: RayObserver>(
+        &self,
+        ray: &Ray,
+        hit: &Hit,
+        differential: Option<&RayDifferential>,
+        counts: &mut RayCounts,
+        observer: &mut O,
+    ) -> PrimarySample {
+        let surface = self.surface::<O>(ray, hit);
+        observer.ray_hit(ray, Some((hit, &surface)));
+        let mut tally = SampleTally {
+            counts,
+            observer,
+            rays_left: self.limits.ray_budget,
+            cut_at: None,
+        };
+        let media = &MediumStack::default();
+        let color = self.shade(
+            ray,
+            differential,
+            &surface,
+            hit.primitive,
+            0,
+            1.0,
+            media,
+            &mut tally,
+        );
+        tally.observer.ray_end(color);
+        PrimarySample {
+            color,
+            cut_at: tally.cut_at.map(|(material, _)| material),
         }
     }
 

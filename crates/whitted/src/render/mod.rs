@@ -18,6 +18,7 @@ mod selection;
 mod settings;
 mod sources;
 mod trace_timing;
+mod world_on_image;
 
 pub use adaptive::{
     Adaptive, AdaptiveError, AntiAliasing, DEFAULT_AA_DEPTH, DEFAULT_AA_THRESHOLD, MAX_AA_DEPTH,
@@ -53,11 +54,12 @@ use crate::integrator::{
 };
 use crate::limits::{MemoryBudget, MemoryError};
 use crate::math::{DVec2, Ray, Vec3};
-use crate::shading::Color;
+use crate::shading::{Color, TextureFilter};
 use crate::world::{Hit, MAX_PRIMITIVES, MaterialId, PACKET_SIZE, Surface, World};
 use adaptive::{AdaptivePixels, Cost};
 use non_finite::NonFinite;
 use sample_ray::{pixel_pattern, sample_differential, sample_position};
+use world_on_image::WorldOnImage;
 
 /// Side of the square tiles the image is cut into, in pixels.
 const TILE_SIZE: u32 = 16;
@@ -415,6 +417,8 @@ fn trace_pixels(
         films.aovs.iter_mut().for_each(|(_, film)| film.map_pages());
     });
     let films = Mutex::new(films);
+    let on_image = WorldOnImage::new(camera, width, height, &prepared.world)
+        .filter(|_| std::env::var_os("NO_CULL").is_none());
     let clock = trace_timing::TraceClock::start();
     // Each worker takes the next tile from a shared counter until none is
     // left: a thread that finishes early takes more, so both cores stay
@@ -430,12 +434,11 @@ fn trace_pixels(
             let tile = clock.tile(|| {
                 render_tile(
                     &integrator,
-                    camera,
+                    (camera, on_image.as_ref()),
                     scene.color_space,
                     settings,
                     selection,
-                    index % tiles_x,
-                    index / tiles_x,
+                    (index % tiles_x, index / tiles_x),
                 )
             });
             let pixels = tile.selected;
@@ -506,16 +509,16 @@ fn tile_is_selected(selection: &PixelSelection, tile_x: u32, tile_y: u32) -> boo
     x0 < w.x1 && x0 + TILE_SIZE > w.x0 && (y0..y0 + TILE_SIZE).any(|y| selection.has_row(y))
 }
 
-/// Renders the selected pixels of one tile of the image (the others are
-/// left black).
+/// Renders the selected pixels of tile (`tile_x`, `tile_y`) of the image
+/// (the others are left black), seen by `camera`; `on_image`, where known,
+/// is where the world can appear.
 fn render_tile(
     integrator: &Integrator,
-    camera: &Camera,
+    (camera, on_image): (&Camera, Option<&WorldOnImage>),
     color_space: ColorSpace,
     settings: &RenderSettings,
     selection: &PixelSelection,
-    tile_x: u32,
-    tile_y: u32,
+    (tile_x, tile_y): (u32, u32),
 ) -> Tile {
     let x0 = tile_x * TILE_SIZE;
     let y0 = tile_y * TILE_SIZE;
@@ -548,7 +551,7 @@ fn render_tile(
         )),
     };
     let row = x0..x0 + width;
-    let mut samples = RowSamples::new(settings, width);
+    let mut samples = RowSamples::new(settings, width, on_image);
     for y in y0..y0 + height {
         match &mut adaptive {
             Some(adaptive) => adaptive_row(
@@ -610,7 +613,7 @@ type Centre = (Ray, Option<(Hit, Surface)>);
 /// worlds that walk packets, their closest hits are then found
 /// [`PACKET_SIZE`] rays at a time ([`World::intersect_packet`]), before
 /// each is shaded.
-struct RowSamples {
+struct RowSamples<'w> {
     positions: [DVec2; TILE_SIZE as usize],
     rays: [Ray; TILE_SIZE as usize],
     patterns: [u32; TILE_SIZE as usize],
@@ -619,11 +622,15 @@ struct RowSamples {
     hits: [Option<Hit>; TILE_SIZE as usize],
     /// With one sample and AOVs, each pixel's ray and its first hit.
     centres: Vec<Option<Centre>>,
+    /// Where the world can appear, when known: rays elsewhere are given
+    /// no hit without a walk.
+    on_image: Option<&'w WorldOnImage>,
 }
 
-impl RowSamples {
-    /// Room for rows of `width` pixels rendered with `settings`.
-    fn new(settings: &RenderSettings, width: u32) -> Self {
+impl<'w> RowSamples<'w> {
+    /// Room for rows of `width` pixels rendered with `settings`, where the
+    /// world appears within `on_image` (when known).
+    fn new(settings: &RenderSettings, width: u32, on_image: Option<&'w WorldOnImage>) -> Self {
         let keep_centres = settings.samples_per_pixel == 1 && !settings.aovs.is_empty();
         Self {
             positions: [DVec2::ZERO; TILE_SIZE as usize],
@@ -632,6 +639,7 @@ impl RowSamples {
             sums: [Color::ZERO; TILE_SIZE as usize],
             hits: [None; TILE_SIZE as usize],
             centres: vec![None; if keep_centres { width as usize } else { 0 }],
+            on_image,
         }
     }
 
@@ -654,10 +662,12 @@ impl RowSamples {
         // The selection, asked once for the row rather than per pixel.
         let (row_selected, columns) = (selection.has_row(y), selection.columns());
         let selected = |x: u32| row_selected && columns.contains(&x);
+        // One sample sits at the pixel's centre whatever the pattern.
         for (i, x) in row.clone().enumerate() {
-            self.patterns[i] = pixel_pattern(x, y);
+            self.patterns[i] = if spp > 1 { pixel_pattern(x, y) } else { 0 };
             self.sums[i] = Color::ZERO;
         }
+        let differentials = settings.texture_filter != TextureFilter::None;
         for s in 0..spp {
             for (i, x) in row.clone().enumerate() {
                 self.positions[i] = sample_position(settings, (x, y), self.patterns[i], s);
@@ -683,11 +693,14 @@ impl RowSamples {
                 }
                 let hit = if packets {
                     self.hits[i]
+                } else if self.on_image.is_some_and(|w| !w.may_hit(x, y)) {
+                    None
                 } else {
                     world.intersect(ray)
                 };
-                let differential =
-                    sample_differential(camera, settings, (x, y), self.patterns[i], s);
+                let differential = differentials
+                    .then(|| sample_differential(camera, settings, (x, y), self.patterns[i], s))
+                    .flatten();
                 let counts = &mut tile.rays;
                 let sample = match self.centres.get_mut(i) {
                     Some(centre) => {
@@ -713,7 +726,7 @@ impl RowSamples {
                 continue;
             }
             tile.selected += 1;
-            let color = self.sums[i] / f64::from(spp);
+            let color = mean(self.sums[i], spp);
             tile.color.extend_from_slice(&color.to_f32());
             if !settings.aovs.is_empty() {
                 let centre = self.centres.get_mut(i).and_then(Option::take);
@@ -739,8 +752,27 @@ impl RowSamples {
         let mut ctx = QueryContext::default();
         for start in (first..end).step_by(PACKET_SIZE) {
             let lanes = start..end.min(start + PACKET_SIZE);
+            let pixels = row.start + lanes.start as u32..row.start + lanes.end as u32;
+            if let Some(window) = self.on_image
+                && window.misses_pixels(pixels, y)
+            {
+                self.hits[lanes].fill(None);
+                continue;
+            }
             world.intersect_packet(&self.rays[lanes.clone()], &mut ctx, &mut self.hits[lanes]);
         }
+    }
+}
+
+/// `sum` over `spp` samples: multiplied by the exact reciprocal when `spp`
+/// is a power of two (the same result, without a division's latency per
+/// pixel), divided otherwise.
+#[inline]
+fn mean(sum: Color, spp: u32) -> Color {
+    if spp.is_power_of_two() {
+        sum * (1.0 / f64::from(spp))
+    } else {
+        sum / f64::from(spp)
     }
 }
 
@@ -957,6 +989,66 @@ mod tests {
         let whole_packets = render(&scene, &|_| {}).unwrap();
         assert_eq!(whole_packets.image, whole_single.image);
         assert_eq!(whole_packets.aovs, whole_single.aovs);
+    }
+
+    #[test]
+    fn pixels_culled_off_the_world_s_image_are_those_the_walks_give() {
+        // Jacks: spheres and cylinders with background all around and
+        // between them, lit and mirrored, one sample or three, packets or
+        // single rays, with the AOVs that keep the first hit.
+        let jacks = "b 0.2 0.05 0.2\nv\nfrom 0 0 -8\nat 0 0 0\nup 0 1 0\nangle 25\n\
+            hither 0.001\nresolution 96 64\nl -10 3 -20\nf 0.737 0.561 0.561 0.7 0.7 11 0.5 1\n\
+            c -0.7 -0.13 -0.22 0.075 0.7 0.13 0.22 0.075\nc 0 -0.65 0.375 0.075 0 0.65 -0.375 0.075\n\
+            s 0.7 0.13 0.22 0.15\ns 0 0.65 -0.375 0.15\ns -0.26 0.35 0.61 0.15\n";
+        let mut scene = crate::scene::parse_nff(jacks, std::path::Path::new("jacks.nff")).unwrap();
+        scene.settings.aovs = vec![Aov::Depth, Aov::Normal, Aov::Id];
+        let (mut culled, mut hit) = (0, 0);
+        for (spp, packets) in [(1, true), (3, true), (1, false)] {
+            scene.settings.samples_per_pixel = spp;
+            scene.settings.packets = packets;
+            let prepared = Prepared::new(&scene).unwrap();
+            let settings = &scene.settings;
+            let limits = RecursionLimits {
+                max_depth: settings.max_depth,
+                min_weight: settings.min_weight,
+                ray_budget: SECONDARY_RAY_BUDGET,
+            };
+            let integrator = Integrator::new(
+                settings.integrator,
+                &prepared.world,
+                shading_of(&scene),
+                limits,
+            );
+            let (width, height) = (settings.width, settings.height);
+            let grid = WorldOnImage::new(&scene.camera, width, height, &prepared.world).unwrap();
+            let whole = PixelSelection::whole(width, height);
+            for tile_y in 0..height.div_ceil(TILE_SIZE) {
+                for tile_x in 0..width.div_ceil(TILE_SIZE) {
+                    let tile = |on_image| {
+                        let view = (&scene.camera, on_image);
+                        let at = (tile_x, tile_y);
+                        render_tile(&integrator, view, scene.color_space, settings, &whole, at)
+                    };
+                    let (walked, kept) = (tile(None), tile(Some(&grid)));
+                    assert_eq!(walked.color, kept.color, "tile {tile_x}, {tile_y}");
+                    assert_eq!(walked.aovs, kept.aovs, "tile {tile_x}, {tile_y}");
+                    assert_eq!(walked.rays, kept.rays, "tile {tile_x}, {tile_y}");
+                }
+            }
+            for y in 0..height {
+                for x in 0..width {
+                    let centre = (f64::from(x) + 0.5, f64::from(y) + 0.5);
+                    let ray = scene.camera.ray(width, height, centre.0, centre.1);
+                    culled += usize::from(!grid.may_hit(x, y));
+                    hit += usize::from(prepared.world.intersect(&ray).is_some());
+                }
+            }
+        }
+        // Most of the background is culled.
+        assert!(
+            culled > 3 * hit && culled < 3 * 96 * 64 - hit,
+            "{culled} culled, {hit} hit"
+        );
     }
 
     /// Whether the processor has AVX, which the packet walk needs.

@@ -640,6 +640,21 @@ impl<'a> World<'a> {
         self.bounds
     }
 
+    /// Boxes that hold every primitive between them, about `limit` of
+    /// them where the structure is a BVH (its first levels' boxes, see
+    /// [`Bvh::covering_boxes`](crate::accel::Bvh::covering_boxes)), else the world's box; `None` when some
+    /// primitive is unbounded (an infinite plane, or an instance of a
+    /// definition that holds one).
+    pub fn covering_boxes(&self, limit: usize) -> Option<Vec<Aabb>> {
+        if !self.unbounded.is_empty() {
+            return None;
+        }
+        Some(match &self.accel {
+            Accelerator::Bvh(bvh) => bvh.covering_boxes(limit),
+            _ => vec![self.bounds],
+        })
+    }
+
     /// How many primitives (shapes and mesh triangles) there are.
     pub fn len(&self) -> usize {
         self.primitive_count

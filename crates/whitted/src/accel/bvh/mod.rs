@@ -77,6 +77,43 @@ impl Bvh {
         &self.nodes
     }
 
+    /// Boxes that hold every primitive between them: the children of the
+    /// first levels of nodes, a whole level at a time, down to the deepest
+    /// level with at most `limit` boxes (the root's children whatever
+    /// `limit`; none for an empty tree). Leaves met on the way stay as they
+    /// are.
+    pub fn covering_boxes(&self, limit: usize) -> Vec<Aabb> {
+        /// A used slot: its box, and its node when it is not a leaf.
+        type Slot = (Aabb, Option<u32>);
+        let slots = |node: &BvhNode| -> Vec<Slot> {
+            (0..WIDTH)
+                .filter(|&i| node.is_used(i))
+                .map(|i| {
+                    let inner = (node.counts[i] == 0).then_some(node.children[i]);
+                    (node.child_bounds(i), inner)
+                })
+                .collect()
+        };
+        let Some(root) = self.nodes.first() else {
+            return Vec::new();
+        };
+        let mut level = slots(root);
+        while level.iter().any(|(_, inner)| inner.is_some()) {
+            let next: Vec<Slot> = level
+                .iter()
+                .flat_map(|&(bounds, inner)| match inner {
+                    Some(node) => slots(&self.nodes[node as usize]),
+                    None => vec![(bounds, None)],
+                })
+                .collect();
+            if next.len() > limit {
+                break;
+            }
+            level = next;
+        }
+        level.into_iter().map(|(bounds, _)| bounds).collect()
+    }
+
     /// The primitive indices the leaves point into.
     pub fn indices(&self) -> &[u32] {
         &self.indices
