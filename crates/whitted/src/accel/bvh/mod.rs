@@ -161,6 +161,39 @@ mod tests {
     use crate::math::Vec3;
     use crate::math::random::Rng;
 
+    #[test]
+    fn covering_boxes_hold_every_primitive_a_level_at_a_time() {
+        let contains = |outer: &Aabb, inner: &Aabb| {
+            outer.min.cmple(inner.min).all() && outer.max.cmpge(inner.max).all()
+        };
+        let mut rng = Rng::new(5);
+        let boxes = random_boxes(&mut rng, 5000, 10.0, 0.5);
+        let bvh = Bvh::build(&boxes);
+        let root = bvh.covering_boxes(0);
+        let used = (0..WIDTH).filter(|&i| bvh.nodes[0].is_used(i)).count();
+        assert_eq!(root.len(), used);
+        let mut previous = root.len();
+        for limit in [64, 512, 4096, 100_000] {
+            let covering = bvh.covering_boxes(limit);
+            assert!(
+                covering.len() <= limit && covering.len() >= previous,
+                "{limit}"
+            );
+            previous = covering.len();
+            for b in &boxes {
+                assert!(covering.iter().any(|c| contains(c, b)), "{limit}: {b:?}");
+            }
+        }
+        // Deep enough, the leaves' boxes: one per leaf slot.
+        let leaves: usize = bvh
+            .nodes
+            .iter()
+            .map(|n| n.counts.iter().filter(|&&c| c > 0).count())
+            .sum();
+        assert_eq!(bvh.covering_boxes(100_000).len(), leaves);
+        assert!(Bvh::build(&[]).covering_boxes(8).is_empty());
+    }
+
     fn assert_valid(name: &str, boxes: &[Aabb], params: &BvhBuildParams) -> Bvh {
         let bvh = Bvh::build_with(boxes, params);
         if let Err(why) = bvh.validate(boxes) {
