@@ -18,13 +18,21 @@
 //! which their bounding rectangle holds; a camera ray meets the box only if
 //! its position on the image lies in that hull, since the projection of its
 //! points in front of the eye is that position. Each rectangle is grown by
-//! [`MARGIN`] pixels for what rounding moves (the ray's direction, the
-//! corners' images, the primitives' own intersection tests: each a few
-//! units of the last place of the coordinates), and every cell it touches
-//! is marked. The guards of [`WorldOnImage::new`] keep a pixel's step far
-//! above those: no box's corner is nearly sideways of the eye nor nearly at
-//! it, and a pixel spans at least [`MIN_PIXEL_ANGLE`]. Outside them, or
-//! with an unbounded primitive, nothing is culled.
+//! [`MARGIN`] pixels, and every cell it touches is marked.
+//!
+//! The margin covers what the exact argument leaves out: the rounding of
+//! the ray's direction and of the corners' images (units of `2⁻⁵³`), and
+//! the hits a shape's test reports just outside its box within its
+//! tolerance (as the structures' early exits also assume), the widest
+//! being CSG's coincidence, `1e-9` of its size, under `4e-9` of the
+//! largest coordinate `c` of the boxes and the eye. The guards make that
+//! under a fifth of a pixel: every corner's depth is at least
+//! [`MIN_DEPTH`] of `c` and of its distance from the eye, so a hit moved
+//! by `4e-9·c` moves on the image plane (at distance one) by at most
+//! `4e-7·(1 + |s|)`, with `s` the plane's coordinates, and a pixel's step
+//! there, `2·tan(fov/2)/height`, is at least [`MIN_PIXEL_STEP`] times
+//! `1 + |s|` at the image's edge. Outside the guards, or with an unbounded
+//! primitive, nothing is culled.
 
 use super::camera::Camera;
 use std::ops::Range;
@@ -39,17 +47,19 @@ const BOXES: usize = 1024;
 /// Pixels each box's rectangle is grown by on each side.
 const MARGIN: f64 = 1.0;
 
-/// The least tangent of a pixel's step (at the image's centre) for which
-/// positions are culled: a microradian, a million times a direction's
-/// rounding (ten units of `2⁻⁵³`).
-const MIN_PIXEL_ANGLE: f64 = 1e-6;
+/// The least step of a pixel on the image plane at distance one, relative
+/// to one plus the plane's largest coordinate on the image, for which
+/// positions are culled (five times the `4e-7` of the module
+/// documentation).
+const MIN_PIXEL_STEP: f64 = 2e-6;
 
 /// The least depth of a corner, relative to its distance from the eye and
-/// to the scene's coordinates, for which positions are culled.
-const MIN_DEPTH: f64 = 1e-6;
+/// to the largest coordinate of the boxes and the eye, for which positions
+/// are culled.
+const MIN_DEPTH: f64 = 1e-2;
 
 /// The side of a cell in pixels, as a power of two: eight, the width of
-/// a packet of camera rays (they start at multiples of eight), or more on
+/// a packet of camera rays (most start at multiples of eight), or more on
 /// images over 4096 pixels wide or high, so that a side has at most 512
 /// cells.
 fn cell_shift(width: u32, height: u32) -> u32 {
@@ -95,7 +105,9 @@ fn rectangle(camera: &Camera, size: (u32, u32), b: &Aabb, scale: f64) -> Option<
 pub(crate) struct WorldOnImage {
     /// Pixels per cell side, as a power of two.
     shift: u32,
+    /// Cells per row.
     columns: usize,
+    /// Rows of cells.
     rows: usize,
     /// Whether some box's rectangle touches each cell, row by row.
     reached: Vec<bool>,
@@ -113,7 +125,8 @@ impl WorldOnImage {
     fn of_boxes(camera: &Camera, width: u32, height: u32, boxes: &[Aabb]) -> Option<Self> {
         let (w, h) = (f64::from(width), f64::from(height));
         let tan_half_fov = (camera.fov_degrees().to_radians() / 2.0).tan();
-        if 2.0 * tan_half_fov * (w / h).min(1.0) / w.max(h) < MIN_PIXEL_ANGLE {
+        let reach = 1.0 + tan_half_fov * (w / h).max(1.0);
+        if 2.0 * tan_half_fov / h < MIN_PIXEL_STEP * reach {
             return None;
         }
         let eye = camera.eye();
@@ -174,7 +187,8 @@ impl WorldOnImage {
         cells.into_iter().all(|c| !self.reached[row + c as usize])
     }
 
-    /// False when the camera rays through pixel (`x`, `y`) miss the world.
+    /// True unless the camera rays through pixel (`x`, `y`) miss the
+    /// world.
     pub(crate) fn may_hit(&self, x: u32, y: u32) -> bool {
         !self.misses_pixels(x..x + 1, y)
     }
