@@ -185,6 +185,15 @@ impl<'a> Integrator<'a> {
         }
     }
 
+    /// What [`Integrator::shade_camera_hit`] gives an unobserved camera
+    /// ray that hits nothing (the renderer's rows off the world's image).
+    #[inline]
+    pub fn camera_miss(&self, counts: &mut RayCounts) -> PrimarySample {
+        match self {
+            Integrator::Whitted(w) => w.camera_miss(counts),
+        }
+    }
+
     /// The first hit along a ray and its surface, without shading.
     pub fn first_hit(&self, ray: &Ray) -> Option<(Hit, Surface)> {
         let world = self.world();

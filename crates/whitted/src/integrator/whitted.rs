@@ -188,6 +188,17 @@ impl<'a> Whitted<'a> {
         }
     }
 
+    /// What [`Self::shade_camera_hit`] gives an unobserved camera ray that
+    /// hits nothing: the background, the ray counted.
+    #[inline]
+    pub fn camera_miss(&self, counts: &mut RayCounts) -> PrimarySample {
+        counts[RayKind::Primary] += 1;
+        PrimarySample {
+            color: self.shading.background,
+            cut_at: None,
+        }
+    }
+
     /// The colour of a camera ray that hits `hit` (counted and started by
     /// the caller).
     fn shade_camera_ray<O: RayObserver>(
