@@ -114,29 +114,25 @@ impl Light {
     /// The light arriving at `p`, or `None` when none can (outside a spot's
     /// cone, or at the light's own position). For an area light, the whole
     /// estimate from the middle of its sample square.
+    ///
+    /// The arms give a direction, a distance and a factor on the light's
+    /// intensity, and one sample is built after them: samples built in each
+    /// arm met in memory, a stall (docs/performance.md).
     #[inline(always)]
     pub fn sample(&self, p: Vec3) -> Option<LightSample> {
-        match self {
+        let (to_light, distance, intensity, factor) = match self {
             Light::Point {
                 position,
                 intensity,
                 attenuation,
             } => {
                 let (to_light, distance) = direction_to(*position, p)?;
-                Some(LightSample {
-                    to_light,
-                    distance,
-                    intensity: *intensity * attenuation.factor(distance),
-                })
+                (to_light, distance, intensity, attenuation.factor(distance))
             }
             Light::Directional {
                 direction,
                 intensity,
-            } => Some(LightSample {
-                to_light: -*direction,
-                distance: f64::INFINITY,
-                intensity: *intensity,
-            }),
+            } => (-*direction, f64::INFINITY, intensity, 1.0),
             Light::Spot {
                 position,
                 direction,
@@ -155,14 +151,20 @@ impl Light {
                 } else {
                     cos_axis.powf(*falloff)
                 };
-                Some(LightSample {
+                (
                     to_light,
                     distance,
-                    intensity: *intensity * (cone * attenuation.factor(distance)),
-                })
+                    intensity,
+                    cone * attenuation.factor(distance),
+                )
             }
-            Light::Area(area) => area.sample(p, [0.5, 0.5], 1),
-        }
+            Light::Area(area) => return area.sample(p, [0.5, 0.5], 1),
+        };
+        Some(LightSample {
+            to_light,
+            distance,
+            intensity: *intensity * factor,
+        })
     }
 }
 
@@ -294,28 +296,26 @@ impl<'l> Iterator for DirectSamples<'l> {
     fn next(&mut self) -> Option<Self::Item> {
         while let Some(light) = self.lights.get(self.light) {
             let light_index = self.light;
-            let sample = match light {
-                Light::Area(area) => {
-                    if self.index == 0 {
-                        self.count = light.sample_count();
-                        self.pattern = point_hash(self.p);
-                    }
-                    let index = self.index;
-                    self.index += 1;
-                    if self.index >= self.count {
-                        self.light += 1;
-                        self.index = 0;
-                    }
-                    let u = pixel_sample(index, self.count, self.pattern);
-                    area.sample(self.p, [u.x, u.y], self.count)
+            if let Light::Area(area) = light {
+                if self.index == 0 {
+                    self.count = light.sample_count();
+                    self.pattern = point_hash(self.p);
                 }
-                _ => {
+                let index = self.index;
+                self.index += 1;
+                if self.index >= self.count {
                     self.light += 1;
-                    light.sample(self.p)
+                    self.index = 0;
                 }
-            };
-            if let Some(sample) = sample {
-                return Some((light_index, light, sample));
+                let u = pixel_sample(index, self.count, self.pattern);
+                if let Some(sample) = area.sample(self.p, [u.x, u.y], self.count) {
+                    return Some((light_index, light, sample));
+                }
+            } else {
+                self.light += 1;
+                if let Some(sample) = light.sample(self.p) {
+                    return Some((light_index, light, sample));
+                }
             }
         }
         None
