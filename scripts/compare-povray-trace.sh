@@ -4,6 +4,12 @@
 #   whitted render X.nff --width 1024 --height 1024 --threads 2
 #     (the time on its summary line: build + trace, not reading or writing)
 #   povray +IX.pov +W1024 +H1024 -A +WT2 -D   (its "Trace Time" line)
+# POV-Ray by default stops rays whose weight on the pixel falls below 1/255
+# (adc_bailout); whitted's NFF reader follows the SPD rules and traces the
+# whole tree to depth 5. With STRICT=1, POV-Ray reads each scene through a
+# wrapper that sets `global_settings { adc_bailout 0 }` (the strict
+# comparison ../shared/scenes/spd/README.md describes), so both trace the
+# same ray tree; only mount and rings differ much (POV-Ray's "Saved" rays).
 # Best of N runs each, interleaved, printed as a Markdown table. With BEFORE
 # set to a second whitted binary, it is run in the same loop and gets a
 # column of its own (before/after figures measured side by side).
@@ -12,7 +18,7 @@
 #   N=3 scripts/compare-povray-trace.sh balls mount
 # Environment: SHARED (default ../shared), WHITTED (default
 # target/release/whitted), BEFORE (unset), SIZE (default 1024), OUT
-# (default /tmp/pov_trace).
+# (default /tmp/pov_trace), STRICT (unset).
 set -euo pipefail
 N=${N:-3}
 SIZE=${SIZE:-1024}
@@ -33,8 +39,13 @@ whitted_time() {
 }
 # The seconds in POV-Ray's "Trace Time: ... (1.769 seconds)" line.
 povray_time() {
+  local input="$1.pov"
+  if [ -n "${STRICT:-}" ]; then
+    input="$OUT/$1.strict.pov"
+    printf 'global_settings { adc_bailout 0 }\n#include "%s.pov"\n' "$1" >"$input"
+  fi
   (cd "$SHARED/scenes/spd/pov" &&
-    povray "+I$1.pov" "+O$OUT/$1.pov.png" "+W$SIZE" "+H$SIZE" -A +WT2 -D 2>&1) |
+    povray "+I$input" "+O$OUT/$1.pov.png" "+W$SIZE" "+H$SIZE" -A +WT2 -D 2>&1) |
     sed -n 's/.*Trace Time:.*(\([0-9.]*\) seconds).*/\1/p'
 }
 min() { echo "if ($1 < $2) $1 else $2" | bc; }
