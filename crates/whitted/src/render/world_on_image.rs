@@ -382,4 +382,66 @@ mod tests {
         }
         assert!(!grid.may_hit(0, 0) && !grid.may_hit(63, 63));
     }
+
+    #[test]
+    fn culled_pixels_miss_the_example_scenes_in_every_structure() {
+        // The example scenes hold every kind of shape, transformed, in CSG,
+        // as Bézier patches and as instances; their unbounded shapes (which
+        // keep any grid from being made) are dropped. Each structure's
+        // world gives the grid its boxes: the BVH its levels, the others
+        // their one box.
+        use crate::accel::AccelKind;
+        let scenes = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+        let mut paths: Vec<_> = std::fs::read_dir(&scenes)
+            .unwrap()
+            .map(|entry| entry.unwrap().path())
+            .filter(|path| path.extension().is_some_and(|e| e == "toml"))
+            .collect();
+        paths.sort();
+        let (width, height) = (64, 48);
+        let corners = [
+            (0.5, 0.5),
+            (0.0, 0.0),
+            (0.999, 0.0),
+            (0.0, 0.999),
+            (0.999, 0.999),
+        ];
+        let (mut grids, mut culled) = (0, 0);
+        for path in &paths {
+            let mut scene = crate::scene::load_any(path).unwrap();
+            scene
+                .objects
+                .primitives
+                .retain(|p| p.shape.bounds().is_finite());
+            let kinds = [
+                AccelKind::Bvh,
+                AccelKind::KdTree,
+                AccelKind::Grid,
+                AccelKind::Linear,
+            ];
+            for (top, bottom) in kinds.into_iter().zip(kinds.into_iter().rev()) {
+                let world = World::build_levels(&scene.objects, top, bottom);
+                let Some(grid) = WorldOnImage::new(&scene.camera, width, height, &world) else {
+                    continue;
+                };
+                grids += 1;
+                for (x, y) in (0..height).flat_map(|y| (0..width).map(move |x| (x, y))) {
+                    if grid.may_hit(x, y) {
+                        continue;
+                    }
+                    culled += 1;
+                    for (dx, dy) in corners {
+                        let (px, py) = (f64::from(x) + dx, f64::from(y) + dy);
+                        let ray = scene.camera.ray(width, height, px, py);
+                        let hit = world.intersect(&ray);
+                        assert!(hit.is_none(), "{path:?}, {top:?}/{bottom:?}: ({px}, {py})");
+                    }
+                }
+            }
+        }
+        assert!(
+            grids >= 20 && culled > 20_000,
+            "{grids} grids, {culled} culled"
+        );
+    }
 }
