@@ -54,11 +54,11 @@ use crate::integrator::{
 };
 use crate::limits::{MemoryBudget, MemoryError};
 use crate::math::{DVec2, Ray, Vec3};
-use crate::shading::{Color, TextureFilter};
+use crate::shading::Color;
 use crate::world::{Hit, MAX_PRIMITIVES, MaterialId, PACKET_SIZE, Surface, World};
 use adaptive::{AdaptivePixels, Cost};
 use non_finite::NonFinite;
-use sample_ray::{pixel_pattern, sample_differential, sample_position};
+use sample_ray::{pixel_pattern, position_differential, sample_position};
 use world_on_image::WorldOnImage;
 
 /// Side of the square tiles the image is cut into, in pixels.
@@ -666,7 +666,8 @@ impl<'w> RowSamples<'w> {
             self.patterns[i] = if spp > 1 { pixel_pattern(x, y) } else { 0 };
             self.sums[i] = Color::ZERO;
         }
-        let differentials = settings.texture_filter != TextureFilter::None;
+        // A differential's step: the spacing of the samples' grid.
+        let step = 1.0 / f64::from(spp).sqrt();
         // A row wholly off the world's image: its rays miss, so they are
         // not even made (AOVs make their centre's ray themselves).
         let misses = self
@@ -710,9 +711,7 @@ impl<'w> RowSamples<'w> {
                 } else {
                     world.intersect(ray)
                 };
-                let differential = differentials
-                    .then(|| sample_differential(camera, settings, (x, y), self.patterns[i], s))
-                    .flatten();
+                let differential = position_differential(camera, settings, self.positions[i], step);
                 let counts = &mut tile.rays;
                 let sample = match self.centres.get_mut(i) {
                     Some(centre) => {
