@@ -18,15 +18,17 @@
 #   N=3 scripts/compare-povray-trace.sh balls mount
 # Environment: SHARED (default ../shared), WHITTED (default
 # target/release/whitted), BEFORE (unset), SIZE (default 1024), OUT
-# (default /tmp/pov_trace), STRICT (unset).
+# (default /tmp/pov_trace), STRICT (1 for adc_bailout 0; default 0).
 set -euo pipefail
 N=${N:-3}
 SIZE=${SIZE:-1024}
 SHARED=$(cd "${SHARED:-../shared}" && pwd)
 WHITTED=$(realpath "${WHITTED:-target/release/whitted}")
 BEFORE=${BEFORE:+$(realpath "$BEFORE")}
-OUT=${OUT:-/tmp/pov_trace}
-mkdir -p "$OUT"
+# Absolute: POV-Ray runs from the scenes' folder. Debian's POV-Ray reads
+# and writes only under /tmp, $HOME and its working folder
+# (/etc/povray/3.7/povray.conf), so OUT must lie there.
+OUT=$(mkdir -p "${OUT:-/tmp/pov_trace}" && cd "${OUT:-/tmp/pov_trace}" && pwd)
 scenes=("$@")
 if [ ${#scenes[@]} -eq 0 ]; then
   scenes=(balls gears mount rings teapot tetra tree jacks lattice nurbtst sample shells sombrero teapot_sf6)
@@ -40,15 +42,21 @@ whitted_time() {
 # The seconds in POV-Ray's "Trace Time: ... (1.769 seconds)" line.
 povray_time() {
   local input="$1.pov"
-  if [ -n "${STRICT:-}" ]; then
+  if [ "${STRICT:-0}" = 1 ]; then
     input="$OUT/$1.strict.pov"
     printf 'global_settings { adc_bailout 0 }\n#include "%s.pov"\n' "$1" >"$input"
   fi
   (cd "$SHARED/scenes/spd/pov" &&
-    povray "+I$input" "+O$OUT/$1.pov.png" "+W$SIZE" "+H$SIZE" -A +WT2 -D 2>&1) |
+    povray "+I$input" "+O$OUT/$1.pov.png" "+W$SIZE" "+H$SIZE" -A +WT2 -D +L. 2>&1) |
     sed -n 's/.*Trace Time:.*(\([0-9.]*\) seconds).*/\1/p'
 }
 min() { echo "if ($1 < $2) $1 else $2" | bc; }
+if [ "${STRICT:-0}" = 1 ]; then
+  echo "POV-Ray with adc_bailout 0 (STRICT=1): both trace the whole ray tree."
+else
+  echo "POV-Ray with its default adc_bailout (1/255); STRICT=1 sets it to 0."
+fi
+echo
 if [ -n "$BEFORE" ]; then
   echo "| scene | POV-Ray trace | whitted before | whitted | ratio before | ratio |"
   echo "|---|---|---|---|---|---|"

@@ -32,10 +32,17 @@ THREADS=${THREADS:-1}
 SHARED=${SHARED:-../shared}
 OUT=${OUT:-/tmp/compare_trace}
 mkdir -p "$OUT"
-# The seconds on the `trace` line of `--stats`.
+# The seconds on the `trace` line of `--stats`; the script stops when a
+# render fails.
 trace_time() {
-  "$1" render "$2" -o "$3" --width "$SIZE" --height "$SIZE" --threads "$THREADS" --stats 2>&1 |
-    awk '$1 == "trace" { print $2 }'
+  local seconds
+  seconds=$("$1" render "$2" -o "$3" --width "$SIZE" --height "$SIZE" --threads "$THREADS" \
+    --stats 2>&1 | awk '$1 == "trace" { print $2 }')
+  if [ -z "$seconds" ]; then
+    echo "$1 failed on $2" >&2
+    exit 1
+  fi
+  echo "$seconds"
 }
 min() { echo "if ($1 < $2) $1 else $2" | bc; }
 echo "| scene | old trace | new trace | old / new | picture |"
@@ -47,11 +54,21 @@ for scene in "$@"; do
     echo "no scene $scene (neither a file nor $file)" >&2
     exit 1
   fi
+  rm -f "$OUT/old.png" "$OUT/new.png"
   best_old=999
   best_new=999
-  for _ in $(seq "$N"); do
-    best_old=$(min "$(trace_time "$OLD" "$file" "$OUT/old.png")" "$best_old")
-    best_new=$(min "$(trace_time "$NEW" "$file" "$OUT/new.png")" "$best_new")
+  for round in $(seq "$N"); do
+    # Each goes first every other round: the first run after a pause
+    # starts on a cold cache.
+    if [ $((round % 2)) -eq 1 ]; then
+      old=$(trace_time "$OLD" "$file" "$OUT/old.png")
+      new=$(trace_time "$NEW" "$file" "$OUT/new.png")
+    else
+      new=$(trace_time "$NEW" "$file" "$OUT/new.png")
+      old=$(trace_time "$OLD" "$file" "$OUT/old.png")
+    fi
+    best_old=$(min "$old" "$best_old")
+    best_new=$(min "$new" "$best_new")
   done
   picture=$(cmp -s "$OUT/old.png" "$OUT/new.png" && echo same || echo DIFFERENT)
   printf "| %s | %.3f s | %.3f s | %.3fx | %s |\n" "$(basename "$scene")" "$best_old" \

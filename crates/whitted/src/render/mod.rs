@@ -58,7 +58,7 @@ use crate::shading::Color;
 use crate::world::{Hit, MAX_PRIMITIVES, MaterialId, PACKET_SIZE, Surface, World};
 use adaptive::{AdaptivePixels, Cost};
 use non_finite::NonFinite;
-use sample_ray::{pixel_pattern, position_differential, sample_position};
+use sample_ray::{differential_step, pixel_pattern, position_differential, sample_position};
 use world_on_image::WorldOnImage;
 
 /// Side of the square tiles the image is cut into, in pixels.
@@ -666,8 +666,7 @@ impl<'w> RowSamples<'w> {
             self.patterns[i] = if spp > 1 { pixel_pattern(x, y) } else { 0 };
             self.sums[i] = Color::ZERO;
         }
-        // A differential's step: the spacing of the samples' grid.
-        let step = 1.0 / f64::from(spp).sqrt();
+        let step = differential_step(settings);
         // A row wholly off the world's image: its rays miss, so they are
         // not even made (AOVs make their centre's ray themselves).
         let misses = self

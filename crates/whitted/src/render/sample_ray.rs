@@ -64,8 +64,14 @@ pub(crate) fn sample_differential(
     s: u32,
 ) -> Option<RayDifferential> {
     let position = sample_position(settings, (x, y), pattern, s);
-    let scale = 1.0 / f64::from(settings.samples_per_pixel).sqrt();
-    position_differential(camera, settings, position, scale)
+    position_differential(camera, settings, position, differential_step(settings))
+}
+
+/// The scale of a sample's differential: `1/√spp`, the spacing of the
+/// samples' grid in pixels.
+#[inline]
+pub(crate) fn differential_step(settings: &RenderSettings) -> f64 {
+    1.0 / f64::from(settings.samples_per_pixel).sqrt()
 }
 
 /// The ray differential of the camera ray through `position` on the image
