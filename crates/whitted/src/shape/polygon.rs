@@ -160,6 +160,15 @@ impl Polygon {
     /// The closest hit in the ray's interval (there is at most one).
     pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
         let t = plane_hit(self.anchor(), self.normal, ray)?;
+        self.hit_on_plane(ray, t)
+    }
+
+    /// The hit at `t`, where `ray` crosses the polygon's plane in its
+    /// interval ([`plane_hit`] from the first vertex and the normal), if the
+    /// outline holds that point: the rest of [`Polygon::intersect`], for a
+    /// caller that has made the plane test already.
+    #[inline]
+    pub(crate) fn hit_on_plane(&self, ray: &Ray, t: f64) -> Option<ShapeHit> {
         self.outline.contains(ray.at(t)).then(|| ShapeHit::at(t))
     }
 

@@ -34,7 +34,10 @@ pub(super) enum EntryKind {
     Sphere,
     /// A polygon without a transform, its first vertex and unit normal in
     /// the entry: a ray that does not cross its plane in the interval is
-    /// turned away right there, the others are tested through the tables.
+    /// turned away right there, sparing the trip to the vertices and
+    /// outline, three allocations away, for most rays that reach its leaf
+    /// (gears: 9,345 polygons); for the others, the tables test only the
+    /// outline, at the plane's `t` found here ([`Polygon::hit_on_plane`]).
     Polygon,
     /// A cylinder or a cone, in the entry as the ends of its axis and a
     /// bound on its points' distance from the axis: a ray whose line
@@ -141,25 +144,34 @@ impl Entry {
         (self.kind == EntryKind::Triangle).then_some(&self.corners)
     }
 
-    /// The entry, a triangle or a sphere, hit by the query's ray closer
-    /// than `t_max`, tested in place; `None` for the entries the world
-    /// tests through its tables.
+    /// The entry hit by the query's ray closer than `t_max`, tested in
+    /// place (a triangle or a sphere, and the polygons and cylinders or
+    /// cones turned away there), or what is left to the world's tables: a
+    /// polygon whose plane the ray crosses in the interval leaves only its
+    /// outline, at the plane's `t`, so that the plane is not tested twice.
     #[inline(always)]
-    pub(super) fn intersect_in_place(&self, query: &Query, t_max: f64) -> Option<Option<ShapeHit>> {
+    pub(super) fn test_in_place(
+        &self,
+        query: &Query,
+        t_max: f64,
+    ) -> Result<Option<ShapeHit>, Rest> {
         match self.kind {
-            EntryKind::Triangle => Some(intersect_triangle(&self.corners, query, t_max)),
+            EntryKind::Triangle => Ok(intersect_triangle(&self.corners, query, t_max)),
             EntryKind::Sphere => {
                 let mut ray = *query.ray;
                 ray.t_max = t_max;
-                Some(self.as_sphere().intersect(&ray))
+                Ok(self.as_sphere().intersect(&ray))
             }
             EntryKind::Polygon => {
                 let mut ray = *query.ray;
                 ray.t_max = t_max;
-                self.polygon_plane_missed(&ray).then_some(None)
+                match plane_hit(self.corners[0], self.corners[1], &ray) {
+                    Some(t) => Err(Rest::Outline(t)),
+                    None => Ok(None),
+                }
             }
-            EntryKind::Axial => self.axis_missed(query.ray).then_some(None),
-            _ => None,
+            EntryKind::Axial if self.axis_missed(query.ray) => Ok(None),
+            _ => Err(Rest::Test),
         }
     }
 
@@ -190,31 +202,23 @@ impl Entry {
         distance * distance > reach * reach * across_squared
     }
 
-    /// Whether a polygon entry's plane is not crossed by `ray` in its
-    /// interval: then the polygon is not hit, since its test
-    /// ([`Polygon::intersect`]) starts with this same plane test on the
-    /// same vertex and normal, and goes on only where it succeeds. This
-    /// spares the trip to the polygon's vertices and outline, three
-    /// allocations away, for most rays that reach its leaf (gears: 9,345
-    /// polygons, a third of the render in their test).
+    /// Whether the entry lies in the query's ray interval, tested in place
+    /// (a triangle or a sphere, and the polygons and cylinders or cones
+    /// turned away there), or what is left to the world's tables, as
+    /// [`Entry::test_in_place`] says it.
     #[inline(always)]
-    fn polygon_plane_missed(&self, ray: &Ray) -> bool {
-        plane_hit(self.corners[0], self.corners[1], ray).is_none()
-    }
-
-    /// Whether the entry, a triangle or a sphere, lies in the query's ray
-    /// interval, tested in place; `None` for the entries the world tests
-    /// through its tables.
-    #[inline(always)]
-    pub(super) fn occludes_in_place(&self, query: &Query) -> Option<bool> {
+    pub(super) fn occlusion_in_place(&self, query: &Query) -> Result<bool, Rest> {
         match self.kind {
             EntryKind::Triangle => {
-                Some(intersect_triangle(&self.corners, query, query.ray.t_max).is_some())
+                Ok(intersect_triangle(&self.corners, query, query.ray.t_max).is_some())
             }
-            EntryKind::Sphere => Some(self.as_sphere().occluded(query.ray)),
-            EntryKind::Polygon => self.polygon_plane_missed(query.ray).then_some(false),
-            EntryKind::Axial => self.axis_missed(query.ray).then_some(false),
-            _ => None,
+            EntryKind::Sphere => Ok(self.as_sphere().occluded(query.ray)),
+            EntryKind::Polygon => match plane_hit(self.corners[0], self.corners[1], query.ray) {
+                Some(t) => Err(Rest::Outline(t)),
+                None => Ok(false),
+            },
+            EntryKind::Axial if self.axis_missed(query.ray) => Ok(false),
+            _ => Err(Rest::Test),
         }
     }
 
@@ -223,6 +227,16 @@ impl Entry {
     pub(super) fn as_sphere(&self) -> Sphere {
         Sphere::from_accepted(self.corners[0], self.corners[1].x)
     }
+}
+
+/// What an entry's test in place leaves to the world's tables.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Rest {
+    /// The whole test.
+    Test,
+    /// A polygon's outline test at `t`, where the ray crosses its plane in
+    /// the interval ([`crate::shape::Polygon::hit_on_plane`]).
+    Outline(f64),
 }
 
 /// A ray with what the triangle test needs of it, computed once per query
@@ -267,7 +281,8 @@ pub(super) fn intersect_triangle(
 
 /// The closest of `entries[range]` hit by the query's ray closer than
 /// `t_max`: triangles and spheres here, other entries by
-/// `other(entry, t_max)`, which returns the number to report and the hit.
+/// `other(entry, t_max, rest)` (what the test in place left, [`Rest`]),
+/// which returns the number to report and the hit.
 /// `found(number, hit)` is told of each nearer hit; returns the closest `t`.
 /// Where `wide` (the processor has AVX), runs of two to four spheres are
 /// culled at once and only the spheres kept are tested, one by one in
@@ -282,7 +297,7 @@ pub(super) fn leaf_hit(
     query: &Query,
     mut t_max: f64,
     wide: bool,
-    mut other: impl FnMut(&Entry, f64) -> Option<(u32, ShapeHit)>,
+    mut other: impl FnMut(&Entry, f64, Rest) -> Option<(u32, ShapeHit)>,
     mut found: impl FnMut(u32, ShapeHit),
 ) -> Option<f64> {
     let mut closest = None;
@@ -308,9 +323,9 @@ pub(super) fn leaf_hit(
             entry += run;
             continue;
         }
-        let hit = match e.intersect_in_place(query, t_max) {
-            Some(hit) => hit.map(|h| (e.number, h)),
-            None => other(e, t_max),
+        let hit = match e.test_in_place(query, t_max) {
+            Ok(hit) => hit.map(|h| (e.number, h)),
+            Err(rest) => other(e, t_max, rest),
         };
         if let Some((number, h)) = hit {
             found(number, h);
@@ -325,7 +340,7 @@ pub(super) fn leaf_hit(
 
 /// An entry of `entries[range]` that lies in the query's ray interval (the
 /// first one found), if any: triangles here, other entries when
-/// `other(entry)` says so.
+/// `other(entry, rest)` says so (`rest`: what the test in place left).
 /// Where `wide` (the processor has AVX), runs of two to four triangles are
 /// tested at once, and runs of two to four spheres culled at once, with the
 /// same answers as one by one.
@@ -335,7 +350,7 @@ pub(super) fn leaf_occludes(
     range: Range<u32>,
     query: &Query,
     wide: bool,
-    other: impl FnMut(&Entry) -> bool,
+    other: impl FnMut(&Entry, Rest) -> bool,
 ) -> Option<u32> {
     leaf_meets(entries, range, query, wide, other, |_| true)
 }
@@ -349,7 +364,7 @@ pub(super) fn leaf_meets(
     range: Range<u32>,
     query: &Query,
     wide: bool,
-    mut other: impl FnMut(&Entry) -> bool,
+    mut other: impl FnMut(&Entry, Rest) -> bool,
     mut stops: impl FnMut(u32) -> bool,
 ) -> Option<u32> {
     let mut entry = range.start;
@@ -384,9 +399,9 @@ pub(super) fn leaf_meets(
             continue;
         }
         let e = &entries[entry as usize];
-        let meets = match e.occludes_in_place(query) {
-            Some(meets) => meets,
-            None => other(e),
+        let meets = match e.occlusion_in_place(query) {
+            Ok(meets) => meets,
+            Err(rest) => other(e, rest),
         };
         if meets && stops(entry) {
             return Some(entry);
@@ -500,8 +515,9 @@ mod tests {
             let query = Query::new(&ray, true);
             let range = 0..entries.len() as u32;
             // Entries tested through the tables hit at a fixed distance.
-            let other =
-                |e: &Entry, t_max: f64| (0.5 < t_max).then_some((e.number, ShapeHit::at(0.5)));
+            let other = |e: &Entry, t_max: f64, _: Rest| {
+                (0.5 < t_max).then_some((e.number, ShapeHit::at(0.5)))
+            };
             let closest = |wide: bool| {
                 let mut found = Vec::new();
                 let t = leaf_hit(
@@ -518,7 +534,7 @@ mod tests {
             let one_by_one = closest(false);
             assert_eq!(closest(true), one_by_one, "{entries:?} {ray:?}");
             hits += usize::from(one_by_one.0.is_some());
-            let meets = |e: &Entry| e.number.is_multiple_of(2) && 0.5 < ray.t_max;
+            let meets = |e: &Entry, _: Rest| e.number.is_multiple_of(2) && 0.5 < ray.t_max;
             let first = |wide: bool| {
                 let mut shown = Vec::new();
                 let stop = leaf_meets(&entries, range.clone(), &query, wide, meets, |n| {

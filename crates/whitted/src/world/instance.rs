@@ -83,7 +83,7 @@ impl MeshStructure {
                     &query,
                     t_max,
                     false,
-                    |_, _| None,
+                    |_, _, _| None,
                     |triangle, hit| best = Some((triangle, hit)),
                 )
             });
@@ -95,7 +95,7 @@ impl MeshStructure {
     pub(super) fn occluded(&self, ray: &Ray, wide: bool, ctx: &mut QueryContext) -> bool {
         let query = Query::new(ray, true);
         self.accel.occluded_in_leaf_order(ray, ctx, |range| {
-            leaf_occludes(&self.entries, range, &query, wide, |_| false).is_some()
+            leaf_occludes(&self.entries, range, &query, wide, |_, _| false).is_some()
         })
     }
 }

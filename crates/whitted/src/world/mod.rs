@@ -54,7 +54,7 @@ use crate::accel::{
 };
 use crate::math::{Aabb, Ray, Transform, Vec3};
 use crate::shape::{Shape, ShapeHit, clipped_triangle_bounds};
-use entry::{Entry, EntryKind, Query, leaf_hit, leaf_occludes};
+use entry::{Entry, EntryKind, Query, Rest, leaf_hit, leaf_occludes};
 use instance::MeshStructure;
 use prefetch::BIG_MESHES;
 use rayon::prelude::*;
@@ -536,6 +536,19 @@ impl<'a> World<'a> {
         }
     }
 
+    /// True when shape `index` lies in the query's ray interval, with `rest`
+    /// of its test left after the test in place ([`World::polygon_outline`]
+    /// for a polygon's outline).
+    #[inline]
+    fn rest_occludes(&self, index: u32, query: &Query, rest: Rest) -> bool {
+        match rest {
+            Rest::Outline(t) => self
+                .polygon_outline(index, query, query.ray.t_max, t)
+                .is_some(),
+            Rest::Test => self.shape_occludes(index, query),
+        }
+    }
+
     /// True when shape `index` lies in the query's ray interval.
     #[inline]
     fn shape_occludes(&self, index: u32, query: &Query) -> bool {
@@ -561,15 +574,15 @@ impl<'a> World<'a> {
     }
 
     /// The entry `e` (a shape or an instance) hit by the query's ray closer
-    /// than `t_max`: the primitive number and the hit. An instance's walk
-    /// counts its work in `inner`.
+    /// than `t_max`: the primitive number and the hit, with `rest` of its
+    /// test left after the test in place. An instance's walk counts its
+    /// work in `inner`.
     #[inline]
     fn intersect_other(
         &self,
         definitions: &[World<'a>],
         e: &Entry,
-        query: &Query,
-        t_max: f64,
+        (query, t_max, rest): (&Query, f64, Rest),
         inner: &mut QueryContext,
     ) -> Option<(u32, ShapeHit)> {
         match e.kind {
@@ -587,7 +600,25 @@ impl<'a> World<'a> {
                     hit.shape_hit,
                 ))
             }
-            _ => Some((e.number, self.intersect_shape(e.number, query, t_max)?)),
+            _ => {
+                let hit = match rest {
+                    Rest::Outline(t) => self.polygon_outline(e.number, query, t_max, t),
+                    Rest::Test => self.intersect_shape(e.number, query, t_max),
+                };
+                Some((e.number, hit?))
+            }
+        }
+    }
+
+    /// Polygon `index` (a shape without a transform) hit at `t`, where the
+    /// query's ray crosses its plane in the interval ending at `t_max`, if
+    /// its outline holds that point; a shape of another kind is tested
+    /// whole.
+    #[inline]
+    fn polygon_outline(&self, index: u32, query: &Query, t_max: f64, t: f64) -> Option<ShapeHit> {
+        match &self.shapes[index as usize].shape {
+            Shape::Polygon(polygon) => polygon.hit_on_plane(query.ray, t),
+            _ => self.intersect_shape(index, query, t_max),
         }
     }
 
@@ -608,13 +639,13 @@ impl<'a> World<'a> {
     }
 
     /// True when the entry `e` (a shape or an instance) lies in the query's
-    /// ray interval.
+    /// ray interval, with `rest` of its test left after the test in place.
     #[inline]
     fn other_occludes(
         &self,
         definitions: &[World<'a>],
         e: &Entry,
-        query: &Query,
+        (query, rest): (&Query, Rest),
         inner: &mut QueryContext,
     ) -> bool {
         match e.kind {
@@ -626,7 +657,7 @@ impl<'a> World<'a> {
                 let (definition, local) = self.placed_ray(definitions, e.number, query.ray);
                 definition.any(definitions, &local, inner)
             }
-            _ => self.shape_occludes(e.number, query),
+            _ => self.rest_occludes(e.number, query, rest),
         }
     }
 
@@ -710,7 +741,7 @@ impl<'a> World<'a> {
         let mut inner = QueryContext::new(ctx.coherence);
         for e in &self.unbounded {
             if let Some((primitive, h)) =
-                self.intersect_other(definitions, e, &query, t_max, &mut inner)
+                self.intersect_other(definitions, e, (&query, t_max, Rest::Test), &mut inner)
             {
                 t_max = h.t;
                 best = Some(Hit {
@@ -729,7 +760,9 @@ impl<'a> World<'a> {
                     &query,
                     t_max,
                     self.wide,
-                    |e, t_max| self.intersect_other(definitions, e, &query, t_max, &mut inner),
+                    |e, t_max, rest| {
+                        self.intersect_other(definitions, e, (&query, t_max, rest), &mut inner)
+                    },
                     |primitive, shape_hit| {
                         best = Some(Hit {
                             primitive: PrimitiveId(primitive),
@@ -760,7 +793,7 @@ impl<'a> World<'a> {
         if self
             .unbounded
             .iter()
-            .any(|e| self.other_occludes(definitions, e, &query, &mut inner))
+            .any(|e| self.other_occludes(definitions, e, (&query, Rest::Test), &mut inner))
         {
             ctx.counters += inner.counters;
             return true;
@@ -769,15 +802,15 @@ impl<'a> World<'a> {
             // One level, no instance walk to count apart (tried one path for
             // both: slower, see docs/performance.md).
             return self.accel.occluded_in_leaf_order(ray, ctx, |range| {
-                leaf_occludes(&self.entries, range, &query, self.wide, |e| {
-                    self.shape_occludes(e.number, &query)
+                leaf_occludes(&self.entries, range, &query, self.wide, |e, rest| {
+                    self.rest_occludes(e.number, &query, rest)
                 })
                 .is_some()
             });
         }
         let occluded = self.accel.occluded_in_leaf_order(ray, ctx, |range| {
-            leaf_occludes(&self.entries, range, &query, self.wide, |e| {
-                self.other_occludes(definitions, e, &query, &mut inner)
+            leaf_occludes(&self.entries, range, &query, self.wide, |e, rest| {
+                self.other_occludes(definitions, e, (&query, rest), &mut inner)
             })
             .is_some()
         });
@@ -1176,7 +1209,7 @@ mod tests {
         let world = World::new(&objects);
         let polygons = entries_of(&world, EntryKind::Polygon);
         assert_eq!(polygons.len(), 150);
-        let (mut turned_away, mut hits) = (0, 0);
+        let (mut turned_away, mut hits, mut outlines) = (0, 0, 0);
         for i in 0..300 {
             // Every other ray aims at the middle of an untransformed polygon.
             let origin = 15.0 * rng.unit_vector() * rng.uniform();
@@ -1205,23 +1238,37 @@ mod tests {
                 };
                 let table = world.intersect_shape(e.number, &query, t_max);
                 hits += usize::from(table.is_some());
-                if e.intersect_in_place(&query, t_max) == Some(None) {
-                    turned_away += 1;
-                    assert_eq!(table, None, "{ray:?} {t_max}");
-                } else {
-                    assert_eq!(e.intersect_in_place(&query, t_max), None);
+                match e.test_in_place(&query, t_max) {
+                    Ok(hit) => {
+                        turned_away += 1;
+                        assert_eq!((hit, table), (None, None), "{ray:?} {t_max}");
+                    }
+                    // The outline alone, at the plane's `t`, gives the
+                    // tables' answer to the bit.
+                    Err(Rest::Outline(t)) => {
+                        let outline = world.polygon_outline(e.number, &query, t_max, t);
+                        assert_eq!(outline, table, "{ray:?} {t_max}");
+                        outlines += 1;
+                    }
+                    Err(Rest::Test) => panic!("a polygon entry left whole to the tables"),
                 }
                 let occludes = world.shape_occludes(e.number, &query);
-                match e.occludes_in_place(&query) {
-                    Some(blocks) => assert!(!blocks && !occludes, "{ray:?}"),
-                    None => {
-                        assert!(plane_hit(polygon.vertices()[0], polygon.normal(), &ray).is_some())
+                match e.occlusion_in_place(&query) {
+                    Ok(blocks) => assert!(!blocks && !occludes, "{ray:?}"),
+                    Err(rest) => {
+                        let t = plane_hit(polygon.vertices()[0], polygon.normal(), &ray);
+                        assert_eq!(Some(rest), t.map(Rest::Outline), "{ray:?}");
+                        let outline = world.rest_occludes(e.number, &query, rest);
+                        assert_eq!(outline, occludes, "{ray:?}");
                     }
                 }
             }
         }
         assert!(turned_away > 20_000, "{turned_away} turned away");
-        assert!(hits > 100, "{hits} hits");
+        assert!(
+            hits > 100 && outlines > 2 * hits,
+            "{hits} hits, {outlines} outlines"
+        );
     }
 
     #[test]
@@ -1288,15 +1335,15 @@ mod tests {
             for e in &axial {
                 let table = world.intersect_shape(e.number, &query, ray.t_max);
                 hits += usize::from(table.is_some());
-                match e.intersect_in_place(&query, ray.t_max) {
+                match e.test_in_place(&query, ray.t_max).ok() {
                     Some(hit) => {
                         turned_away += 1;
                         assert_eq!(hit, None);
                         assert_eq!(table, None, "{ray:?}");
                         assert!(!world.shape_occludes(e.number, &query), "{ray:?}");
-                        assert_eq!(e.occludes_in_place(&query), Some(false));
+                        assert_eq!(e.occlusion_in_place(&query).ok(), Some(false));
                     }
-                    None => assert_eq!(e.occludes_in_place(&query), None),
+                    None => assert_eq!(e.occlusion_in_place(&query).ok(), None),
                 }
             }
         }
@@ -1311,7 +1358,7 @@ mod tests {
         assert_eq!(e.kind, EntryKind::Axial);
         let query = Query::new(ray, world.has_triangles);
         let table = world.intersect_shape(e.number, &query, ray.t_max);
-        let turned_away = e.intersect_in_place(&query, ray.t_max) == Some(None);
+        let turned_away = e.test_in_place(&query, ray.t_max).ok() == Some(None);
         assert!(!(turned_away && table.is_some()), "{ray:?} hits {table:?}");
         turned_away
     }
@@ -1395,11 +1442,11 @@ mod tests {
                 let t_max = ray.t_max * rng.uniform();
                 let table = world.intersect_shape(e.number, &query, t_max);
                 let occludes = world.shape_occludes(e.number, &query);
-                match e.intersect_in_place(&query, t_max) {
+                match e.test_in_place(&query, t_max).ok() {
                     Some(hit) => {
                         hits += usize::from(hit.is_some());
                         assert_eq!(hit, table, "{ray:?}");
-                        assert_eq!(e.occludes_in_place(&query), Some(occludes));
+                        assert_eq!(e.occlusion_in_place(&query).ok(), Some(occludes));
                     }
                     None => assert!(matches!(
                         e.kind,

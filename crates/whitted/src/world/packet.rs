@@ -29,7 +29,7 @@ use crate::math::Ray;
 #[cfg(target_arch = "x86_64")]
 use crate::shape::{LANES, RayLanes4, RayShear, ShapeHit, watertight_rays4};
 
-use super::entry::{EntryKind, Query, leaf_hit};
+use super::entry::{EntryKind, Query, Rest, leaf_hit};
 use super::{Hit, PrimitiveId, World};
 
 /// The most rays a packet holds.
@@ -117,9 +117,12 @@ impl<'a> World<'a> {
                 clipped[lane] = *ray;
                 let query = queries[lane].insert(Query::new(ray, self.has_triangles));
                 for e in &self.unbounded {
-                    if let Some((primitive, h)) =
-                        self.intersect_other(definitions, e, query, clipped[lane].t_max, &mut inner)
-                    {
+                    if let Some((primitive, h)) = self.intersect_other(
+                        definitions,
+                        e,
+                        (query, clipped[lane].t_max, Rest::Test),
+                        &mut inner,
+                    ) {
                         clipped[lane].t_max = h.t;
                         hits[lane] = Some(Hit {
                             primitive: PrimitiveId(primitive),
@@ -170,7 +173,9 @@ impl<'a> World<'a> {
                     query,
                     t_max[lane],
                     self.wide,
-                    |e, t_max| self.intersect_other(definitions, e, query, t_max, &mut inner),
+                    |e, t_max, rest| {
+                        self.intersect_other(definitions, e, (query, t_max, rest), &mut inner)
+                    },
                     |primitive, shape_hit| {
                         hits[lane] = Some(Hit {
                             primitive: PrimitiveId(primitive),
@@ -605,7 +610,7 @@ pub(super) mod tests {
                             queries[lane].as_ref().unwrap(),
                             ends[lane],
                             false,
-                            |_, _| unreachable!("triangles only"),
+                            |_, _, _| unreachable!("triangles only"),
                             |primitive, shape_hit| {
                                 own = Some(Hit {
                                     primitive: PrimitiveId(primitive),

@@ -13,7 +13,7 @@ use crate::accel::{Accelerator, Bvh, QueryContext};
 use crate::math::Ray;
 
 use super::World;
-use super::entry::{Query, leaf_occludes};
+use super::entry::{Query, Rest, leaf_occludes};
 use super::packet::PACKET_SIZE;
 
 impl World<'_> {
@@ -54,11 +54,9 @@ impl World<'_> {
         if !self.unbounded.is_empty() {
             for (lane, ray) in rays.iter().enumerate() {
                 let query = queries[lane].insert(Query::new(ray, self.has_triangles));
-                if self
-                    .unbounded
-                    .iter()
-                    .any(|e| self.other_occludes(&self.definitions, e, query, &mut inner))
-                {
+                if self.unbounded.iter().any(|e| {
+                    self.other_occludes(&self.definitions, e, (query, Rest::Test), &mut inner)
+                }) {
                     occluded |= 1 << lane;
                 }
             }
@@ -76,8 +74,8 @@ impl World<'_> {
                     let query = queries[lane]
                         .get_or_insert_with(|| Query::new(&rays[lane], self.has_triangles));
                     let meets =
-                        leaf_occludes(&self.entries, range.clone(), query, self.wide, |e| {
-                            self.shape_occludes(e.number, query)
+                        leaf_occludes(&self.entries, range.clone(), query, self.wide, |e, rest| {
+                            self.rest_occludes(e.number, query, rest)
                         });
                     if meets.is_some() {
                         found |= 1 << lane;

@@ -35,13 +35,13 @@ impl World<'_> {
         let Some(e) = self.entries.get(hint.0 as usize) else {
             return false;
         };
-        match e.occludes_in_place(query) {
-            Some(blocks) => blocks,
-            None => {
+        match e.occlusion_in_place(query) {
+            Ok(blocks) => blocks,
+            Err(rest) => {
                 matches!(
                     e.kind,
                     EntryKind::Primitive | EntryKind::Polygon | EntryKind::Axial
-                ) && self.shape_occludes(e.number, query)
+                ) && self.rest_occludes(e.number, query, rest)
             }
         }
     }
@@ -68,8 +68,8 @@ impl World<'_> {
         }
         let mut ctx = QueryContext::default();
         self.accel.occluded_in_leaf_order(ray, &mut ctx, |range| {
-            let blocker = leaf_occludes(&self.entries, range, &query, self.wide, |e| {
-                self.shape_occludes(e.number, &query)
+            let blocker = leaf_occludes(&self.entries, range, &query, self.wide, |e, rest| {
+                self.rest_occludes(e.number, &query, rest)
             });
             if let Some(entry) = blocker {
                 *hint = ShadowHint(entry);

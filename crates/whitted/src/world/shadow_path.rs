@@ -263,7 +263,7 @@ impl World<'_> {
                 range,
                 &query,
                 self.wide,
-                |e| self.shape_occludes(e.number, &query),
+                |e, rest| self.rest_occludes(e.number, &query, rest),
                 |entry| match opaque.entries[entry as usize] {
                     Passage::Stops => true,
                     Passage::Listed => {
@@ -325,9 +325,12 @@ impl World<'_> {
         for e in unbounded.chain(entries) {
             // Past the closest so far by the tie window, to see a near tie.
             let t_max = best.map_or(ray.t_max, |b| near_tie(b.shape_hit.t).1);
-            let hit = match e.intersect_in_place(&query, t_max) {
-                Some(hit) => hit.map(|h| (e.number, h)),
-                None => self.intersect_other(&self.definitions, e, &query, t_max, &mut inner),
+            let hit = match e.test_in_place(&query, t_max) {
+                Ok(hit) => hit.map(|h| (e.number, h)),
+                Err(rest) => {
+                    let test = (&query, t_max, rest);
+                    self.intersect_other(&self.definitions, e, test, &mut inner)
+                }
             };
             let Some((primitive, shape_hit)) = hit else {
                 continue;
