@@ -34,10 +34,13 @@ pub enum ShadowStep<'s> {
         blocked: bool,
     },
     /// By the closest-hit query (some surfaces let light through): the
-    /// surface crossed first, if any.
+    /// surface crossed first, if any. A shadow ray that crosses only
+    /// spheres is answered from their crossings at once; its steps are
+    /// then the segments from each crossing on, each hit the next
+    /// crossing.
     Closest {
-        /// The surface the segment meets first.
-        blocker: Option<(&'s Hit, &'s Surface)>,
+        /// Where the segment meets a surface first.
+        blocker: Option<&'s Hit>,
     },
 }
 

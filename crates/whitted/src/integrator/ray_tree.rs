@@ -302,7 +302,7 @@ impl RayObserver for RayTreeRecorder<'_> {
             }
             ShadowStep::Closest { blocker } => {
                 self.world.intersect_with(ray, &mut ctx);
-                blocker.map(|(hit, _)| (hit.primitive, hit.t()))
+                blocker.map(|hit| (hit.primitive, hit.t()))
             }
         };
         self.shadow.push(ShadowSegment {

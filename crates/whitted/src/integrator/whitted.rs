@@ -29,16 +29,17 @@ use crate::integrator::observer::{RayObserver, ShadowStep, Unobserved};
 use crate::integrator::photon_map::{self, CausticMap};
 use crate::integrator::shadow_cache;
 use crate::integrator::{PrimarySample, RayCounts, RayKind, RecursionLimits, Shading};
-use crate::math::{Ray, RayOrigins, Vec3, offset_ray_origin};
+use crate::math::{DVec2, Ray, RayOrigins, Vec3, offset_ray_origin};
 use crate::shading::differential::Bend;
 use crate::shading::optics::reflect;
 use crate::shading::{
     Color, Crossing, Light, Lobes, Material, MediumStack, RayDifferential, Weights, direct_samples,
     phong, shading_normal,
 };
+use crate::shape::ShapeHit;
 use crate::world::{
-    Hit, Interiors, MaterialId, OpaqueEntries, PassedEntries, PrimitiveId, ShadowPath, Surface,
-    World,
+    Hit, Interiors, MaterialId, OpaqueEntries, PassedEntries, PrimitiveId, ShadowPath,
+    SphereCrossings, Surface, World,
 };
 
 /// Longest chain of transmissive surfaces one shadow ray passes through.
@@ -499,7 +500,13 @@ impl<'a> Whitted<'a> {
         let mut passed = PassedEntries::UNLISTED;
         if let Some(opaque) = &self.opaque {
             match shadow_cache::shadow_path(self.world, &ray, opaque, index) {
-                ShadowPath::Crossed(entries) => passed = entries,
+                ShadowPath::Crossed(entries) => {
+                    let crossings = self.world.sphere_crossings(&ray, &entries);
+                    if let Some(through) = crossings.and_then(|c| self.through(&ray, &c, tally)) {
+                        return through;
+                    }
+                    passed = entries;
+                }
                 path => {
                     let blocked = path == ShadowPath::Blocked;
                     tally
@@ -518,14 +525,10 @@ impl<'a> Whitted<'a> {
             };
             let blocker = self.surface::<O>(&ray, &hit);
             let step = ShadowStep::Closest {
-                blocker: Some((&hit, &blocker)),
+                blocker: Some(&hit),
             };
             tally.observer.shadow_ray(&ray, step);
-            let m = &self.shading.materials[blocker.material.0 as usize];
-            through *= match self.caustics {
-                Some(_) => photon_map::shadow_pass_through(m, blocker.uv),
-                None => m.pass_through(blocker.uv),
-            };
+            through *= self.pass_through(blocker.material, blocker.uv);
             if through.max_element() <= 0.0 {
                 return Color::ZERO;
             }
@@ -535,6 +538,58 @@ impl<'a> Whitted<'a> {
             ray = segment(origin);
         }
         Color::ZERO
+    }
+
+    /// What a shadow ray along `ray` that crosses only spheres lets
+    /// through, from its `crossings` (nearest first): the product, in the
+    /// same order, of what the surface-to-surface walk would find at each,
+    /// and the same shadow rays counted. `None` when a sphere's material
+    /// reads (u, v): the walk then finds each point.
+    fn through<O: RayObserver>(
+        &self,
+        ray: &Ray,
+        crossings: &SphereCrossings,
+        tally: &mut SampleTally<'_, O>,
+    ) -> Option<Color> {
+        if crossings
+            .iter()
+            .any(|c| self.reads_uv[c.material.0 as usize])
+        {
+            return None;
+        }
+        // The observer is shown the steps as segments from each crossing
+        // on, as the walk would have made them.
+        let from = |t: f64| Ray::segment(ray.at(t), ray.dir, ray.t_max - t);
+        let mut through = Color::ONE;
+        let mut last = 0.0;
+        for c in crossings.iter() {
+            let hit = Hit {
+                primitive: c.primitive,
+                shape_hit: ShapeHit::at(c.t - last),
+            };
+            let step = ShadowStep::Closest {
+                blocker: Some(&hit),
+            };
+            tally.observer.shadow_ray(&from(last), step);
+            through *= self.pass_through(c.material, DVec2::ZERO);
+            if through.max_element() <= 0.0 {
+                return Some(Color::ZERO);
+            }
+            tally.counts[RayKind::Shadow] += 1;
+            last = c.t;
+        }
+        let step = ShadowStep::Closest { blocker: None };
+        tally.observer.shadow_ray(&from(last), step);
+        Some(through)
+    }
+
+    /// What a shadow ray lets through a surface of `material` at `uv`.
+    fn pass_through(&self, material: MaterialId, uv: DVec2) -> Color {
+        let m = &self.shading.materials[material.0 as usize];
+        match self.caustics {
+            Some(_) => photon_map::shadow_pass_through(m, uv),
+            None => m.pass_through(uv),
+        }
     }
 }
 

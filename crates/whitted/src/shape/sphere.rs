@@ -117,6 +117,21 @@ impl Sphere {
         quadratic::nearest_in(roots, ray.t_min, ray.t_max).map(ShapeHit::at)
     }
 
+    /// Where the ray crosses the sphere in its interval, nearest first: the
+    /// hits that closest-hit tests find one after the other, each with
+    /// the interval starting at the hit before, from one quadratic. A ray
+    /// that touches the sphere (two equal roots) crosses it once.
+    pub fn crossings(&self, ray: &Ray) -> impl Iterator<Item = f64> {
+        let (t_min, t_max) = (ray.t_min, ray.t_max);
+        let roots = self
+            .roots(ray)
+            .map_or([None, None], |(t0, t1)| [Some(t0), (t1 > t0).then_some(t1)]);
+        roots
+            .into_iter()
+            .flatten()
+            .filter(move |&t| t > t_min && t < t_max)
+    }
+
     /// True when the ray meets the sphere in its interval.
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.intersect(ray).is_some()
@@ -290,6 +305,31 @@ mod tests {
         assert!((hit.t - 5.0).abs() < 1e-7);
         let s = unit().surface(&ray, &hit);
         assert!(s.normal.is_finite() && (s.normal - Vec3::X).length() < 1e-6);
+    }
+
+    #[test]
+    fn crossings_are_the_hits_of_successive_tests() {
+        let mut rng = crate::math::random::Rng::new(5);
+        let sphere = Sphere::new(Vec3::new(0.5, -0.25, 1.0), 1.5).unwrap();
+        let mut counts = [0; 3];
+        for _ in 0..2000 {
+            // From inside and outside, towards points in and around it.
+            let origin = sphere.center() + 4.0 * rng.unit_vector() * rng.uniform();
+            let aim = sphere.center() + 2.0 * rng.unit_vector() * rng.uniform();
+            let dir = (aim - origin).normalize();
+            let mut ray = Ray::segment(origin, dir, 8.0 * rng.uniform());
+            let crossings = sphere.crossings(&ray).collect::<Vec<_>>();
+            let mut hits = Vec::new();
+            while let Some(hit) = sphere.intersect(&ray) {
+                hits.push(hit.t);
+                ray.t_min = hit.t;
+            }
+            assert_eq!(crossings, hits, "{ray:?}");
+            counts[hits.len()] += 1;
+        }
+        assert!(counts.iter().all(|&n| n > 100), "{counts:?}");
+        let touching = Ray::new(Vec3::new(-5.0, 1.0, 0.0), Vec3::X);
+        assert_eq!(unit().crossings(&touching).collect::<Vec<_>>(), [5.0]);
     }
 
     #[test]

@@ -47,7 +47,7 @@ pub use objects::{
 };
 pub use packet::PACKET_SIZE;
 pub use shadow_hint::ShadowHint;
-pub use shadow_path::{OpaqueEntries, PassedEntries, ShadowPath};
+pub use shadow_path::{OpaqueEntries, PassedEntries, ShadowPath, SphereCrossing, SphereCrossings};
 
 use crate::accel::{
     AccelKind, AccelerationStructure, Accelerator, Clipper, KdTree, KdTreeBuildParams, QueryContext,

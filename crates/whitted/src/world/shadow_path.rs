@@ -352,6 +352,99 @@ impl World<'_> {
     }
 }
 
+/// Where a shadow ray crosses the spheres a [`PassedEntries`] lists,
+/// nearest first ([`World::sphere_crossings`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SphereCrossings {
+    /// The crossings, the first `len` of them sorted by `t`.
+    crossings: [SphereCrossing; 2 * PASSED_CAPACITY],
+    /// How many there are.
+    len: usize,
+}
+
+/// One place where a shadow ray crosses a sphere's surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SphereCrossing {
+    /// The ray parameter.
+    pub t: f64,
+    /// The sphere.
+    pub primitive: PrimitiveId,
+    /// Its material.
+    pub material: MaterialId,
+}
+
+impl SphereCrossings {
+    /// None yet.
+    const EMPTY: Self = Self {
+        crossings: [SphereCrossing {
+            t: 0.0,
+            primitive: PrimitiveId(0),
+            material: MaterialId(0),
+        }; 2 * PASSED_CAPACITY],
+        len: 0,
+    };
+
+    /// The crossings, nearest first.
+    pub fn iter(&self) -> impl Iterator<Item = &SphereCrossing> {
+        self.crossings[..self.len].iter()
+    }
+
+    /// Adds `crossing` in its place along the ray; [`NearTie`] when it
+    /// lies within [`NEAR_TIE`] of one of another material.
+    fn insert(&mut self, crossing: SphereCrossing) -> Result<(), NearTie> {
+        let tied = |c: &SphereCrossing| {
+            let (low, high) = (c.t.min(crossing.t), c.t.max(crossing.t));
+            high < near_tie(low).1 && c.material != crossing.material
+        };
+        if self.iter().any(tied) {
+            return Err(NearTie);
+        }
+        let at = self.iter().take_while(|c| c.t <= crossing.t).count();
+        self.crossings.copy_within(at..self.len, at + 1);
+        self.crossings[at] = crossing;
+        self.len += 1;
+        Ok(())
+    }
+}
+
+impl World<'_> {
+    /// Where `ray`'s interval crosses the entries `passed` lists (a shadow
+    /// ray's, found by [`World::shadow_path`] for the same ray), nearest
+    /// first, when every entry listed is a sphere: the hits that the
+    /// surface-to-surface walk steps through, each interval starting at
+    /// the hit before, found from each sphere's two roots at once
+    /// ([`Sphere::crossings`]). `None` when the list is not known, names an
+    /// unbounded entry or another kind of shape, or when two crossings of
+    /// different materials lie within [`NEAR_TIE`] of each other: which
+    /// comes first is then the walk's to say.
+    ///
+    /// [`Sphere::crossings`]: crate::shape::Sphere::crossings
+    pub fn sphere_crossings(&self, ray: &Ray, passed: &PassedEntries) -> Option<SphereCrossings> {
+        if !passed.is_listed() || passed.unbounded != 0 {
+            return None;
+        }
+        let mut crossings = SphereCrossings::EMPTY;
+        for entry in passed.entries() {
+            let e = &self.entries[entry as usize];
+            if e.kind != EntryKind::Sphere {
+                return None;
+            }
+            let material = self.entry_material(e)?;
+            for t in e.as_sphere().crossings(ray) {
+                let primitive = PrimitiveId(e.number);
+                crossings
+                    .insert(SphereCrossing {
+                        t,
+                        primitive,
+                        material,
+                    })
+                    .ok()?;
+            }
+        }
+        Some(crossings)
+    }
+}
+
 /// Two listed primitives hit within [`NEAR_TIE`] of each other: the walk
 /// decides between them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -382,7 +475,7 @@ mod tests {
     use crate::accel::AccelKind;
     use crate::math::random::Rng;
     use crate::math::{Transform, Vec3};
-    use crate::shape::{Cylinder, Plane, Sphere};
+    use crate::shape::{Cylinder, Plane, ShapeHit, Sphere};
     use crate::world::Objects;
     use crate::world::{scattered_triangles, turned_square};
 
@@ -527,6 +620,100 @@ mod tests {
             }
             assert!(seen.iter().all(|&n| n > 50), "{kind:?}: {seen:?}");
         }
+    }
+
+    #[test]
+    fn sphere_crossings_are_the_hits_of_the_surface_walk() {
+        // Overlapping spheres: material 0 opaque, 1 and 2 clear; and a
+        // clear triangle mesh, whose crossings are left to the walk.
+        let mut rng = Rng::new(17);
+        let mut objects = Objects::default();
+        for i in 0..120 {
+            let centre = 8.0 * (rng.unit_vector() * rng.uniform());
+            let sphere = Sphere::new(centre, 0.3 + 1.2 * rng.uniform()).unwrap();
+            let material = MaterialId([0, 1, 2][i % 3]);
+            objects.add_primitive(Shape::Sphere(sphere), material, Transform::IDENTITY);
+        }
+        let mesh = objects.add_mesh(scattered_triangles(&mut rng, 40, 8.0));
+        objects.add_mesh_instance(mesh, MaterialId(1), Transform::IDENTITY);
+        for kind in [AccelKind::Bvh, AccelKind::KdTree, AccelKind::Grid] {
+            let world = World::build(&objects, kind);
+            let opaque = world.opaque_entries(&[true, false, false]).unwrap();
+            // Answered by crossings (of which: two or more, and two
+            // materials), and left to the walk.
+            let mut seen = [0; 4];
+            for _ in 0..3000 {
+                let from = 10.0 * rng.unit_vector() * rng.uniform();
+                let light = Vec3::new(3.0, 20.0, -4.0) + 4.0 * rng.unit_vector();
+                let ray = Ray::segment(from, (light - from).normalize(), (light - from).length());
+                let ShadowPath::Crossed(passed) =
+                    world.shadow_path(&ray, &opaque, &mut ShadowHint::default())
+                else {
+                    continue;
+                };
+                let Some(crossings) = world.sphere_crossings(&ray, &passed) else {
+                    seen[3] += 1;
+                    continue;
+                };
+                let (_, whole) = walk(&world, &ray, |r| world.intersect(r));
+                let found = crossings
+                    .iter()
+                    .map(|c| Hit {
+                        primitive: c.primitive,
+                        shape_hit: ShapeHit::at(c.t),
+                    })
+                    .collect::<Vec<_>>();
+                let times = |hits: &[Hit]| {
+                    hits.iter()
+                        .map(|h| (h.primitive, h.t()))
+                        .collect::<Vec<_>>()
+                };
+                assert_eq!(times(&found), times(&whole), "{kind:?} {ray:?}");
+                for c in crossings.iter() {
+                    let hit = whole.iter().find(|h| h.primitive == c.primitive).unwrap();
+                    assert_eq!(world.surface(&ray, hit).material, c.material);
+                }
+                seen[0] += 1;
+                seen[1] += usize::from(found.len() >= 2);
+                seen[2] += usize::from(
+                    crossings
+                        .iter()
+                        .any(|c| c.material != crossings.iter().next().unwrap().material),
+                );
+            }
+            assert!(seen.iter().all(|&n| n > 30), "{kind:?}: {seen:?}");
+        }
+    }
+
+    #[test]
+    fn crossings_of_two_materials_at_the_same_place_are_left_to_the_walk() {
+        let mut objects = Objects::default();
+        for material in [1, 2, 1] {
+            let sphere = Sphere::new(Vec3::ZERO, 1.0).unwrap();
+            objects.add_primitive(
+                Shape::Sphere(sphere),
+                MaterialId(material),
+                Transform::IDENTITY,
+            );
+        }
+        let world = World::new(&objects);
+        let ray = Ray::segment(Vec3::new(0.0, -3.0, 0.0), Vec3::Y, 6.0);
+        // By primitive: the structure orders its entries as it likes.
+        let listed = |primitives: &[u32]| {
+            let mut passed = PassedEntries::EMPTY;
+            for &p in primitives {
+                let entry = world.entries.iter().position(|e| e.number == p).unwrap();
+                passed.push(entry as u32, &world.entries);
+            }
+            world.sphere_crossings(&ray, &passed)
+        };
+        let same = listed(&[0, 2]).expect("one material: any order gives the same light");
+        assert_eq!(
+            same.iter().map(|c| c.t).collect::<Vec<_>>(),
+            [2.0, 2.0, 4.0, 4.0]
+        );
+        assert_eq!(listed(&[0, 1]), None);
+        assert_eq!(listed(&[]).map(|c| c.iter().count()), Some(0));
     }
 
     #[test]

@@ -1,0 +1,111 @@
+//! Shadow rays through clear spheres: each surface crossed lets its
+//! material's share of the light through, the steps the ray tree shows are
+//! the crossings in order, and they are the shadow rays the render counts.
+
+use whitted::integrator::{LightVerdict, RayKind, RayNode};
+use whitted::math::{Transform, Vec3};
+use whitted::render::{Scene, explain_pixel, render};
+use whitted::shading::{Attenuation, Color, Light, Material};
+use whitted::shape::{Plane, Shape, Sphere};
+use whitted::world::PrimitiveId;
+
+// Not every helper is used here.
+#[allow(dead_code)]
+mod common;
+use common::{black, scene_looking_down_z};
+
+/// What each clear sphere's material lets through, by primitive number
+/// (the floor is primitive 0).
+const PASS: [f64; 3] = [0.0, 0.5, 0.8];
+
+/// A white floor at z = 0 under two overlapping clear spheres of
+/// different materials, lit from the side so that their shadows fall
+/// beside them.
+fn floor_under_glass() -> Scene {
+    let mut scene = scene_looking_down_z(24, 24, 60.0);
+    scene.ambient = Color::splat(0.1);
+    let floor = scene.add_material(Material {
+        diffuse: Color::ONE.into(),
+        ambient: Color::ONE.into(),
+        ..black()
+    });
+    scene.add_primitive(
+        Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Z).unwrap()),
+        floor,
+        Transform::IDENTITY,
+    );
+    for (centre, pass) in [
+        (Vec3::new(0.2, 0.1, 1.2), PASS[1]),
+        (Vec3::new(-0.4, -0.3, 1.6), PASS[2]),
+    ] {
+        let glass = scene.add_material(Material {
+            transmission: Color::splat(pass).into(),
+            ..black()
+        });
+        let sphere = Sphere::new(centre, 0.7).unwrap();
+        scene.add_primitive(Shape::Sphere(sphere), glass, Transform::IDENTITY);
+    }
+    scene.lights.push(Light::Point {
+        position: Vec3::new(5.0, 4.0, 4.0),
+        intensity: Color::ONE,
+        attenuation: Attenuation::NONE,
+    });
+    scene
+}
+
+/// The shadow steps in `node`'s tree.
+fn shadow_steps(node: &RayNode) -> usize {
+    node.hit.iter().fold(0, |sum, hit| {
+        let own: usize = hit.lights.iter().map(|l| l.shadow_rays.len()).sum();
+        sum + own + hit.children.iter().map(shadow_steps).sum::<usize>()
+    })
+}
+
+#[test]
+fn light_through_clear_spheres_is_the_product_of_each_crossing_in_order() {
+    let scene = floor_under_glass();
+    let output = render(&scene, &|_| {}).unwrap();
+    let (mut steps, mut crossed) = (0, [0; 5]);
+    for y in 0..24 {
+        for x in 0..24 {
+            let tree = explain_pixel(&scene, (x, y), 0).unwrap().tree;
+            steps += shadow_steps(&tree);
+            let Some(hit) = tree.hit.as_ref().filter(|h| h.primitive == PrimitiveId(0)) else {
+                continue;
+            };
+            let segments = &hit.lights[0].shadow_rays;
+            let (last, crossings) = segments.split_last().unwrap();
+            assert_eq!(last.blocker, None, "pixel {x},{y}");
+            // Each step starts where the one before met a sphere.
+            let mut expected = Color::ONE;
+            let mut from = hit.point;
+            for segment in crossings {
+                let (sphere, t) = segment.blocker.unwrap();
+                assert!((segment.origin - from).length() < 1e-9, "pixel {x},{y}");
+                assert!(t > 0.0, "pixel {x},{y}");
+                from = segment.origin + t * segment.direction;
+                expected *= Color::splat(PASS[sphere.0 as usize]);
+            }
+            assert!((last.origin - from).length() < 1e-9, "pixel {x},{y}");
+            let verdict = hit.lights[0].verdict;
+            if crossings.is_empty() {
+                assert_eq!(verdict, LightVerdict::Lit, "pixel {x},{y}");
+            } else {
+                let transmittance = expected;
+                assert_eq!(
+                    verdict,
+                    LightVerdict::Attenuated { transmittance },
+                    "pixel {x},{y}"
+                );
+            }
+            crossed[crossings.len()] += 1;
+        }
+    }
+    // Floor pixels lit directly, through one sphere (two crossings) and
+    // through both (four).
+    assert!(
+        crossed[0] > 20 && crossed[2] > 20 && crossed[4] > 5,
+        "{crossed:?}"
+    );
+    assert_eq!(steps as u64, output.rays[RayKind::Shadow]);
+}
