@@ -466,6 +466,7 @@ impl<'a> Whitted<'a> {
     /// transmissive or dissolved surface crossed lets through otherwise
     /// ([`Material::pass_through`]). The shadow ray leaves from `s`'s
     /// `origins`.
+    #[inline(always)]
     fn transmittance<O: RayObserver>(
         &self,
         s: &Surface,
@@ -482,11 +483,7 @@ impl<'a> Whitted<'a> {
             Light::Point { position, .. } | Light::Spot { position, .. } => Some(*position),
             Light::Area(_) => Some(s.point + distance * to_light),
         };
-        let segment = |origin: Vec3| {
-            let t_max = target.map_or(distance, |p| (p - origin).dot(to_light));
-            Ray::segment(origin, to_light, t_max)
-        };
-        let mut ray = segment(origin);
+        let ray = shadow_segment(origin, to_light, (target, distance));
         if !self.any_transmissive {
             let blocked = shadow_cache::occluded(self.world, &ray, index);
             tally
@@ -494,15 +491,30 @@ impl<'a> Whitted<'a> {
                 .shadow_ray(&ray, ShadowStep::AnyHit { blocked });
             return if blocked { Color::ZERO } else { Color::ONE };
         }
+        self.light_through(&ray, index, (target, distance), tally)
+    }
+
+    /// How much light passes along the shadow ray `ray` towards light
+    /// number `index` (ending as [`shadow_segment`] says with `end`), in a
+    /// world where some surfaces let light through. Kept out of line: the
+    /// shadow rays of worlds without such surfaces then take a short path.
+    #[inline(never)]
+    fn light_through<O: RayObserver>(
+        &self,
+        ray: &Ray,
+        index: usize,
+        end: (Option<Vec3>, f64),
+        tally: &mut SampleTally<'_, O>,
+    ) -> Color {
         // One any-hit walk tells most shadow rays apart; for those that
         // cross surfaces letting light through, it lists them, and the
         // surface-to-surface walk tests only those.
         let mut passed = PassedEntries::UNLISTED;
         if let Some(opaque) = &self.opaque {
-            match shadow_cache::shadow_path(self.world, &ray, opaque, index) {
+            match shadow_cache::shadow_path(self.world, ray, opaque, index) {
                 ShadowPath::Crossed(entries) => {
-                    let crossings = self.world.sphere_crossings(&ray, &entries);
-                    if let Some(through) = crossings.and_then(|c| self.through(&ray, &c, tally)) {
+                    let crossings = self.world.sphere_crossings(ray, &entries);
+                    if let Some(through) = crossings.and_then(|c| self.through(ray, &c, tally)) {
                         return through;
                     }
                     passed = entries;
@@ -511,11 +523,12 @@ impl<'a> Whitted<'a> {
                     let blocked = path == ShadowPath::Blocked;
                     tally
                         .observer
-                        .shadow_ray(&ray, ShadowStep::AnyHit { blocked });
+                        .shadow_ray(ray, ShadowStep::AnyHit { blocked });
                     return if blocked { Color::ZERO } else { Color::ONE };
                 }
             }
         }
+        let mut ray = *ray;
         let mut through = Color::ONE;
         for _ in 0..MAX_SHADOW_CROSSINGS {
             let Some(hit) = self.world.intersect_passed(&ray, &passed) else {
@@ -534,8 +547,8 @@ impl<'a> Whitted<'a> {
             }
             tally.counts[RayKind::Shadow] += 1;
             let origin =
-                offset_ray_origin(blocker.point, blocker.point_error, blocker.normal, to_light);
-            ray = segment(origin);
+                offset_ray_origin(blocker.point, blocker.point_error, blocker.normal, ray.dir);
+            ray = shadow_segment(origin, ray.dir, end);
         }
         Color::ZERO
     }
@@ -591,6 +604,15 @@ impl<'a> Whitted<'a> {
             None => m.pass_through(uv),
         }
     }
+}
+
+/// The shadow ray from `origin` along `to_light` (unit) towards a light at
+/// `target`, or `distance` away where there is none (a directional
+/// light).
+#[inline(always)]
+fn shadow_segment(origin: Vec3, to_light: Vec3, (target, distance): (Option<Vec3>, f64)) -> Ray {
+    let t_max = target.map_or(distance, |p| (p - origin).dot(to_light));
+    Ray::segment(origin, to_light, t_max)
 }
 
 /// Which entries of `world` stop shadow rays outright, when some material
