@@ -14,23 +14,14 @@ use whitted::shading::{Attenuation, Light};
 use whitted::shape::{Parallelogram, Plane, Shape, Sphere};
 
 mod common;
-use common::{black, pixel, rendered, scene_looking_down_z};
+use common::{add_white_floor, black, pixel, rendered, scene_looking_down_z};
 
 /// A white floor at z = 0 lit by a point light off the axis, with a
 /// sphere of `material` between them and the camera.
 fn floor_and_sphere(material: Option<Material>) -> Scene {
     let mut scene = scene_looking_down_z(16, 16, 60.0);
     scene.ambient = Color::splat(0.1);
-    let floor = scene.add_material(Material {
-        diffuse: Color::ONE.into(),
-        ambient: Color::ONE.into(),
-        ..black()
-    });
-    scene.add_primitive(
-        Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Z).unwrap()),
-        floor,
-        Transform::IDENTITY,
-    );
+    add_white_floor(&mut scene);
     if let Some(material) = material {
         let m = scene.add_material(material);
         scene.add_primitive(

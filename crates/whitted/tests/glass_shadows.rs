@@ -6,13 +6,11 @@ use whitted::integrator::{LightVerdict, RayKind, RayNode};
 use whitted::math::{Transform, Vec3};
 use whitted::render::{Scene, explain_pixel, render};
 use whitted::shading::{Attenuation, Color, Light, Material};
-use whitted::shape::{Plane, Shape, Sphere};
+use whitted::shape::{Shape, Sphere};
 use whitted::world::PrimitiveId;
 
-// Not every helper is used here.
-#[allow(dead_code)]
 mod common;
-use common::{black, scene_looking_down_z};
+use common::{add_white_floor, black, scene_looking_down_z};
 
 /// What each clear sphere's material lets through, by primitive number
 /// (the floor is primitive 0).
@@ -24,16 +22,7 @@ const PASS: [f64; 3] = [0.0, 0.5, 0.8];
 fn floor_under_glass() -> Scene {
     let mut scene = scene_looking_down_z(24, 24, 60.0);
     scene.ambient = Color::splat(0.1);
-    let floor = scene.add_material(Material {
-        diffuse: Color::ONE.into(),
-        ambient: Color::ONE.into(),
-        ..black()
-    });
-    scene.add_primitive(
-        Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Z).unwrap()),
-        floor,
-        Transform::IDENTITY,
-    );
+    add_white_floor(&mut scene);
     for (centre, pass) in [
         (Vec3::new(0.2, 0.1, 1.2), PASS[1]),
         (Vec3::new(-0.4, -0.3, 1.6), PASS[2]),

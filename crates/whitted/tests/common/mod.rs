@@ -1,13 +1,17 @@
 //! Helpers shared by the known-answer render tests.
 
+// Each test crate uses some of them.
+#![allow(dead_code)]
+
 use whitted::image::Film;
-use whitted::math::Vec3;
+use whitted::math::{Transform, Vec3};
 use whitted::render::Camera;
 use whitted::render::Scene;
 use whitted::render::render;
 use whitted::shading::Color;
 use whitted::shading::Material;
 use whitted::shading::Texture;
+use whitted::shape::{Plane, Shape};
 
 /// A material with no ambient and no diffuse colour.
 pub fn black() -> Material {
@@ -37,4 +41,18 @@ pub fn rendered(scene: &Scene) -> Film {
 pub fn pixel(film: &Film, x: u32, y: u32) -> Color {
     let p = film.pixel(x, y);
     Color::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
+}
+
+/// Adds a white floor at z = 0, lit and ambient at full strength.
+pub fn add_white_floor(scene: &mut Scene) {
+    let floor = scene.add_material(Material {
+        diffuse: Color::ONE.into(),
+        ambient: Color::ONE.into(),
+        ..black()
+    });
+    scene.add_primitive(
+        Shape::Plane(Plane::new(Vec3::ZERO, Vec3::Z).unwrap()),
+        floor,
+        Transform::IDENTITY,
+    );
 }
