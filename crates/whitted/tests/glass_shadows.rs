@@ -1,11 +1,15 @@
 //! Shadow rays through clear spheres: each surface crossed lets its
 //! material's share of the light through, the steps the ray tree shows are
 //! the crossings in order, and they are the shadow rays the render counts.
+//! Answered from the spheres' crossings or by the surface-to-surface walk
+//! (for materials that read (u, v)), the picture and the counts are the
+//! same.
 
 use whitted::integrator::{LightVerdict, RayKind, RayNode};
 use whitted::math::{Transform, Vec3};
 use whitted::render::{Scene, explain_pixel, render};
-use whitted::shading::{Attenuation, Color, Light, Material};
+use whitted::shading::texture::Checker;
+use whitted::shading::{Attenuation, Color, Light, Material, Texture};
 use whitted::shape::{Shape, Sphere};
 use whitted::world::PrimitiveId;
 
@@ -14,25 +18,43 @@ use common::{add_white_floor, black, scene_looking_down_z};
 
 /// What each clear sphere's material lets through, by primitive number
 /// (the floor is primitive 0).
-const PASS: [f64; 3] = [0.0, 0.5, 0.8];
+const PASS: [f64; 4] = [0.0, 0.5, 0.8, 0.5];
 
 /// A white floor at z = 0 under two overlapping clear spheres of
-/// different materials, lit from the side so that their shadows fall
-/// beside them.
-fn floor_under_glass() -> Scene {
+/// different materials, and a third of the first's material in the same
+/// place as the first, lit from the side so that their shadows fall
+/// beside them. With `walked`, each transmission is a checker of one
+/// colour: the same light, but read at (u, v), so that shadow rays take
+/// the surface-to-surface walk.
+fn floor_under_glass(walked: bool) -> Scene {
     let mut scene = scene_looking_down_z(24, 24, 60.0);
     scene.ambient = Color::splat(0.1);
     add_white_floor(&mut scene);
-    for (centre, pass) in [
-        (Vec3::new(0.2, 0.1, 1.2), PASS[1]),
-        (Vec3::new(-0.4, -0.3, 1.6), PASS[2]),
-    ] {
-        let glass = scene.add_material(Material {
-            transmission: Color::splat(pass).into(),
+    let glass = |scene: &mut Scene, pass: f64| {
+        let pass = Color::splat(pass);
+        let transmission = if walked {
+            Texture::Checker(Checker {
+                even: pass,
+                odd: pass,
+                size: 0.25,
+            })
+        } else {
+            pass.into()
+        };
+        scene.add_material(Material {
+            transmission,
             ..black()
-        });
+        })
+    };
+    let (first, second) = (glass(&mut scene, PASS[1]), glass(&mut scene, PASS[2]));
+    let spheres = [
+        (Vec3::new(0.2, 0.1, 1.2), first),
+        (Vec3::new(-0.4, -0.3, 1.6), second),
+        (Vec3::new(0.2, 0.1, 1.2), first),
+    ];
+    for (centre, material) in spheres {
         let sphere = Sphere::new(centre, 0.7).unwrap();
-        scene.add_primitive(Shape::Sphere(sphere), glass, Transform::IDENTITY);
+        scene.add_primitive(Shape::Sphere(sphere), material, Transform::IDENTITY);
     }
     scene.lights.push(Light::Point {
         position: Vec3::new(5.0, 4.0, 4.0),
@@ -52,7 +74,7 @@ fn shadow_steps(node: &RayNode) -> usize {
 
 #[test]
 fn light_through_clear_spheres_is_the_product_of_each_crossing_in_order() {
-    let scene = floor_under_glass();
+    let scene = floor_under_glass(false);
     let output = render(&scene, &|_| {}).unwrap();
     let (mut steps, mut crossed) = (0, [0; 5]);
     for y in 0..24 {
@@ -97,4 +119,14 @@ fn light_through_clear_spheres_is_the_product_of_each_crossing_in_order() {
         "{crossed:?}"
     );
     assert_eq!(steps as u64, output.rays[RayKind::Shadow]);
+}
+
+#[test]
+fn crossings_and_the_surface_walk_give_the_same_picture_and_shadow_rays() {
+    let crossed = render(&floor_under_glass(false), &|_| {}).unwrap();
+    let walked = render(&floor_under_glass(true), &|_| {}).unwrap();
+    assert_eq!(crossed.image, walked.image);
+    assert_eq!(crossed.rays[RayKind::Shadow], walked.rays[RayKind::Shadow]);
+    // More shadow rays than camera hits: some crossed the spheres.
+    assert!(crossed.rays[RayKind::Shadow] > 24 * 24 + 100);
 }

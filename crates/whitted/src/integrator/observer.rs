@@ -36,8 +36,8 @@ pub enum ShadowStep<'s> {
     /// By the closest-hit query (some surfaces let light through): the
     /// surface crossed first, if any. A shadow ray that crosses only
     /// spheres is answered from their crossings at once; its steps are
-    /// then the segments from each crossing on, each hit the next
-    /// crossing.
+    /// then the segments from each crossing on (starting on the surface,
+    /// not at an offset origin), each hit the next crossing.
     Closest {
         /// Where the segment meets a surface first.
         blocker: Option<&'s Hit>,

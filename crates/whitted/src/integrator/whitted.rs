@@ -45,6 +45,9 @@ use crate::world::{
 /// Longest chain of transmissive surfaces one shadow ray passes through.
 const MAX_SHADOW_CROSSINGS: usize = 64;
 
+// A shadow ray answered from its crossings never meets the walk's limit.
+const _: () = assert!(SphereCrossings::CAPACITY < MAX_SHADOW_CROSSINGS);
+
 /// What one camera sample has traced so far: its rays by kind, the
 /// secondary rays it may still trace, and where it was cut; and who
 /// watches it.
@@ -514,7 +517,9 @@ impl<'a> Whitted<'a> {
             match shadow_cache::shadow_path(self.world, ray, opaque, index) {
                 ShadowPath::Crossed(entries) => {
                     let crossings = self.world.sphere_crossings(ray, &entries);
-                    if let Some(through) = crossings.and_then(|c| self.through(ray, &c, tally)) {
+                    if let Some(through) =
+                        crossings.and_then(|c| self.light_through_spheres(ray, &c, tally))
+                    {
                         return through;
                     }
                     passed = entries;
@@ -558,7 +563,7 @@ impl<'a> Whitted<'a> {
     /// same order, of what the surface-to-surface walk would find at each,
     /// and the same shadow rays counted. `None` when a sphere's material
     /// reads (u, v): the walk then finds each point.
-    fn through<O: RayObserver>(
+    fn light_through_spheres<O: RayObserver>(
         &self,
         ray: &Ray,
         crossings: &SphereCrossings,

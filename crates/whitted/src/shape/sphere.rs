@@ -121,7 +121,7 @@ impl Sphere {
     /// hits that closest-hit tests find one after the other, each with
     /// the interval starting at the hit before, from one quadratic. A ray
     /// that touches the sphere (two equal roots) crosses it once.
-    pub fn crossings(&self, ray: &Ray) -> impl Iterator<Item = f64> {
+    pub(crate) fn crossings(&self, ray: &Ray) -> impl Iterator<Item = f64> {
         let (t_min, t_max) = (ray.t_min, ray.t_max);
         let roots = self
             .roots(ray)

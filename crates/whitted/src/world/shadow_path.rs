@@ -357,7 +357,7 @@ impl World<'_> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SphereCrossings {
     /// The crossings, the first `len` of them sorted by `t`.
-    crossings: [SphereCrossing; 2 * PASSED_CAPACITY],
+    crossings: [SphereCrossing; Self::CAPACITY],
     /// How many there are.
     len: usize,
 }
@@ -374,13 +374,19 @@ pub struct SphereCrossing {
 }
 
 impl SphereCrossings {
+    /// Most crossings it holds: four spheres' two sides. A shadow ray that
+    /// crosses more takes the surface-to-surface walk; the list is kept
+    /// small, as one is made and copied for every shadow ray that crosses
+    /// glass.
+    pub const CAPACITY: usize = 8;
+
     /// None yet.
     const EMPTY: Self = Self {
         crossings: [SphereCrossing {
             t: 0.0,
             primitive: PrimitiveId(0),
             material: MaterialId(0),
-        }; 2 * PASSED_CAPACITY],
+        }; Self::CAPACITY],
         len: 0,
     };
 
@@ -389,21 +395,27 @@ impl SphereCrossings {
         self.crossings[..self.len].iter()
     }
 
-    /// Adds `crossing` in its place along the ray; [`NearTie`] when it
-    /// lies within [`NEAR_TIE`] of one of another material.
-    fn insert(&mut self, crossing: SphereCrossing) -> Result<(), NearTie> {
+    /// Adds `crossing` in its place along the ray; false, leaving the
+    /// answer to the walk, when the list is full or the crossing lies
+    /// within [`NEAR_TIE`] of one of another sphere: the walk's step
+    /// leaves the first of two such surfaces a rounding error past both,
+    /// and so crosses one of them only.
+    fn insert(&mut self, crossing: SphereCrossing) -> bool {
         let tied = |c: &SphereCrossing| {
             let (low, high) = (c.t.min(crossing.t), c.t.max(crossing.t));
-            high < near_tie(low).1 && c.material != crossing.material
+            high < near_tie(low).1 && c.primitive != crossing.primitive
         };
-        if self.iter().any(tied) {
-            return Err(NearTie);
+        if self.len == Self::CAPACITY || self.iter().any(tied) {
+            return false;
         }
-        let at = self.iter().take_while(|c| c.t <= crossing.t).count();
-        self.crossings.copy_within(at..self.len, at + 1);
+        let mut at = self.len;
+        while at > 0 && self.crossings[at - 1].t > crossing.t {
+            self.crossings[at] = self.crossings[at - 1];
+            at -= 1;
+        }
         self.crossings[at] = crossing;
         self.len += 1;
-        Ok(())
+        true
     }
 }
 
@@ -414,9 +426,10 @@ impl World<'_> {
     /// surface-to-surface walk steps through, each interval starting at
     /// the hit before, found from each sphere's two roots at once
     /// ([`Sphere::crossings`]). `None` when the list is not known, names an
-    /// unbounded entry or another kind of shape, or when two crossings of
-    /// different materials lie within [`NEAR_TIE`] of each other: which
-    /// comes first is then the walk's to say.
+    /// unbounded entry or another kind of shape, when two spheres'
+    /// crossings lie within [`NEAR_TIE`] of each other (the walk's offset
+    /// origins then cross one of them only), or when there are more than
+    /// [`SphereCrossings::CAPACITY`].
     ///
     /// [`Sphere::crossings`]: crate::shape::Sphere::crossings
     pub fn sphere_crossings(&self, ray: &Ray, passed: &PassedEntries) -> Option<SphereCrossings> {
@@ -432,13 +445,14 @@ impl World<'_> {
             let material = self.entry_material(e)?;
             for t in e.as_sphere().crossings(ray) {
                 let primitive = PrimitiveId(e.number);
-                crossings
-                    .insert(SphereCrossing {
-                        t,
-                        primitive,
-                        material,
-                    })
-                    .ok()?;
+                let crossing = SphereCrossing {
+                    t,
+                    primitive,
+                    material,
+                };
+                if !crossings.insert(crossing) {
+                    return None;
+                }
             }
         }
         Some(crossings)
@@ -686,7 +700,7 @@ mod tests {
     }
 
     #[test]
-    fn crossings_of_two_materials_at_the_same_place_are_left_to_the_walk() {
+    fn crossings_of_two_spheres_at_the_same_place_are_left_to_the_walk() {
         let mut objects = Objects::default();
         for material in [1, 2, 1] {
             let sphere = Sphere::new(Vec3::ZERO, 1.0).unwrap();
@@ -707,13 +721,41 @@ mod tests {
             }
             world.sphere_crossings(&ray, &passed)
         };
-        let same = listed(&[0, 2]).expect("one material: any order gives the same light");
-        assert_eq!(
-            same.iter().map(|c| c.t).collect::<Vec<_>>(),
-            [2.0, 2.0, 4.0, 4.0]
-        );
+        // Of one material or two: the walk crosses one of two surfaces in
+        // the same place.
+        assert_eq!(listed(&[0, 2]), None);
         assert_eq!(listed(&[0, 1]), None);
+        let one = listed(&[1]).unwrap();
+        assert_eq!(one.iter().map(|c| c.t).collect::<Vec<_>>(), [2.0, 4.0]);
         assert_eq!(listed(&[]).map(|c| c.iter().count()), Some(0));
+    }
+
+    #[test]
+    fn more_crossings_than_the_list_holds_are_left_to_the_walk() {
+        // Clear spheres in a row along x, two crossings each.
+        let spheres = SphereCrossings::CAPACITY / 2 + 1;
+        let mut objects = Objects::default();
+        for i in 0..spheres {
+            let sphere = Sphere::new(Vec3::new(3.0 * i as f64, 0.0, 0.0), 1.0).unwrap();
+            objects.add_primitive(Shape::Sphere(sphere), MaterialId(1), Transform::IDENTITY);
+        }
+        let world = World::new(&objects);
+        let opaque = world.opaque_entries(&[true, false]).unwrap();
+        let crossings = |end: f64| {
+            let ray = Ray::segment(Vec3::new(-5.0, 0.0, 0.0), Vec3::X, end + 5.0);
+            let path = world.shadow_path(&ray, &opaque, &mut ShadowHint::default());
+            let ShadowPath::Crossed(passed) = path else {
+                panic!("the ray crosses spheres");
+            };
+            world.sphere_crossings(&ray, &passed)
+        };
+        // Past all but the last sphere: full; into the last: one too many.
+        let last = 3.0 * (spheres - 1) as f64;
+        let full = crossings(last - 1.5).expect("the list holds them");
+        assert_eq!(full.iter().count(), SphereCrossings::CAPACITY);
+        let ts = full.iter().map(|c| c.t).collect::<Vec<_>>();
+        assert!(ts.windows(2).all(|w| w[0] < w[1]), "{ts:?}");
+        assert_eq!(crossings(last), None);
     }
 
     #[test]
