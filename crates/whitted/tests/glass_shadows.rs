@@ -1,31 +1,32 @@
-//! Shadow rays through clear spheres: each surface crossed lets its
-//! material's share of the light through, the steps the ray tree shows are
-//! the crossings in order, and they are the shadow rays the render counts.
-//! Answered from the spheres' crossings or by the surface-to-surface walk
-//! (for materials that read (u, v)), the picture and the counts are the
-//! same.
+//! Shadow rays through clear spheres and a clear pane: each surface
+//! crossed lets its material's share of the light through, the steps the
+//! ray tree shows are the crossings in order, and they are the shadow rays
+//! the render counts. Answered from the surfaces' crossings or by the
+//! surface-to-surface walk (for materials that read (u, v)), the picture
+//! and the counts are the same.
 
 use whitted::integrator::{LightVerdict, RayKind, RayNode};
 use whitted::math::{Transform, Vec3};
 use whitted::render::{Scene, explain_pixel, render};
 use whitted::shading::texture::Checker;
 use whitted::shading::{Attenuation, Color, Light, Material, Texture};
-use whitted::shape::{Shape, Sphere};
+use whitted::shape::{Polygon, Shape, Sphere};
 use whitted::world::PrimitiveId;
 
 mod common;
 use common::{add_white_floor, black, scene_looking_down_z};
 
-/// What each clear sphere's material lets through, by primitive number
-/// (the floor is primitive 0).
-const PASS: [f64; 4] = [0.0, 0.5, 0.8, 0.5];
+/// What each clear primitive's material lets through, by primitive number
+/// (the floor is primitive 0, the pane 4).
+const PASS: [f64; 5] = [0.0, 0.5, 0.8, 0.5, 0.6];
 
 /// A white floor at z = 0 under two overlapping clear spheres of
 /// different materials, and a third of the first's material in the same
 /// place as the first, lit from the side so that their shadows fall
-/// beside them. With `walked`, each transmission is a checker of one
-/// colour: the same light, but read at (u, v), so that shadow rays take
-/// the surface-to-surface walk.
+/// beside them; a clear pane out of the camera's view lies over part of
+/// the floor and of one shadow. With `walked`, each transmission is a
+/// checker of one colour: the same light, but read at (u, v), so that
+/// shadow rays take the surface-to-surface walk.
 fn floor_under_glass(walked: bool) -> Scene {
     let mut scene = scene_looking_down_z(24, 24, 60.0);
     scene.ambient = Color::splat(0.1);
@@ -56,6 +57,10 @@ fn floor_under_glass(walked: bool) -> Scene {
         let sphere = Sphere::new(centre, 0.7).unwrap();
         scene.add_primitive(Shape::Sphere(sphere), material, Transform::IDENTITY);
     }
+    let corners = [(3.15, 2.2), (3.4, 2.2), (3.4, 3.8), (3.15, 3.8)];
+    let pane = Polygon::new(corners.map(|(x, y)| Vec3::new(x, y, 3.0)).to_vec()).unwrap();
+    let pane_glass = glass(&mut scene, PASS[4]);
+    scene.add_primitive(Shape::Polygon(pane), pane_glass, Transform::IDENTITY);
     scene.lights.push(Light::Point {
         position: Vec3::new(5.0, 4.0, 4.0),
         intensity: Color::ONE,
@@ -73,10 +78,11 @@ fn shadow_steps(node: &RayNode) -> usize {
 }
 
 #[test]
-fn light_through_clear_spheres_is_the_product_of_each_crossing_in_order() {
+fn light_through_clear_surfaces_is_the_product_of_each_crossing_in_order() {
     let scene = floor_under_glass(false);
     let output = render(&scene, &|_| {}).unwrap();
-    let (mut steps, mut crossed) = (0, [0; 5]);
+    // By spheres' crossings (0, 2 or 4), and whether the pane is crossed.
+    let (mut steps, mut crossed) = (0, [[0; 2]; 5]);
     for y in 0..24 {
         for x in 0..24 {
             let tree = explain_pixel(&scene, (x, y), 0).unwrap().tree;
@@ -109,15 +115,18 @@ fn light_through_clear_spheres_is_the_product_of_each_crossing_in_order() {
                     "pixel {x},{y}"
                 );
             }
-            crossed[crossings.len()] += 1;
+            let pane = crossings
+                .iter()
+                .any(|c| c.blocker.unwrap().0 == PrimitiveId(4));
+            crossed[crossings.len() - usize::from(pane)][usize::from(pane)] += 1;
         }
     }
     // Floor pixels lit directly, through one sphere (two crossings) and
-    // through both (four).
-    assert!(
-        crossed[0] > 20 && crossed[2] > 20 && crossed[4] > 5,
-        "{crossed:?}"
-    );
+    // through both (four); and through the pane alone, with one sphere and
+    // with both.
+    let [none, _, one, _, both] = crossed;
+    assert!(none[0] > 20 && one[0] > 10 && both[0] > 10, "{crossed:?}");
+    assert!(none[1] > 20 && one[1] > 10 && both[1] > 10, "{crossed:?}");
     assert_eq!(steps as u64, output.rays[RayKind::Shadow]);
 }
 

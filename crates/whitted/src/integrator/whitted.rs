@@ -38,15 +38,15 @@ use crate::shading::{
 };
 use crate::shape::ShapeHit;
 use crate::world::{
-    Hit, Interiors, MaterialId, OpaqueEntries, PassedEntries, PrimitiveId, ShadowPath,
-    SphereCrossings, Surface, World,
+    Hit, Interiors, MaterialId, OpaqueEntries, PassedEntries, PrimitiveId, ShadowCrossings,
+    ShadowPath, Surface, World,
 };
 
 /// Longest chain of transmissive surfaces one shadow ray passes through.
 const MAX_SHADOW_CROSSINGS: usize = 64;
 
 // A shadow ray answered from its crossings never meets the walk's limit.
-const _: () = assert!(SphereCrossings::CAPACITY < MAX_SHADOW_CROSSINGS);
+const _: () = assert!(ShadowCrossings::CAPACITY < MAX_SHADOW_CROSSINGS);
 
 /// What one camera sample has traced so far: its rays by kind, the
 /// secondary rays it may still trace, and where it was cut; and who
@@ -516,9 +516,9 @@ impl<'a> Whitted<'a> {
         if let Some(opaque) = &self.opaque {
             match shadow_cache::shadow_path(self.world, ray, opaque, index) {
                 ShadowPath::Crossed(entries) => {
-                    let crossings = self.world.sphere_crossings(ray, &entries);
+                    let crossings = self.world.shadow_crossings(ray, &entries);
                     if let Some(through) =
-                        crossings.and_then(|c| self.light_through_spheres(ray, &c, tally))
+                        crossings.and_then(|c| self.light_through_crossings(ray, &c, tally))
                     {
                         return through;
                     }
@@ -558,15 +558,15 @@ impl<'a> Whitted<'a> {
         Color::ZERO
     }
 
-    /// What a shadow ray along `ray` that crosses only spheres lets
-    /// through, from its `crossings` (nearest first): the product, in the
-    /// same order, of what the surface-to-surface walk would find at each,
-    /// and the same shadow rays counted. `None` when a sphere's material
-    /// reads (u, v): the walk then finds each point.
-    fn light_through_spheres<O: RayObserver>(
+    /// What a shadow ray along `ray` lets through, from its `crossings`
+    /// (nearest first): the product, in the same order, of what the
+    /// surface-to-surface walk would find at each, and the same shadow
+    /// rays counted. `None` when a crossed material reads (u, v): the walk
+    /// then finds each point.
+    fn light_through_crossings<O: RayObserver>(
         &self,
         ray: &Ray,
-        crossings: &SphereCrossings,
+        crossings: &ShadowCrossings,
         tally: &mut SampleTally<'_, O>,
     ) -> Option<Color> {
         if crossings

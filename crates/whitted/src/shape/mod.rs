@@ -322,6 +322,20 @@ impl Shape {
         }
     }
 
+    /// True when the shape lies in one plane (plane, triangle,
+    /// parallelogram, polygon, disk), whatever its transform: a line
+    /// crosses it once at most, so a ray's closest hit is its only one.
+    pub fn is_flat(&self) -> bool {
+        matches!(
+            self,
+            Shape::Plane(_)
+                | Shape::Triangle(_)
+                | Shape::Parallelogram(_)
+                | Shape::Polygon(_)
+                | Shape::Disk(_)
+        )
+    }
+
     /// The closest hit with `t` in the ray's open interval.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {

@@ -47,7 +47,7 @@ pub use objects::{
 };
 pub use packet::PACKET_SIZE;
 pub use shadow_hint::ShadowHint;
-pub use shadow_path::{OpaqueEntries, PassedEntries, ShadowPath, SphereCrossing, SphereCrossings};
+pub use shadow_path::{OpaqueEntries, PassedEntries, ShadowCrossing, ShadowCrossings, ShadowPath};
 
 use crate::accel::{
     AccelKind, AccelerationStructure, Accelerator, Clipper, KdTree, KdTreeBuildParams, QueryContext,

@@ -10,7 +10,7 @@
 
 use crate::accel::{AccelerationStructure, QueryContext};
 use crate::math::Ray;
-use crate::shape::Shape;
+use crate::shape::{Shape, ShapeHit};
 use crate::world::entry::{Entry, EntryKind, Query, leaf_meets};
 use crate::world::{Hit, MaterialId, PrimitiveId, PrimitiveRef, ShadowHint, World};
 
@@ -320,19 +320,11 @@ impl World<'_> {
         let query = Query::new(ray, triangles);
         let mut inner = QueryContext::default();
         let mut best: Option<Hit> = None;
-        let unbounded = set_bits(listed.unbounded).map(|i| &self.unbounded[i]);
-        let entries = listed.entries().map(|entry| &self.entries[entry as usize]);
-        for e in unbounded.chain(entries) {
+        for e in self.listed(listed) {
             // Past the closest so far by the tie window, to see a near tie.
             let t_max = best.map_or(ray.t_max, |b| near_tie(b.shape_hit.t).1);
-            let hit = match e.test_in_place(&query, t_max) {
-                Ok(hit) => hit.map(|h| (e.number, h)),
-                Err(rest) => {
-                    let test = (&query, t_max, rest);
-                    self.intersect_other(&self.definitions, e, test, &mut inner)
-                }
-            };
-            let Some((primitive, shape_hit)) = hit else {
+            let Some((primitive, shape_hit)) = self.test_listed(e, &query, t_max, &mut inner)
+            else {
                 continue;
             };
             if let Some(b) = best
@@ -350,39 +342,74 @@ impl World<'_> {
         }
         Ok(best)
     }
+
+    /// The entries `listed` names: its unbounded ones, then the others in
+    /// the walk's order.
+    fn listed<'s>(&'s self, listed: &'s PassedEntries) -> impl Iterator<Item = &'s Entry> {
+        let unbounded = set_bits(listed.unbounded).map(|i| &self.unbounded[i]);
+        let entries = listed.entries().map(|entry| &self.entries[entry as usize]);
+        unbounded.chain(entries)
+    }
+
+    /// Entry `e`'s closest hit in the interval of `query`'s ray ending at
+    /// `t_max`, as the closest-hit walk tests it: in place, then through
+    /// the tables.
+    #[inline]
+    fn test_listed(
+        &self,
+        e: &Entry,
+        query: &Query,
+        t_max: f64,
+        inner: &mut QueryContext,
+    ) -> Option<(u32, ShapeHit)> {
+        match e.test_in_place(query, t_max) {
+            Ok(hit) => hit.map(|h| (e.number, h)),
+            Err(rest) => self.intersect_other(&self.definitions, e, (query, t_max, rest), inner),
+        }
+    }
+
+    /// True when every hit on entry `e` lies in one plane: a line crosses
+    /// it once at most ([`Shape::is_flat`]).
+    fn is_flat(&self, e: &Entry) -> bool {
+        match e.kind {
+            EntryKind::Triangle | EntryKind::Polygon => true,
+            EntryKind::Primitive => self.shapes[e.number as usize].shape.is_flat(),
+            _ => false,
+        }
+    }
 }
 
-/// Where a shadow ray crosses the spheres a [`PassedEntries`] lists,
-/// nearest first ([`World::sphere_crossings`]).
+/// Where a shadow ray crosses the surfaces a [`PassedEntries`] lists,
+/// nearest first ([`World::shadow_crossings`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SphereCrossings {
+pub struct ShadowCrossings {
     /// The crossings, the first `len` of them sorted by `t`.
-    crossings: [SphereCrossing; Self::CAPACITY],
+    crossings: [ShadowCrossing; Self::CAPACITY],
     /// How many there are.
     len: usize,
 }
 
-/// One place where a shadow ray crosses a sphere's surface.
+/// One place where a shadow ray crosses a surface.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SphereCrossing {
+pub struct ShadowCrossing {
     /// The ray parameter.
     pub t: f64,
-    /// The sphere.
+    /// The primitive crossed.
     pub primitive: PrimitiveId,
     /// Its material.
     pub material: MaterialId,
 }
 
-impl SphereCrossings {
-    /// Most crossings it holds: four spheres' two sides. A shadow ray that
-    /// crosses more takes the surface-to-surface walk; the list is kept
-    /// small, as one is made and copied for every shadow ray that crosses
-    /// glass.
+impl ShadowCrossings {
+    /// Most crossings it holds: four spheres' two sides, or eight flat
+    /// surfaces. A shadow ray that crosses more takes the
+    /// surface-to-surface walk; the list is kept small, as one is made and
+    /// copied for every shadow ray that crosses glass.
     pub const CAPACITY: usize = 8;
 
     /// None yet.
     const EMPTY: Self = Self {
-        crossings: [SphereCrossing {
+        crossings: [ShadowCrossing {
             t: 0.0,
             primitive: PrimitiveId(0),
             material: MaterialId(0),
@@ -391,17 +418,17 @@ impl SphereCrossings {
     };
 
     /// The crossings, nearest first.
-    pub fn iter(&self) -> impl Iterator<Item = &SphereCrossing> {
+    pub fn iter(&self) -> impl Iterator<Item = &ShadowCrossing> {
         self.crossings[..self.len].iter()
     }
 
     /// Adds `crossing` in its place along the ray; false, leaving the
     /// answer to the walk, when the list is full or the crossing lies
-    /// within [`NEAR_TIE`] of one of another sphere: the walk's step
+    /// within [`NEAR_TIE`] of one of another primitive: the walk's step
     /// leaves the first of two such surfaces a rounding error past both,
     /// and so crosses one of them only.
-    fn insert(&mut self, crossing: SphereCrossing) -> bool {
-        let tied = |c: &SphereCrossing| {
+    fn insert(&mut self, crossing: ShadowCrossing) -> bool {
+        let tied = |c: &ShadowCrossing| {
             let (low, high) = (c.t.min(crossing.t), c.t.max(crossing.t));
             high < near_tie(low).1 && c.primitive != crossing.primitive
         };
@@ -422,37 +449,48 @@ impl SphereCrossings {
 impl World<'_> {
     /// Where `ray`'s interval crosses the entries `passed` lists (a shadow
     /// ray's, found by [`World::shadow_path`] for the same ray), nearest
-    /// first, when every entry listed is a sphere: the hits that the
-    /// surface-to-surface walk steps through, each interval starting at
-    /// the hit before, found from each sphere's two roots at once
-    /// ([`Sphere::crossings`]). `None` when the list is not known, names an
-    /// unbounded entry or another kind of shape, when two spheres'
-    /// crossings lie within [`NEAR_TIE`] of each other (the walk's offset
-    /// origins then cross one of them only), or when there are more than
-    /// [`SphereCrossings::CAPACITY`].
+    /// first: the hits that the surface-to-surface walk steps through,
+    /// each interval starting at the hit before, found all at once along
+    /// `ray` itself. A sphere gives both its roots ([`Sphere::crossings`]);
+    /// a flat entry (a triangle, polygon, plane, parallelogram or disk,
+    /// [`Shape::is_flat`]) its one hit, found by the walk's own test of
+    /// it. `None` when the list is not known or names another kind of
+    /// entry, when two primitives' crossings lie within [`NEAR_TIE`] of
+    /// each other (the walk's offset origins then cross one of them only),
+    /// or when there are more than [`ShadowCrossings::CAPACITY`].
     ///
     /// [`Sphere::crossings`]: crate::shape::Sphere::crossings
-    pub fn sphere_crossings(&self, ray: &Ray, passed: &PassedEntries) -> Option<SphereCrossings> {
-        if !passed.is_listed() || passed.unbounded != 0 {
+    pub fn shadow_crossings(&self, ray: &Ray, passed: &PassedEntries) -> Option<ShadowCrossings> {
+        if !passed.is_listed() {
             return None;
         }
-        let mut crossings = SphereCrossings::EMPTY;
-        for entry in passed.entries() {
-            let e = &self.entries[entry as usize];
-            if e.kind != EntryKind::Sphere {
-                return None;
-            }
+        // Most lists hold a triangle or none: its shear is made where it
+        // is tested.
+        let query = Query::new(ray, false);
+        let mut inner = QueryContext::default();
+        let mut crossings = ShadowCrossings::EMPTY;
+        for e in self.listed(passed) {
             let material = self.entry_material(e)?;
-            for t in e.as_sphere().crossings(ray) {
-                let primitive = PrimitiveId(e.number);
-                let crossing = SphereCrossing {
+            let mut add = |t: f64, primitive: u32| {
+                crossings.insert(ShadowCrossing {
                     t,
-                    primitive,
+                    primitive: PrimitiveId(primitive),
                     material,
-                };
-                if !crossings.insert(crossing) {
-                    return None;
+                })
+            };
+            if e.kind == EntryKind::Sphere {
+                for t in e.as_sphere().crossings(ray) {
+                    if !add(t, e.number) {
+                        return None;
+                    }
                 }
+            } else if !self.is_flat(e) {
+                return None;
+            } else if let Some((primitive, hit)) =
+                self.test_listed(e, &query, ray.t_max, &mut inner)
+                && !add(hit.t, primitive)
+            {
+                return None;
             }
         }
         Some(crossings)
@@ -489,7 +527,7 @@ mod tests {
     use crate::accel::AccelKind;
     use crate::math::random::Rng;
     use crate::math::{Transform, Vec3};
-    use crate::shape::{Cylinder, Plane, ShapeHit, Sphere};
+    use crate::shape::{Cylinder, Disk, Parallelogram, Plane, Sphere};
     use crate::world::Objects;
     use crate::world::{scattered_triangles, turned_square};
 
@@ -637,63 +675,93 @@ mod tests {
     }
 
     #[test]
-    fn sphere_crossings_are_the_hits_of_the_surface_walk() {
-        // Overlapping spheres: material 0 opaque, 1 and 2 clear; and a
-        // clear triangle mesh, whose crossings are left to the walk.
+    fn crossings_are_the_hits_of_the_surface_walk() {
+        // Overlapping spheres, a triangle mesh, polygons, parallelograms
+        // and disks (moved), of materials 0 (opaque), 1 and 2 (clear); a
+        // clear floor plane (unbounded); and clear cylinders, whose
+        // crossings are left to the walk.
         let mut rng = Rng::new(17);
         let mut objects = Objects::default();
+        let material = |i: usize| MaterialId([0, 1, 2][i % 3]);
         for i in 0..120 {
             let centre = 8.0 * (rng.unit_vector() * rng.uniform());
             let sphere = Sphere::new(centre, 0.3 + 1.2 * rng.uniform()).unwrap();
-            let material = MaterialId([0, 1, 2][i % 3]);
-            objects.add_primitive(Shape::Sphere(sphere), material, Transform::IDENTITY);
+            objects.add_primitive(Shape::Sphere(sphere), material(i), Transform::IDENTITY);
         }
-        let mesh = objects.add_mesh(scattered_triangles(&mut rng, 40, 8.0));
-        objects.add_mesh_instance(mesh, MaterialId(1), Transform::IDENTITY);
+        for i in 0..3 {
+            let mesh = objects.add_mesh(scattered_triangles(&mut rng, 40, 8.0));
+            objects.add_mesh_instance(mesh, material(i), Transform::IDENTITY);
+        }
+        for i in 0..45 {
+            let centre = 8.0 * (rng.unit_vector() * rng.uniform());
+            let moved = Transform::translate(centre).unwrap();
+            let shape = match i % 4 {
+                0 | 1 => Shape::Polygon(turned_square(&mut rng, centre)),
+                2 => {
+                    let (u, v) = (rng.unit_vector(), rng.unit_vector());
+                    Shape::Parallelogram(Parallelogram::new(centre, u, v).unwrap())
+                }
+                _ => Shape::Disk(Disk::new(1.0, 0.3 * rng.uniform()).unwrap()),
+            };
+            let transform = if i % 4 == 3 {
+                moved
+            } else {
+                Transform::IDENTITY
+            };
+            objects.add_primitive(shape, material(i), transform);
+        }
+        for i in 0..10 {
+            let cylinder = Cylinder::new(0.5, 1.5, true).unwrap();
+            let moved = Transform::translate(8.0 * rng.unit_vector() * rng.uniform()).unwrap();
+            objects.add_primitive(Shape::Cylinder(cylinder), material(i), moved);
+        }
+        let floor = Plane::new(Vec3::new(0.0, -9.0, 0.0), Vec3::Y).unwrap();
+        objects.add_primitive(Shape::Plane(floor), MaterialId(1), Transform::IDENTITY);
+        let floor = PrimitiveId(objects.primitives.len() as u32 - 1);
         for kind in [AccelKind::Bvh, AccelKind::KdTree, AccelKind::Grid] {
             let world = World::build(&objects, kind);
             let opaque = world.opaque_entries(&[true, false, false]).unwrap();
-            // Answered by crossings (of which: two or more, and two
-            // materials), and left to the walk.
-            let mut seen = [0; 4];
-            for _ in 0..3000 {
+            // Answered by crossings (of which: two or more, two materials,
+            // a flat one, the floor), and left to the walk.
+            let mut seen = [0; 6];
+            for i in 0..4000 {
                 let from = 10.0 * rng.unit_vector() * rng.uniform();
-                let light = Vec3::new(3.0, 20.0, -4.0) + 4.0 * rng.unit_vector();
+                let y = if i % 2 == 0 { 20.0 } else { -20.0 };
+                let light = Vec3::new(3.0, y, -4.0) + 4.0 * rng.unit_vector();
                 let ray = Ray::segment(from, (light - from).normalize(), (light - from).length());
                 let ShadowPath::Crossed(passed) =
                     world.shadow_path(&ray, &opaque, &mut ShadowHint::default())
                 else {
                     continue;
                 };
-                let Some(crossings) = world.sphere_crossings(&ray, &passed) else {
-                    seen[3] += 1;
+                let Some(crossings) = world.shadow_crossings(&ray, &passed) else {
+                    seen[5] += 1;
                     continue;
                 };
                 let (_, whole) = walk(&world, &ray, |r| world.intersect(r));
                 let found = crossings
                     .iter()
-                    .map(|c| Hit {
-                        primitive: c.primitive,
-                        shape_hit: ShapeHit::at(c.t),
-                    })
+                    .map(|c| (c.primitive, c.t))
                     .collect::<Vec<_>>();
-                let times = |hits: &[Hit]| {
-                    hits.iter()
-                        .map(|h| (h.primitive, h.t()))
-                        .collect::<Vec<_>>()
-                };
-                assert_eq!(times(&found), times(&whole), "{kind:?} {ray:?}");
+                let walked = whole
+                    .iter()
+                    .map(|h| (h.primitive, h.t()))
+                    .collect::<Vec<_>>();
+                assert_eq!(found, walked, "{kind:?} {ray:?}");
                 for c in crossings.iter() {
                     let hit = whole.iter().find(|h| h.primitive == c.primitive).unwrap();
                     assert_eq!(world.surface(&ray, hit).material, c.material);
                 }
+                let first = crossings.iter().next().map(|c| c.material);
+                let flat = |c: &ShadowCrossing| match world.primitive_ref(c.primitive.0) {
+                    PrimitiveRef::Shape(i) => objects.primitives[i as usize].shape.is_flat(),
+                    _ => true,
+                };
                 seen[0] += 1;
                 seen[1] += usize::from(found.len() >= 2);
-                seen[2] += usize::from(
-                    crossings
-                        .iter()
-                        .any(|c| c.material != crossings.iter().next().unwrap().material),
-                );
+                seen[2] += usize::from(crossings.iter().any(|c| Some(c.material) != first));
+                seen[3] += usize::from(crossings.iter().any(flat));
+                seen[4] += usize::from(crossings.iter().any(|c| c.primitive == floor));
             }
             assert!(seen.iter().all(|&n| n > 30), "{kind:?}: {seen:?}");
         }
@@ -719,7 +787,7 @@ mod tests {
                 let entry = world.entries.iter().position(|e| e.number == p).unwrap();
                 passed.push(entry as u32, &world.entries);
             }
-            world.sphere_crossings(&ray, &passed)
+            world.shadow_crossings(&ray, &passed)
         };
         // Of one material or two: the walk crosses one of two surfaces in
         // the same place.
@@ -733,7 +801,7 @@ mod tests {
     #[test]
     fn more_crossings_than_the_list_holds_are_left_to_the_walk() {
         // Clear spheres in a row along x, two crossings each.
-        let spheres = SphereCrossings::CAPACITY / 2 + 1;
+        let spheres = ShadowCrossings::CAPACITY / 2 + 1;
         let mut objects = Objects::default();
         for i in 0..spheres {
             let sphere = Sphere::new(Vec3::new(3.0 * i as f64, 0.0, 0.0), 1.0).unwrap();
@@ -747,12 +815,12 @@ mod tests {
             let ShadowPath::Crossed(passed) = path else {
                 panic!("the ray crosses spheres");
             };
-            world.sphere_crossings(&ray, &passed)
+            world.shadow_crossings(&ray, &passed)
         };
         // Past all but the last sphere: full; into the last: one too many.
         let last = 3.0 * (spheres - 1) as f64;
         let full = crossings(last - 1.5).expect("the list holds them");
-        assert_eq!(full.iter().count(), SphereCrossings::CAPACITY);
+        assert_eq!(full.iter().count(), ShadowCrossings::CAPACITY);
         let ts = full.iter().map(|c| c.t).collect::<Vec<_>>();
         assert!(ts.windows(2).all(|w| w[0] < w[1]), "{ts:?}");
         assert_eq!(crossings(last), None);
