@@ -21,13 +21,15 @@ use common::{add_white_floor, black, scene_looking_down_z};
 const PASS: [f64; 5] = [0.0, 0.5, 0.8, 0.5, 0.6];
 
 /// A white floor at z = 0 under two overlapping clear spheres of
-/// different materials, and a third of the first's material in the same
-/// place as the first, lit from the side so that their shadows fall
-/// beside them; a clear pane out of the camera's view lies over part of
-/// the floor and of one shadow. With `walked`, each transmission is a
-/// checker of one colour: the same light, but read at (u, v), so that
-/// shadow rays take the surface-to-surface walk.
-fn floor_under_glass(walked: bool) -> Scene {
+/// different materials, lit from the side so that their shadows fall
+/// beside them, and a third sphere of the first's material: in the same
+/// place as the first with `twin` (the rays through both then take the
+/// walk: a near tie), far out of the way without. A clear pane out of the
+/// camera's view lies over part of the floor and of the first sphere's
+/// shadow. With `walked`, each transmission is a checker of one colour:
+/// the same light, but read at (u, v), so that shadow rays take the
+/// surface-to-surface walk.
+fn floor_under_glass(walked: bool, twin: bool) -> Scene {
     let mut scene = scene_looking_down_z(24, 24, 60.0);
     scene.ambient = Color::splat(0.1);
     add_white_floor(&mut scene);
@@ -51,7 +53,11 @@ fn floor_under_glass(walked: bool) -> Scene {
     let spheres = [
         (Vec3::new(0.2, 0.1, 1.2), first),
         (Vec3::new(-0.4, -0.3, 1.6), second),
-        (Vec3::new(0.2, 0.1, 1.2), first),
+        if twin {
+            (Vec3::new(0.2, 0.1, 1.2), first)
+        } else {
+            (Vec3::new(-40.0, 0.0, 1.2), first)
+        },
     ];
     for (centre, material) in spheres {
         let sphere = Sphere::new(centre, 0.7).unwrap();
@@ -79,13 +85,19 @@ fn shadow_steps(node: &RayNode) -> usize {
 
 #[test]
 fn light_through_clear_surfaces_is_the_product_of_each_crossing_in_order() {
-    let scene = floor_under_glass(false);
-    let output = render(&scene, &|_| {}).unwrap();
+    for twin in [false, true] {
+        product_of_each_crossing_in_order(&floor_under_glass(false, twin));
+    }
+}
+
+/// Checks the shadow rays of `scene`'s floor pixels ([`floor_under_glass`]).
+fn product_of_each_crossing_in_order(scene: &Scene) {
+    let output = render(scene, &|_| {}).unwrap();
     // By spheres' crossings (0, 2 or 4), and whether the pane is crossed.
     let (mut steps, mut crossed) = (0, [[0; 2]; 5]);
     for y in 0..24 {
         for x in 0..24 {
-            let tree = explain_pixel(&scene, (x, y), 0).unwrap().tree;
+            let tree = explain_pixel(scene, (x, y), 0).unwrap().tree;
             steps += shadow_steps(&tree);
             let Some(hit) = tree.hit.as_ref().filter(|h| h.primitive == PrimitiveId(0)) else {
                 continue;
@@ -93,15 +105,15 @@ fn light_through_clear_surfaces_is_the_product_of_each_crossing_in_order() {
             let segments = &hit.lights[0].shadow_rays;
             let (last, crossings) = segments.split_last().unwrap();
             assert_eq!(last.blocker, None, "pixel {x},{y}");
-            // Each step starts where the one before met a sphere.
+            // Each step starts where the one before met a surface.
             let mut expected = Color::ONE;
             let mut from = hit.point;
             for segment in crossings {
-                let (sphere, t) = segment.blocker.unwrap();
+                let (crossed, t) = segment.blocker.unwrap();
                 assert!((segment.origin - from).length() < 1e-9, "pixel {x},{y}");
                 assert!(t > 0.0, "pixel {x},{y}");
                 from = segment.origin + t * segment.direction;
-                expected *= Color::splat(PASS[sphere.0 as usize]);
+                expected *= Color::splat(PASS[crossed.0 as usize]);
             }
             assert!((last.origin - from).length() < 1e-9, "pixel {x},{y}");
             let verdict = hit.lights[0].verdict;
@@ -132,10 +144,13 @@ fn light_through_clear_surfaces_is_the_product_of_each_crossing_in_order() {
 
 #[test]
 fn crossings_and_the_surface_walk_give_the_same_picture_and_shadow_rays() {
-    let crossed = render(&floor_under_glass(false), &|_| {}).unwrap();
-    let walked = render(&floor_under_glass(true), &|_| {}).unwrap();
-    assert_eq!(crossed.image, walked.image);
-    assert_eq!(crossed.rays[RayKind::Shadow], walked.rays[RayKind::Shadow]);
-    // More shadow rays than camera hits: some crossed the spheres.
-    assert!(crossed.rays[RayKind::Shadow] > 24 * 24 + 100);
+    for twin in [false, true] {
+        let crossed = render(&floor_under_glass(false, twin), &|_| {}).unwrap();
+        let walked = render(&floor_under_glass(true, twin), &|_| {}).unwrap();
+        assert_eq!(crossed.image, walked.image, "twin: {twin}");
+        let shadow_rays = crossed.rays[RayKind::Shadow];
+        assert_eq!(shadow_rays, walked.rays[RayKind::Shadow], "twin: {twin}");
+        // More shadow rays than camera hits: some crossed the glass.
+        assert!(shadow_rays > 24 * 24 + 100, "twin: {twin}");
+    }
 }

@@ -456,16 +456,17 @@ impl World<'_> {
     /// [`Shape::is_flat`]) its one hit, found by the walk's own test of
     /// it. `None` when the list is not known or names another kind of
     /// entry, when two primitives' crossings lie within [`NEAR_TIE`] of
-    /// each other (the walk's offset origins then cross one of them only),
-    /// or when there are more than [`ShadowCrossings::CAPACITY`].
+    /// each other (the walk's offset origins then cross one of them only)
+    /// or one lies that near the ray's end, or when there are more than
+    /// [`ShadowCrossings::CAPACITY`].
     ///
     /// [`Sphere::crossings`]: crate::shape::Sphere::crossings
     pub fn shadow_crossings(&self, ray: &Ray, passed: &PassedEntries) -> Option<ShadowCrossings> {
         if !passed.is_listed() {
             return None;
         }
-        // Most lists hold a triangle or none: its shear is made where it
-        // is tested.
+        // A triangle's shear is made where it is tested: most lists hold
+        // one triangle or none.
         let query = Query::new(ray, false);
         let mut inner = QueryContext::default();
         let mut crossings = ShadowCrossings::EMPTY;
@@ -492,6 +493,13 @@ impl World<'_> {
             {
                 return None;
             }
+        }
+        // A crossing at the ray's end (a light in a clear surface) is one
+        // that the walk's steps, whose ends are worked out again from
+        // each offset origin, may or may not reach.
+        let last = crossings.iter().last();
+        if last.is_some_and(|c| c.t >= near_tie(ray.t_max).0) {
+            return None;
         }
         Some(crossings)
     }
@@ -527,7 +535,7 @@ mod tests {
     use crate::accel::AccelKind;
     use crate::math::random::Rng;
     use crate::math::{Transform, Vec3};
-    use crate::shape::{Cylinder, Disk, Parallelogram, Plane, Sphere};
+    use crate::shape::{Cylinder, Disk, Parallelogram, Plane, Polygon, Sphere};
     use crate::world::Objects;
     use crate::world::{scattered_triangles, turned_square};
 
@@ -677,7 +685,8 @@ mod tests {
     #[test]
     fn crossings_are_the_hits_of_the_surface_walk() {
         // Overlapping spheres, a triangle mesh, polygons, parallelograms
-        // and disks (moved), of materials 0 (opaque), 1 and 2 (clear); a
+        // and disks (moved, turned and stretched), of materials 0 (opaque),
+        // 1 and 2 (clear); a
         // clear floor plane (unbounded); and clear cylinders, whose
         // crossings are left to the walk.
         let mut rng = Rng::new(17);
@@ -703,8 +712,11 @@ mod tests {
                 }
                 _ => Shape::Disk(Disk::new(1.0, 0.3 * rng.uniform()).unwrap()),
             };
+            // Disks moved, turned and stretched.
+            let turned = Transform::rotate(rng.unit_vector(), 360.0 * rng.uniform()).unwrap();
+            let stretched = Transform::scale(Vec3::new(1.5, 0.5, 1.0)).unwrap();
             let transform = if i % 4 == 3 {
-                moved
+                moved.then_after(&turned.then_after(&stretched))
             } else {
                 Transform::IDENTITY
             };
@@ -796,6 +808,34 @@ mod tests {
         let one = listed(&[1]).unwrap();
         assert_eq!(one.iter().map(|c| c.t).collect::<Vec<_>>(), [2.0, 4.0]);
         assert_eq!(listed(&[]).map(|c| c.iter().count()), Some(0));
+    }
+
+    #[test]
+    fn a_crossing_at_the_end_of_the_ray_is_left_to_the_walk() {
+        // A clear sphere, then a clear pane in the plane x = 3.
+        let mut objects = Objects::default();
+        let sphere = Sphere::new(Vec3::ZERO, 1.0).unwrap();
+        objects.add_primitive(Shape::Sphere(sphere), MaterialId(1), Transform::IDENTITY);
+        let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
+        let pane = Polygon::new(corners.map(|(y, z)| Vec3::new(3.0, y, z)).to_vec()).unwrap();
+        objects.add_primitive(Shape::Polygon(pane), MaterialId(1), Transform::IDENTITY);
+        let world = World::new(&objects);
+        let opaque = world.opaque_entries(&[true, false]).unwrap();
+        // From x = -5: the pane is 8 along.
+        let crossings = |length: f64| {
+            let ray = Ray::segment(Vec3::new(-5.0, 0.1, 0.2), Vec3::X, length);
+            let path = world.shadow_path(&ray, &opaque, &mut ShadowHint::default());
+            let ShadowPath::Crossed(passed) = path else {
+                panic!("the ray crosses the sphere");
+            };
+            world.shadow_crossings(&ray, &passed)
+        };
+        let count = |length: f64| crossings(length).map(|c| c.iter().count());
+        // Ending before the pane, past it, and just past it (a light in
+        // the pane, as far as the walk's steps can tell).
+        assert_eq!(count(7.5), Some(2));
+        assert_eq!(count(8.001), Some(3));
+        assert_eq!(count(8.0f64.next_up()), None);
     }
 
     #[test]
