@@ -603,6 +603,14 @@ mod tests {
         (kind, hits)
     }
 
+    /// A shadow ray from a random point within `reach` of the origin to a
+    /// random light near `(3, light_y, -4)`.
+    fn shadow_ray(rng: &mut Rng, reach: f64, light_y: f64) -> Ray {
+        let from = reach * rng.unit_vector() * rng.uniform();
+        let light = Vec3::new(3.0, light_y, -4.0) + 4.0 * rng.unit_vector();
+        Ray::segment(from, (light - from).normalize(), (light - from).length())
+    }
+
     /// A [`ShadowPath`] without its entries.
     #[derive(Clone, Copy, Debug, PartialEq, Eq)]
     enum PathKind {
@@ -634,9 +642,7 @@ mod tests {
             let mut seen = [0; 3];
             let mut hint = ShadowHint::NONE;
             for _ in 0..1500 {
-                let from = 12.0 * rng.unit_vector() * rng.uniform();
-                let light = Vec3::new(3.0, 20.0, -4.0) + 4.0 * rng.unit_vector();
-                let ray = Ray::segment(from, (light - from).normalize(), (light - from).length());
+                let ray = shadow_ray(&mut rng, 12.0, 20.0);
                 let path = world.shadow_path(&ray, &opaque, &mut ShadowHint::default());
                 assert_eq!(world.shadow_path(&ray, &opaque, &mut hint), path, "hinted");
                 let (expected, _) = walk(&world, &ray, |r| world.intersect(r));
@@ -660,11 +666,8 @@ mod tests {
             // cylinder.
             let mut seen = [0; 4];
             for i in 0..3000 {
-                let from = 12.0 * rng.unit_vector() * rng.uniform();
                 // Lights above and below the floor at y = -11.
-                let y = if i % 2 == 0 { 20.0 } else { -20.0 };
-                let light = Vec3::new(3.0, y, -4.0) + 4.0 * rng.unit_vector();
-                let ray = Ray::segment(from, (light - from).normalize(), (light - from).length());
+                let ray = shadow_ray(&mut rng, 12.0, if i % 2 == 0 { 20.0 } else { -20.0 });
                 let ShadowPath::Crossed(passed) =
                     world.shadow_path(&ray, &opaque, &mut ShadowHint::default())
                 else {
@@ -737,10 +740,7 @@ mod tests {
             // a flat one, the floor), and left to the walk.
             let mut seen = [0; 6];
             for i in 0..4000 {
-                let from = 10.0 * rng.unit_vector() * rng.uniform();
-                let y = if i % 2 == 0 { 20.0 } else { -20.0 };
-                let light = Vec3::new(3.0, y, -4.0) + 4.0 * rng.unit_vector();
-                let ray = Ray::segment(from, (light - from).normalize(), (light - from).length());
+                let ray = shadow_ray(&mut rng, 10.0, if i % 2 == 0 { 20.0 } else { -20.0 });
                 let ShadowPath::Crossed(passed) =
                     world.shadow_path(&ray, &opaque, &mut ShadowHint::default())
                 else {
