@@ -80,10 +80,10 @@ for f in "${scenes[@]}"; do
     fi
     bp=$(min "$(povray_time "$f")" "$bp")
   done
-  ratio=$(echo "scale=2; $bp / $bw" | bc)
+  ratio=$(echo "scale=4; $bp / $bw" | bc)
   if [ -n "$BEFORE" ]; then
     printf "| %s | %.3f s | %.3f s | %.3f s | %.2fx | %.2fx |\n" "$f" "$bp" "$bb" "$bw" \
-      "$(echo "scale=2; $bp / $bb" | bc)" "$ratio"
+      "$(echo "scale=4; $bp / $bb" | bc)" "$ratio"
   else
     printf "| %s | %.3f s | %.3f s | %.2fx |\n" "$f" "$bp" "$bw" "$ratio"
   fi
