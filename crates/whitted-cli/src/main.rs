@@ -56,13 +56,16 @@ fn main() -> ExitCode {
     if let Err(message) = signals::remove_partial_files_on_signals() {
         note!("warning: {message}; an interrupted render may leave .partial files behind");
     }
-    let result = match cli.command {
+    // A backend asked for by name that is no instruction set, or one the
+    // processor lacks, is refused before any work (the library would use
+    // the widest instead).
+    let result = whitted::accel::Isa::from_environment().and_then(|_| match cli.command {
         Command::Render(args) => render_command::run(&args),
         Command::Bench(args) => bench_command::run(&args),
         Command::Merge(args) => merge_command::run(&args),
         Command::Explain(args) => explain_command::run(&args),
         Command::Serve(args) => serve::run(args),
-    };
+    });
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {

@@ -16,6 +16,8 @@
 //! intersection contexts carry the same hint
 //! (`RTC_INTERSECT_CONTEXT_FLAG_COHERENT` / `INCOHERENT`).
 
+use super::kernel::Backend;
+
 /// How the directions of the rays a caller traces one after the other
 /// relate.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -47,25 +49,38 @@ impl std::ops::AddAssign for TraversalCounters {
     }
 }
 
-/// The context of a query: the caller's hint in, the work done out. A
-/// caller may keep one per thread of queries (`whitted bench` does) or make
-/// a default one per query; the counters add up over the queries made with
-/// it.
+/// The context of a query: the caller's hint and the backend to run with
+/// in, the work done out. A caller may keep one per thread of queries
+/// (`whitted bench` does) or make a default one per query; the counters add
+/// up over the queries made with it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct QueryContext {
     /// How the rays of the queries made with this context relate.
     pub coherence: RayCoherence,
+    /// The instruction set the walks run with ([`Backend::current`] by
+    /// default); every backend gives the same answers.
+    pub backend: Backend,
     /// The work done so far by the queries made with this context.
     pub counters: TraversalCounters,
 }
 
 impl QueryContext {
-    /// A context for rays that relate as `coherence` says, with no work
-    /// counted yet.
+    /// A context for rays that relate as `coherence` says, with the
+    /// current backend and no work counted yet.
     pub fn new(coherence: RayCoherence) -> Self {
         Self {
             coherence,
+            backend: Backend::current(),
             counters: TraversalCounters::default(),
+        }
+    }
+
+    /// A context like this one with no work counted yet: for a query
+    /// within a query (an instance's walk), whose work the caller adds.
+    pub fn fresh(&self) -> Self {
+        Self {
+            counters: TraversalCounters::default(),
+            ..*self
         }
     }
 }

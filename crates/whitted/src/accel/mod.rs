@@ -27,6 +27,8 @@ pub mod bvh;
 mod context;
 pub mod grid;
 pub mod kdtree;
+pub mod kernel;
+mod leaves;
 pub mod linear;
 mod mailbox;
 mod stack;
@@ -38,6 +40,9 @@ pub use bvh::{Bvh, BvhBuildParams};
 pub use context::{QueryContext, RayCoherence, TraversalCounters};
 pub use grid::{Grid, GridBuildParams};
 pub use kdtree::{Clipper, KdTree, KdTreeBuildParams};
+use kernel::Kernel;
+pub use kernel::{Backend, ISA_VARIABLE, Isa};
+pub(crate) use leaves::{AnyLeaves, ClosestLeaves};
 pub use linear::Linear;
 
 use crate::math::{Aabb, Ray};
@@ -277,6 +282,40 @@ impl Accelerator {
             Accelerator::Linear(_) => AccelKind::Linear,
             Accelerator::Grid(_) => AccelKind::Grid,
             Accelerator::KdTree(_) => AccelKind::KdTree,
+        }
+    }
+}
+
+impl Accelerator {
+    /// The closest hit with kernel `K`, the leaves tested by `leaves` (see
+    /// [`AccelerationStructure::intersect_in_leaf_order`]).
+    #[inline(always)]
+    pub(crate) fn closest_with<K: Kernel>(
+        &self,
+        ray: &Ray,
+        ctx: &mut QueryContext,
+        mut leaves: impl ClosestLeaves,
+    ) -> Option<f64> {
+        match self {
+            Accelerator::Bvh(bvh) => bvh.closest_with::<K>(ray, &mut ctx.counters, leaves),
+            other => {
+                other.intersect_in_leaf_order(ray, ctx, |range, t_max| leaves.closest(range, t_max))
+            }
+        }
+    }
+
+    /// Any hit with kernel `K`, the leaves tested by `leaves` (see
+    /// [`AccelerationStructure::occluded_in_leaf_order`]).
+    #[inline(always)]
+    pub(crate) fn any_with<K: Kernel>(
+        &self,
+        ray: &Ray,
+        ctx: &mut QueryContext,
+        mut leaves: impl AnyLeaves,
+    ) -> bool {
+        match self {
+            Accelerator::Bvh(bvh) => bvh.any_with::<K>(ray, &mut ctx.counters, leaves),
+            other => other.occluded_in_leaf_order(ray, ctx, |range| leaves.occludes(range)),
         }
     }
 }

@@ -38,6 +38,7 @@ mod packet_any;
 mod prefetch;
 mod shadow_hint;
 mod shadow_path;
+mod walk;
 
 pub use hit::{Hit, Surface};
 pub use interiors::Interiors;
@@ -50,11 +51,12 @@ pub use shadow_hint::ShadowHint;
 pub use shadow_path::{OpaqueEntries, PassedEntries, ShadowCrossing, ShadowCrossings, ShadowPath};
 
 use crate::accel::{
-    AccelKind, AccelerationStructure, Accelerator, Clipper, KdTree, KdTreeBuildParams, QueryContext,
+    AccelKind, AccelerationStructure, Accelerator, Backend, Clipper, KdTree, KdTreeBuildParams,
+    QueryContext,
 };
 use crate::math::{Aabb, Ray, Transform, Vec3};
 use crate::shape::{Shape, ShapeHit, clipped_triangle_bounds};
-use entry::{Entry, EntryKind, Query, Rest, leaf_hit, leaf_occludes};
+use entry::{Entry, EntryKind, Query, Rest};
 use instance::MeshStructure;
 use prefetch::BIG_MESHES;
 use rayon::prelude::*;
@@ -139,8 +141,10 @@ pub struct World<'a> {
     /// Whether some entry of `entries` is a triangle, so queries compute
     /// the ray's shear up front.
     has_triangles: bool,
-    /// Whether the processor has AVX, so leaves cull runs of spheres four
-    /// at a time, and shadow rays test runs of triangles four at a time.
+    /// Whether the current backend has AVX ([`Backend::current`]), so the
+    /// leaf tests of the walks not yet entered through a kernel (packets,
+    /// shadow paths) cull runs of spheres four at a time, and shadow rays
+    /// test runs of triangles four at a time.
     wide: bool,
     /// The unbounded shapes (infinite planes) and instances of definitions
     /// holding one, tested beside the structure.
@@ -443,10 +447,7 @@ impl<'a> World<'a> {
             .iter()
             .filter(|e| e.kind == EntryKind::Placed)
             .count();
-        #[cfg(target_arch = "x86_64")]
-        let wide = is_x86_feature_detected!("avx");
-        #[cfg(not(target_arch = "x86_64"))]
-        let wide = false;
+        let wide = Backend::current().has_avx();
         let mut world = Self {
             objects,
             shapes: &objects.primitives,
@@ -733,48 +734,6 @@ impl<'a> World<'a> {
         self.closest(&self.definitions, ray, ctx)
     }
 
-    /// The closest hit in this level, its instances placing `definitions`.
-    fn closest(&self, definitions: &[World<'a>], ray: &Ray, ctx: &mut QueryContext) -> Option<Hit> {
-        let query = Query::new(ray, self.has_triangles);
-        let mut best: Option<Hit> = None;
-        let mut t_max = ray.t_max;
-        let mut inner = QueryContext::new(ctx.coherence);
-        for e in &self.unbounded {
-            if let Some((primitive, h)) =
-                self.intersect_other(definitions, e, (&query, t_max, Rest::Test), &mut inner)
-            {
-                t_max = h.t;
-                best = Some(Hit {
-                    primitive: PrimitiveId(primitive),
-                    shape_hit: h,
-                });
-            }
-        }
-        let mut clipped = *ray;
-        clipped.t_max = t_max;
-        self.accel
-            .intersect_in_leaf_order(&clipped, ctx, |range, t_max| {
-                leaf_hit(
-                    &self.entries,
-                    range,
-                    &query,
-                    t_max,
-                    self.wide,
-                    |e, t_max, rest| {
-                        self.intersect_other(definitions, e, (&query, t_max, rest), &mut inner)
-                    },
-                    |primitive, shape_hit| {
-                        best = Some(Hit {
-                            primitive: PrimitiveId(primitive),
-                            shape_hit,
-                        })
-                    },
-                )
-            });
-        ctx.counters += inner.counters;
-        best
-    }
-
     /// True when anything lies in the ray's interval.
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.occluded_with(ray, &mut QueryContext::default())
@@ -784,38 +743,6 @@ impl<'a> World<'a> {
     /// traversal work (of both levels) to its counters.
     pub fn occluded_with(&self, ray: &Ray, ctx: &mut QueryContext) -> bool {
         self.any(&self.definitions, ray, ctx)
-    }
-
-    /// Any hit in this level, its instances placing `definitions`.
-    fn any(&self, definitions: &[World<'a>], ray: &Ray, ctx: &mut QueryContext) -> bool {
-        let query = Query::new(ray, self.has_triangles);
-        let mut inner = QueryContext::new(ctx.coherence);
-        if self
-            .unbounded
-            .iter()
-            .any(|e| self.other_occludes(definitions, e, (&query, Rest::Test), &mut inner))
-        {
-            ctx.counters += inner.counters;
-            return true;
-        }
-        if self.instance_count == 0 {
-            // One level, no instance walk to count apart (tried one path for
-            // both: slower, see docs/performance.md).
-            return self.accel.occluded_in_leaf_order(ray, ctx, |range| {
-                leaf_occludes(&self.entries, range, &query, self.wide, |e, rest| {
-                    self.rest_occludes(e.number, &query, rest)
-                })
-                .is_some()
-            });
-        }
-        let occluded = self.accel.occluded_in_leaf_order(ray, ctx, |range| {
-            leaf_occludes(&self.entries, range, &query, self.wide, |e, rest| {
-                self.other_occludes(definitions, e, (&query, rest), &mut inner)
-            })
-            .is_some()
-        });
-        ctx.counters += inner.counters;
-        occluded
     }
 
     /// The world-space surface at a hit returned for `ray`.

@@ -5,10 +5,12 @@
 //! the walk would run on that entry, and a hint is only ever a guess to try
 //! (a wrong or stale one costs one test).
 
-use crate::accel::{AccelerationStructure, QueryContext};
+use crate::accel::kernel::{self, Kernel, KernelTask};
+use crate::accel::{Backend, Isa, QueryContext};
 use crate::math::Ray;
 use crate::world::World;
-use crate::world::entry::{EntryKind, Query, leaf_occludes};
+use crate::world::entry::{EntryKind, Query};
+use crate::world::walk::AnyInLeaves;
 
 /// The entry that blocked the last shadow ray of one thread towards one
 /// light, if it was one the hinted query can test alone.
@@ -54,6 +56,33 @@ impl World<'_> {
             *hint = ShadowHint::NONE;
             return self.occluded(ray);
         }
+        /// The query as a kernel's task.
+        struct Hinted<'q, 'a> {
+            world: &'q World<'a>,
+            ray: &'q Ray,
+            hint: &'q mut ShadowHint,
+        }
+        impl KernelTask for Hinted<'_, '_> {
+            type Output = bool;
+            #[inline(always)]
+            fn run<K: Kernel>(self) -> bool {
+                self.world.occluded_hinted_with::<K>(self.ray, self.hint)
+            }
+        }
+        let backend = Backend::current();
+        kernel::run(
+            backend,
+            Hinted {
+                world: self,
+                ray,
+                hint,
+            },
+        )
+    }
+
+    /// [`World::occluded_hinted`] with kernel `K`.
+    #[inline(always)]
+    fn occluded_hinted_with<K: Kernel>(&self, ray: &Ray, hint: &mut ShadowHint) -> bool {
         let query = Query::new(ray, self.has_triangles);
         if self.hint_blocks(*hint, &query) {
             return true;
@@ -67,14 +96,15 @@ impl World<'_> {
             return true;
         }
         let mut ctx = QueryContext::default();
-        self.accel.occluded_in_leaf_order(ray, &mut ctx, |range| {
-            let blocker = leaf_occludes(&self.entries, range, &query, self.wide, |e, rest| {
-                self.rest_occludes(e.number, &query, rest)
-            });
-            if let Some(entry) = blocker {
-                *hint = ShadowHint(entry);
-            }
-            blocker.is_some()
-        })
+        let mut inner = ctx.fresh();
+        let leaves = AnyInLeaves::<false> {
+            world: self,
+            definitions: &[],
+            query: &query,
+            wide: K::ISA >= Isa::Avx,
+            inner: &mut inner,
+            blocker: &mut hint.0,
+        };
+        self.accel.any_with::<K>(ray, &mut ctx, leaves)
     }
 }

@@ -34,6 +34,9 @@ mod validate;
 pub use build::{BvhBuildParams, SplitMethod};
 pub use node::{BvhNode, WIDTH};
 pub use packet::PACKET_LANES;
+pub(crate) use slabs::{Halves, SlabTest};
+#[cfg(target_arch = "x86_64")]
+pub(crate) use slabs_avx::Avx as SlabsAvx;
 
 use super::AccelStats;
 use crate::math::Aabb;

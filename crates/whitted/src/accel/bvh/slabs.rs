@@ -70,7 +70,7 @@ impl Planes {
 }
 
 /// A way to run the slab test of a node's children for one ray.
-pub(super) trait SlabTest {
+pub(crate) trait SlabTest {
     /// Prepares the test for `ray` (its [`Planes`]).
     fn new(ray: &Ray) -> Self;
 
@@ -103,7 +103,7 @@ fn min_keeping(a: Vec4, b: Vec4) -> Vec4 {
 }
 
 /// The test on two halves of four lanes.
-pub(super) struct Halves {
+pub(crate) struct Halves {
     entry_origin: [Vec4; 3],
     exit_origin: [Vec4; 3],
     inv_dir: [Vec4; 3],

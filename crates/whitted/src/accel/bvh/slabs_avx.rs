@@ -22,7 +22,7 @@ use crate::math::apart::coordinates_apart;
 use crate::math::{Ray, Vec3};
 
 /// The test on one AVX register.
-pub(super) struct Avx {
+pub(crate) struct Avx {
     entry_origin: [__m256; 3],
     exit_origin: [__m256; 3],
     inv_dir: [__m256; 3],

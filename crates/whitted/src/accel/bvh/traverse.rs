@@ -85,12 +85,11 @@
 use std::ops::Range;
 
 use super::node::{BvhNode, WIDTH, round_up};
-use super::slabs::{Halves, SlabTest};
-#[cfg(target_arch = "x86_64")]
-use super::slabs_avx::Avx;
+use super::slabs::SlabTest;
 use super::{Bvh, MAX_DEPTH};
+use crate::accel::kernel::{self, Kernel, KernelTask};
 use crate::accel::stack::Stack;
-use crate::accel::{QueryContext, TraversalCounters};
+use crate::accel::{AnyLeaves, ClosestLeaves, QueryContext, TraversalCounters};
 use crate::math::Ray;
 
 /// Entries the stack needs for a tree whose leaves lie at most `depth` deep:
@@ -154,7 +153,7 @@ impl Bvh {
         ctx: &mut QueryContext,
         mut hit: impl FnMut(u32, f64) -> Option<f64>,
     ) -> Option<f64> {
-        self.intersect_in_leaf_order(ray, ctx, |entries, mut t_max| {
+        self.intersect_in_leaf_order(ray, ctx, |entries: Range<u32>, mut t_max| {
             let mut found = None;
             for entry in entries {
                 if let Some(t) = hit(self.indices[entry as usize], t_max) {
@@ -178,44 +177,48 @@ impl Bvh {
         ctx: &mut QueryContext,
         hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
     ) -> Option<f64> {
-        let counters = &mut ctx.counters;
+        /// The walk as a kernel's task.
+        struct Closest<'q, L> {
+            bvh: &'q Bvh,
+            ray: &'q Ray,
+            counters: &'q mut TraversalCounters,
+            leaves: L,
+        }
+        impl<L: ClosestLeaves> KernelTask for Closest<'_, L> {
+            type Output = Option<f64>;
+            #[inline(always)]
+            fn run<K: Kernel>(self) -> Option<f64> {
+                self.bvh
+                    .closest_with::<K>(self.ray, self.counters, self.leaves)
+            }
+        }
+        let task = Closest {
+            bvh: self,
+            ray,
+            counters: &mut ctx.counters,
+            leaves: hit,
+        };
+        kernel::run(ctx.backend, task)
+    }
+
+    /// [`Self::intersect_in_leaf_order`] with kernel `K`, the leaves tested
+    /// by `leaves`, adding the work to `counters`.
+    #[inline(always)]
+    pub(crate) fn closest_with<K: Kernel>(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        leaves: impl ClosestLeaves,
+    ) -> Option<f64> {
         if self.nodes.is_empty() {
             None
         } else if self.max_depth <= SHALLOW {
-            self.closest_on_this_cpu::<{ stack_size(SHALLOW) }>(ray, counters, hit)
+            self.closest::<{ stack_size(SHALLOW) }, K::Slabs>(ray, counters, leaves)
         } else if self.max_depth <= MIDDLE {
-            self.closest_on_this_cpu::<{ stack_size(MIDDLE) }>(ray, counters, hit)
+            self.closest::<{ stack_size(MIDDLE) }, K::Slabs>(ray, counters, leaves)
         } else {
-            self.closest_on_this_cpu::<{ stack_size(MAX_DEPTH) }>(ray, counters, hit)
+            self.closest::<{ stack_size(MAX_DEPTH) }, K::Slabs>(ray, counters, leaves)
         }
-    }
-
-    /// [`Self::closest`] with the widest slab test this processor has.
-    #[inline(always)]
-    fn closest_on_this_cpu<const N: usize>(
-        &self,
-        ray: &Ray,
-        counters: &mut TraversalCounters,
-        hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
-    ) -> Option<f64> {
-        #[cfg(target_arch = "x86_64")]
-        if is_x86_feature_detected!("avx") {
-            // SAFETY: the processor has AVX.
-            return unsafe { self.closest_avx::<N>(ray, counters, hit) };
-        }
-        self.closest::<N, Halves>(ray, counters, hit)
-    }
-
-    /// [`Self::closest`] with AVX, compiled for it.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx")]
-    fn closest_avx<const N: usize>(
-        &self,
-        ray: &Ray,
-        counters: &mut TraversalCounters,
-        hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
-    ) -> Option<f64> {
-        self.closest::<N, Avx>(ray, counters, hit)
     }
 
     /// [`Self::intersect_in_leaf_order`] with a stack of `N` entries and
@@ -225,7 +228,7 @@ impl Bvh {
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
-        mut hit: impl FnMut(Range<u32>, f64) -> Option<f64>,
+        mut leaves: impl ClosestLeaves,
     ) -> Option<f64> {
         let slabs = S::new(ray);
         let mut closest = ray.t_max;
@@ -239,7 +242,9 @@ impl Bvh {
             let first = current.child as usize;
             if current.count > 0 {
                 work.primitives += u64::from(current.count);
-                if let Some(t) = hit(current.child..current.child + current.count, closest) {
+                if let Some(t) =
+                    leaves.closest(current.child..current.child + current.count, closest)
+                {
                     closest = t;
                     found = Some(t);
                     far = round_up(closest);
@@ -291,7 +296,7 @@ impl Bvh {
         ctx: &mut QueryContext,
         mut occludes: impl FnMut(u32) -> bool,
     ) -> bool {
-        self.occluded_in_leaf_order(ray, ctx, |mut entries| {
+        self.occluded_in_leaf_order(ray, ctx, |mut entries: Range<u32>| {
             entries.any(|entry| occludes(self.indices[entry as usize]))
         })
     }
@@ -308,44 +313,47 @@ impl Bvh {
         ctx: &mut QueryContext,
         occludes: impl FnMut(Range<u32>) -> bool,
     ) -> bool {
-        let counters = &mut ctx.counters;
+        /// The walk as a kernel's task.
+        struct Any<'q, L> {
+            bvh: &'q Bvh,
+            ray: &'q Ray,
+            counters: &'q mut TraversalCounters,
+            leaves: L,
+        }
+        impl<L: AnyLeaves> KernelTask for Any<'_, L> {
+            type Output = bool;
+            #[inline(always)]
+            fn run<K: Kernel>(self) -> bool {
+                self.bvh.any_with::<K>(self.ray, self.counters, self.leaves)
+            }
+        }
+        let task = Any {
+            bvh: self,
+            ray,
+            counters: &mut ctx.counters,
+            leaves: occludes,
+        };
+        kernel::run(ctx.backend, task)
+    }
+
+    /// [`Self::occluded_in_leaf_order`] with kernel `K`, the leaves tested
+    /// by `leaves`, adding the work to `counters`.
+    #[inline(always)]
+    pub(crate) fn any_with<K: Kernel>(
+        &self,
+        ray: &Ray,
+        counters: &mut TraversalCounters,
+        leaves: impl AnyLeaves,
+    ) -> bool {
         if self.nodes.is_empty() {
             false
         } else if self.max_depth <= SHALLOW {
-            self.any_on_this_cpu::<{ stack_size(SHALLOW) }>(ray, counters, occludes)
+            self.any::<{ stack_size(SHALLOW) }, K::Slabs>(ray, counters, leaves)
         } else if self.max_depth <= MIDDLE {
-            self.any_on_this_cpu::<{ stack_size(MIDDLE) }>(ray, counters, occludes)
+            self.any::<{ stack_size(MIDDLE) }, K::Slabs>(ray, counters, leaves)
         } else {
-            self.any_on_this_cpu::<{ stack_size(MAX_DEPTH) }>(ray, counters, occludes)
+            self.any::<{ stack_size(MAX_DEPTH) }, K::Slabs>(ray, counters, leaves)
         }
-    }
-
-    /// [`Self::any`] with the widest slab test this processor has.
-    #[inline(always)]
-    fn any_on_this_cpu<const N: usize>(
-        &self,
-        ray: &Ray,
-        counters: &mut TraversalCounters,
-        occludes: impl FnMut(Range<u32>) -> bool,
-    ) -> bool {
-        #[cfg(target_arch = "x86_64")]
-        if is_x86_feature_detected!("avx") {
-            // SAFETY: the processor has AVX.
-            return unsafe { self.any_avx::<N>(ray, counters, occludes) };
-        }
-        self.any::<N, Halves>(ray, counters, occludes)
-    }
-
-    /// [`Self::any`] with AVX, compiled for it.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx")]
-    fn any_avx<const N: usize>(
-        &self,
-        ray: &Ray,
-        counters: &mut TraversalCounters,
-        occludes: impl FnMut(Range<u32>) -> bool,
-    ) -> bool {
-        self.any::<N, Avx>(ray, counters, occludes)
     }
 
     /// [`Self::occluded_in_leaf_order`] with a stack of `N` entries and the
@@ -355,7 +363,7 @@ impl Bvh {
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
-        mut occludes: impl FnMut(Range<u32>) -> bool,
+        mut leaves: impl AnyLeaves,
     ) -> bool {
         let slabs = S::new(ray);
         let far = round_up(ray.t_max);
@@ -367,7 +375,7 @@ impl Bvh {
             let first = current.child as usize;
             if current.count > 0 {
                 work.primitives += u64::from(current.count);
-                if occludes(current.child..current.child + current.count) {
+                if leaves.occludes(current.child..current.child + current.count) {
                     break true;
                 }
             } else if let Some(node) = self.nodes.get(first) {
@@ -398,7 +406,8 @@ impl Bvh {
 
 #[cfg(test)]
 mod tests {
-    use super::{Halves, MAX_DEPTH, stack_size};
+    use super::super::slabs::Halves;
+    use super::{MAX_DEPTH, stack_size};
     use crate::accel::{Bvh, Linear, QueryContext, TraversalCounters};
     use crate::math::random::Rng;
     use crate::math::{Aabb, Ray, Vec3};

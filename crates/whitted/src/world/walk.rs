@@ -1,0 +1,296 @@
+//! The world's closest-hit and any-hit walks as kernel tasks
+//! ([`crate::accel::kernel`]): a query enters its kernel once, and the
+//! structure's walk and the leaf tests here (triangles, spheres and the
+//! other entries' tests in place) are compiled together under its target
+//! features. What is left to the world's tables (a shape's whole test, an
+//! instance's own walk) stays a call.
+
+use std::ops::Range;
+
+use super::entry::{Query, leaf_hit, leaf_occludes};
+use super::{Hit, PrimitiveId, World};
+use crate::accel::kernel::{self, Kernel, KernelTask};
+use crate::accel::{AnyLeaves, ClosestLeaves, Isa, QueryContext};
+use crate::math::Ray;
+
+impl<'a> World<'a> {
+    /// The closest hit in this level, its instances placing `definitions`.
+    pub(super) fn closest(
+        &self,
+        definitions: &[World<'a>],
+        ray: &Ray,
+        ctx: &mut QueryContext,
+    ) -> Option<Hit> {
+        /// The query as a kernel's task.
+        struct Closest<'q, 'a> {
+            world: &'q World<'a>,
+            definitions: &'q [World<'a>],
+            ray: &'q Ray,
+            ctx: &'q mut QueryContext,
+        }
+        impl KernelTask for Closest<'_, '_> {
+            type Output = Option<Hit>;
+            #[inline(always)]
+            fn run<K: Kernel>(self) -> Option<Hit> {
+                self.world
+                    .closest_with::<K>(self.definitions, self.ray, self.ctx)
+            }
+        }
+        let backend = ctx.backend;
+        let task = Closest {
+            world: self,
+            definitions,
+            ray,
+            ctx,
+        };
+        kernel::run(backend, task)
+    }
+
+    /// [`World::closest`] with kernel `K`.
+    #[inline(always)]
+    fn closest_with<K: Kernel>(
+        &self,
+        definitions: &[World<'a>],
+        ray: &Ray,
+        ctx: &mut QueryContext,
+    ) -> Option<Hit> {
+        let query = Query::new(ray, self.has_triangles);
+        let mut best: Option<Hit> = None;
+        let mut t_max = ray.t_max;
+        let mut inner = ctx.fresh();
+        for e in &self.unbounded {
+            if let Some((primitive, h)) = self.intersect_other(
+                definitions,
+                e,
+                (&query, t_max, super::entry::Rest::Test),
+                &mut inner,
+            ) {
+                t_max = h.t;
+                best = Some(Hit {
+                    primitive: PrimitiveId(primitive),
+                    shape_hit: h,
+                });
+            }
+        }
+        let mut clipped = *ray;
+        clipped.t_max = t_max;
+        let leaves = ClosestInLeaves {
+            world: self,
+            definitions,
+            query: &query,
+            wide: K::ISA >= Isa::Avx,
+            best: &mut best,
+            inner: &mut inner,
+        };
+        self.accel.closest_with::<K>(&clipped, ctx, leaves);
+        ctx.counters += inner.counters;
+        best
+    }
+
+    /// True when anything lies in the ray's interval in this level, its
+    /// instances placing `definitions`.
+    pub(super) fn any(&self, definitions: &[World<'a>], ray: &Ray, ctx: &mut QueryContext) -> bool {
+        /// The query as a kernel's task.
+        struct Any<'q, 'a> {
+            world: &'q World<'a>,
+            definitions: &'q [World<'a>],
+            ray: &'q Ray,
+            ctx: &'q mut QueryContext,
+        }
+        impl KernelTask for Any<'_, '_> {
+            type Output = bool;
+            #[inline(always)]
+            fn run<K: Kernel>(self) -> bool {
+                self.world
+                    .any_with::<K>(self.definitions, self.ray, self.ctx)
+            }
+        }
+        let backend = ctx.backend;
+        let task = Any {
+            world: self,
+            definitions,
+            ray,
+            ctx,
+        };
+        kernel::run(backend, task)
+    }
+
+    /// [`World::any`] with kernel `K`.
+    #[inline(always)]
+    fn any_with<K: Kernel>(
+        &self,
+        definitions: &[World<'a>],
+        ray: &Ray,
+        ctx: &mut QueryContext,
+    ) -> bool {
+        let query = Query::new(ray, self.has_triangles);
+        let mut inner = ctx.fresh();
+        if self.unbounded.iter().any(|e| {
+            self.other_occludes(
+                definitions,
+                e,
+                (&query, super::entry::Rest::Test),
+                &mut inner,
+            )
+        }) {
+            ctx.counters += inner.counters;
+            return true;
+        }
+        let wide = K::ISA >= Isa::Avx;
+        if self.instance_count == 0 {
+            // One level, no instance walk to count apart (tried one path for
+            // both: slower, see docs/performance.md).
+            let leaves = AnyInLeaves::<false> {
+                world: self,
+                definitions,
+                query: &query,
+                wide,
+                inner: &mut inner,
+                blocker: &mut 0,
+            };
+            return self.accel.any_with::<K>(ray, ctx, leaves);
+        }
+        let leaves = AnyInLeaves::<true> {
+            world: self,
+            definitions,
+            query: &query,
+            wide,
+            inner: &mut inner,
+            blocker: &mut 0,
+        };
+        let occluded = self.accel.any_with::<K>(ray, ctx, leaves);
+        ctx.counters += inner.counters;
+        occluded
+    }
+}
+
+/// The closest-hit test of a leaf of the world's entries: the hits nearer
+/// than the walk's go to `best`, instances' work to `inner`.
+struct ClosestInLeaves<'q, 'a> {
+    world: &'q World<'a>,
+    definitions: &'q [World<'a>],
+    query: &'q Query<'q>,
+    /// Whether the kernel has AVX's `f64` lanes.
+    wide: bool,
+    best: &'q mut Option<Hit>,
+    inner: &'q mut QueryContext,
+}
+
+impl ClosestLeaves for ClosestInLeaves<'_, '_> {
+    #[inline(always)]
+    fn closest(&mut self, range: Range<u32>, t_max: f64) -> Option<f64> {
+        let (world, definitions, query) = (self.world, self.definitions, self.query);
+        let inner = &mut *self.inner;
+        let best = &mut *self.best;
+        leaf_hit(
+            &world.entries,
+            range,
+            query,
+            t_max,
+            self.wide,
+            |e, t_max, rest| world.intersect_other(definitions, e, (query, t_max, rest), inner),
+            |primitive, shape_hit| {
+                *best = Some(Hit {
+                    primitive: PrimitiveId(primitive),
+                    shape_hit,
+                })
+            },
+        )
+    }
+}
+
+/// The any-hit test of a leaf of the world's entries, which leaves the
+/// entry found in `blocker`; with `INSTANCES`, entries walked as instances
+/// count their work in `inner`.
+pub(super) struct AnyInLeaves<'q, 'a, const INSTANCES: bool> {
+    pub(super) world: &'q World<'a>,
+    pub(super) definitions: &'q [World<'a>],
+    pub(super) query: &'q Query<'q>,
+    /// Whether the kernel has AVX's `f64` lanes.
+    pub(super) wide: bool,
+    pub(super) inner: &'q mut QueryContext,
+    /// The position in the world's entries of the entry found, if one was.
+    pub(super) blocker: &'q mut u32,
+}
+
+impl<const INSTANCES: bool> AnyLeaves for AnyInLeaves<'_, '_, INSTANCES> {
+    #[inline(always)]
+    fn occludes(&mut self, range: Range<u32>) -> bool {
+        let (world, definitions, query) = (self.world, self.definitions, self.query);
+        let inner = &mut *self.inner;
+        let found = leaf_occludes(&world.entries, range, query, self.wide, |e, rest| {
+            if INSTANCES {
+                world.other_occludes(definitions, e, (query, rest), inner)
+            } else {
+                world.rest_occludes(e.number, query, rest)
+            }
+        });
+        if let Some(entry) = found {
+            *self.blocker = entry;
+        }
+        found.is_some()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::accel::{AccelKind, Backend, Isa, QueryContext};
+    use crate::math::random::Rng;
+    use crate::math::{Ray, Transform, Vec3};
+    use crate::mesh::TriangleMesh;
+    use crate::world::packet::tests::closed_form_scene;
+    use crate::world::{MaterialId, ShadowHint, World};
+
+    /// Every backend this processor runs finds the same closest hits (the
+    /// primitive and `t` bit for bit), the same any-hit answers and the
+    /// same work as the portable one, on every structure, in worlds of
+    /// spheres, polygons, moved cylinders, a triangle soup, a mesh placed
+    /// twice (instances) and a floor plane; the shadow cache's answers
+    /// are the any-hit query's.
+    #[test]
+    fn every_backend_answers_as_the_portable_one() {
+        let mut rng = Rng::new(46);
+        let portable = Backend::new(Isa::Sse2).unwrap();
+        let mut compared = 0;
+        for floor in [false, true] {
+            let mut objects = closed_form_scene(&mut rng, floor);
+            let positions: Vec<Vec3> = (0..90)
+                .map(|_| rng.point_in(Vec3::splat(-1.0), Vec3::splat(1.0)))
+                .collect();
+            let triangles: Vec<[u32; 3]> = (0..30).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+            let mesh = objects.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
+            for offset in [Vec3::new(2.0, 0.0, 1.0), Vec3::new(-2.0, 1.0, 0.0)] {
+                let moved = Transform::translate(offset).unwrap();
+                objects.add_mesh_instance(mesh, MaterialId(0), moved);
+            }
+            for kind in AccelKind::ALL {
+                let world = World::build(&objects, kind);
+                let mut hint = ShadowHint::NONE;
+                for _ in 0..400 {
+                    let origin = rng.point_in(Vec3::splat(-6.0), Vec3::splat(6.0));
+                    let towards = rng.point_in(Vec3::splat(-3.0), Vec3::splat(3.0));
+                    let mut ray = Ray::new(origin, towards - origin);
+                    if rng.below(2) == 0 {
+                        ray.t_max = rng.range(0.2, 1.0);
+                    }
+                    let answers = |backend: Backend| {
+                        let mut ctx = QueryContext {
+                            backend,
+                            ..QueryContext::default()
+                        };
+                        let hit = world.intersect_with(&ray, &mut ctx);
+                        let hit = hit.map(|h| (h.primitive, h.t().to_bits()));
+                        (hit, world.occluded_with(&ray, &mut ctx), ctx.counters)
+                    };
+                    let expected = answers(portable);
+                    for backend in Backend::available() {
+                        assert_eq!(answers(backend), expected, "{kind:?} {backend:?} {ray:?}");
+                        compared += 1;
+                    }
+                    assert_eq!(world.occluded_hinted(&ray, &mut hint), expected.1);
+                }
+            }
+        }
+        assert!(compared >= 8 * 400, "{compared}");
+    }
+}
