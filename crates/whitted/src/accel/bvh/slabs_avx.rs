@@ -1,5 +1,5 @@
 //! The slab test of `slabs` on one eight-lane AVX register, for processors
-//! that have AVX (checked at run time by the walk's caller): the same
+//! that have AVX (the AVX kernels of `accel/kernel.rs` use it): the same
 //! operations in the same order as [`Halves`](super::slabs::Halves), so the
 //! two agree bit for bit (`vmaxps`/`vminps` keep the second operand when
 //! the first is NaN, as `maxps`/`minps` do). Its set-up computes the ray's
@@ -184,8 +184,8 @@ impl Avx {
 impl SlabTest for Avx {
     #[inline(always)]
     fn new(ray: &Ray) -> Self {
-        // SAFETY: an `Avx` is made only by walks entered after
-        // `is_x86_feature_detected!("avx")` (see `traverse`).
+        // SAFETY: an `Avx` is made only by the walks of the AVX kernels,
+        // entered through a backend the processor runs (accel/kernel.rs).
         unsafe { Self::prepare(ray) }
     }
 

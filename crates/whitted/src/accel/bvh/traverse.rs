@@ -1,8 +1,10 @@
 //! Ray queries: an iterative walk over the eight-wide nodes with a fixed
 //! stack, testing a node's child boxes at once in `f32` SIMD (`slabs`: one
-//! AVX register where the processor has AVX, checked at run time, two SSE
-//! halves otherwise); the closest-hit query visits the children the ray
-//! meets nearest first.
+//! AVX register with the AVX kernels, two SSE halves otherwise; the kernel
+//! is chosen once per query, `accel/kernel.rs`); the closest-hit query
+//! visits the children the ray meets nearest first. The leaves are the
+//! caller's policy ([`ClosestLeaves`], [`AnyLeaves`]), inlined into the
+//! walk.
 //!
 //! # Why the `f32` test never culls a box the `f64` ray meets
 //!
