@@ -1078,12 +1078,10 @@ mod tests {
         );
     }
 
-    /// Whether the processor has AVX, which the packet walk needs.
+    /// Whether the current backend has AVX, which the packet walk needs
+    /// (`WHITTED_ISA=sse2` turns it off).
     fn has_avx() -> bool {
-        #[cfg(target_arch = "x86_64")]
-        return is_x86_feature_detected!("avx");
-        #[cfg(not(target_arch = "x86_64"))]
-        false
+        crate::accel::Backend::current().has_avx()
     }
 
     #[test]

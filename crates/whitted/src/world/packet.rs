@@ -308,12 +308,10 @@ pub(super) mod tests {
     use crate::shape::{Cylinder, Plane, Polygon, Shape, Sphere, Torus};
     use crate::world::{MaterialId, Objects};
 
-    /// Whether the processor has AVX, which the packet walk needs.
+    /// Whether the current backend has AVX, which the packet walk needs
+    /// (`WHITTED_ISA=sse2` turns it off).
     pub(in crate::world) fn has_avx() -> bool {
-        #[cfg(target_arch = "x86_64")]
-        return is_x86_feature_detected!("avx");
-        #[cfg(not(target_arch = "x86_64"))]
-        false
+        crate::accel::Backend::current().has_avx()
     }
 
     /// Spheres, a triangle soup placed once, polygons, capped cylinders
