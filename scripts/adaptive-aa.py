@@ -7,7 +7,7 @@ reference, with the camera rays and times of both.
                            [--min-depth M] [--threads T] [--scenes DIR]
                            [--spd NAME ...] [--only NAME ...]
 
-The defaults are the setting docs/performance.md reports (512x512,
+The defaults are the setting docs/performance-log.md reports (512x512,
 threshold 0.1, depth 4, minimum depth 1) on balls, gears and teapot from
 ../shared/scenes/spd; `--spd` names other SPD scenes.
 

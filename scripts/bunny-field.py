@@ -12,7 +12,7 @@ one OBJ file beside the scene (N=100: 6.9 million triangles, ~400 MB of
 text), which the scene defines and places once where it was modelled: one
 structure over every triangle, the comparison for the instanced render.
 The same seed gives the same field either way. Nothing written here belongs
-in the repository. Figures and commands: docs/performance.md (instancing).
+in the repository. Figures and commands: docs/performance-log.md (instancing).
 """
 
 import argparse

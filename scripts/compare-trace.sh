@@ -10,7 +10,7 @@
 #
 # Build both binaries with the same profile: a build with debug info lays
 # the code out differently, and that alone moved whitted.toml's trace by 2
-# to 7% (docs/performance.md, 2026-11-29 afternoon).
+# to 7% (docs/performance-log.md, 2026-11-29 afternoon).
 #
 # Run from the repository root:
 #   OLD=/tmp/whitted-old N=9 scripts/compare-trace.sh tree balls

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes a TOML scene with every CSG object replaced by its solids placed as
 plain objects (same shapes, materials and transforms; not the same picture),
-the comparison for CSG's cost in docs/performance.md:
+the comparison for CSG's cost in docs/performance-log.md:
 
     python3 scripts/csg-flattened.py scenes/csg.toml > /tmp/csg-flattened.toml
     whitted render scenes/csg.toml --threads 1 -o /tmp/csg.png

@@ -5,7 +5,7 @@
 //! measurement), both after the same move of the ray's origin
 //! near the centre. The ray families are those of the accuracy comparison
 //! in the torus's tests (near and far cameras, through the hole, grazing,
-//! spindle tori); the figures are in docs/performance.md ("Torus solvers").
+//! spindle tori); the figures are in docs/performance-log.md ("Torus solvers").
 //!
 //! `cargo bench -p whitted --bench torus_solver`.
 

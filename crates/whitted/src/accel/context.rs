@@ -12,7 +12,7 @@
 //! bounces) do not, and the walk waits on mispredicted branches. For those
 //! the kd-tree first goes down to the origin's leaf, branching on the
 //! origin's side of each plane instead, which neighbouring origins share
-//! (docs/performance.md, kd-tree descent to the origin's leaf). Embree's
+//! (docs/performance-log.md, kd-tree descent to the origin's leaf). Embree's
 //! intersection contexts carry the same hint
 //! (`RTC_INTERSECT_CONTEXT_FLAG_COHERENT` / `INCOHERENT`).
 

@@ -102,7 +102,7 @@ pub fn trace_all(world: &World, set: &RaySet, walk: Walk) -> (TraceResults, Trav
 ///
 /// Each thread takes the next 256 rays from a shared counter until
 /// none are left, as the anchor harness hands out its tiles (tried rayon's
-/// `par_chunks`: scaled worse, see docs/performance.md).
+/// `par_chunks`: scaled worse, see docs/performance-log.md).
 pub fn time_set(
     world: &World,
     set: &RaySet,

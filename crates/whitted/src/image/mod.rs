@@ -205,7 +205,7 @@ impl Film {
     /// write; a render maps it here, before the trace and on all its
     /// threads, rather than at each tile's first write, which is made
     /// under the lock that gathers the tiles (a fifth of the threads' time
-    /// on a quick render, docs/performance.md). Where the system has them,
+    /// on a quick render, docs/performance-log.md). Where the system has them,
     /// the film asks for 2 MiB pages first ([`advise_huge_pages`]).
     pub fn map_pages(&mut self) {
         /// One 4 KiB page of values.

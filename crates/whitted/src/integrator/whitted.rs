@@ -167,7 +167,7 @@ impl<'a> Whitted<'a> {
     /// together, see [`World::intersect_packet`]). A miss is answered
     /// inline, so that its colour reaches the caller in registers (a
     /// result returned through memory field by field and read back whole
-    /// waited on failed store forwarding, see docs/performance.md).
+    /// waited on failed store forwarding, see docs/performance-log.md).
     #[inline]
     pub fn shade_camera_hit<O: RayObserver>(
         &self,

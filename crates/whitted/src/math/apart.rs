@@ -5,7 +5,7 @@
 //! merged the reads of two or three coordinates into one wide load, that
 //! load could not take its bytes from the narrower stores still waiting to
 //! be written (store forwarding fails) and waited for them (the BVH walk's
-//! set-up and the triangles' shear on small meshes: docs/performance.md).
+//! set-up and the triangles' shear on small meshes: docs/performance-log.md).
 //! A load of one coordinate is forwarded from the store that wrote it,
 //! whatever its width.
 

@@ -423,7 +423,7 @@ fn trace_pixels(
     // left: a thread that finishes early takes more, so both cores stay
     // busy to the last tile. (Rayon's `for_each` over the list splits it
     // into a few long runs up front: on mount one thread sat idle for a
-    // third of the render, see docs/performance.md.)
+    // third of the render, see docs/performance-log.md.)
     let next_tile = AtomicUsize::new(0);
     pool.broadcast(|_| {
         while let Some(&index) = tiles.get(next_tile.fetch_add(1, Ordering::Relaxed)) {

@@ -117,7 +117,7 @@ impl Light {
     ///
     /// The arms give a direction, a distance and a factor on the light's
     /// intensity, and one sample is built after them: samples built in each
-    /// arm met in memory, a stall (docs/performance.md).
+    /// arm met in memory, a stall (docs/performance-log.md).
     #[inline(always)]
     pub fn sample(&self, p: Vec3) -> Option<LightSample> {
         let (to_light, distance, intensity, factor) = match self {
@@ -214,7 +214,7 @@ pub fn direct_samples(lights: &[Light], p: Vec3) -> DirectSamples<'_> {
 
 /// The iterator [`direct_samples`] returns: a loop over the lights and
 /// each light's samples written out, which costs less per shaded point
-/// than the nested iterator adapters it replaced (docs/performance.md).
+/// than the nested iterator adapters it replaced (docs/performance-log.md).
 #[derive(Clone, Debug)]
 pub struct DirectSamples<'l> {
     lights: &'l [Light],

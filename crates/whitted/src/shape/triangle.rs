@@ -168,7 +168,7 @@ impl RayShear {
 pub fn watertight(p0: Vec3, p1: Vec3, p2: Vec3, ray: &Ray, shear: &RayShear) -> Option<ShapeHit> {
     // One copy per permutation, so the axes are constants: indexing the
     // vertices by a run-time axis took more instructions (figures in
-    // docs/performance.md, one-triangle test).
+    // docs/performance-log.md, one-triangle test).
     match shear.kz {
         0 => watertight_permuted::<1, 2, 0>(p0, p1, p2, ray, shear),
         1 => watertight_permuted::<2, 0, 1>(p0, p1, p2, ray, shear),
@@ -197,7 +197,7 @@ fn watertight_permuted<const KX: usize, const KY: usize, const KZ: usize>(
     // edge shared with a neighbour gives the same value, negated, there.
     // Their signs are combined with `|` and `&`, not `||` and `&&`: one
     // branch per triangle, mostly a predictable miss, instead of one per
-    // sign (faster with both structures: docs/performance.md, one-triangle
+    // sign (faster with both structures: docs/performance-log.md, one-triangle
     // test).
     let e0 = b.x * c.y - b.y * c.x;
     let e1 = c.x * a.y - c.y * a.x;

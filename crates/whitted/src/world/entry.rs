@@ -57,7 +57,7 @@ pub(super) enum EntryKind {
 /// triangle, its corners; for a sphere, its centre and radius (as the
 /// first corner and the second's x), so that its test reads no other
 /// table. The number shares the corners' 80 bytes, so a hit
-/// reads it from the cache line its test read (docs/performance.md, world
+/// reads it from the cache line its test read (docs/performance-log.md, world
 /// entries and preparation, has the figures for this layout).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Entry {
@@ -288,7 +288,7 @@ pub(super) fn intersect_triangle(
 /// culled at once and only the spheres kept are tested, one by one in
 /// order, so the answers are those of one by one. Triangles are tested one
 /// at a time: tried testing runs of them four at a time as
-/// [`leaf_occludes`] does: slower, see docs/performance.md (four-at-once
+/// [`leaf_occludes`] does: slower, see docs/performance-log.md (four-at-once
 /// triangle test).
 #[inline(always)]
 pub(super) fn leaf_hit(

@@ -379,7 +379,7 @@ impl<'a> World<'a> {
         // place too, with no trip to the primitive table (shells, some 60
         // sphere tests per camera ray: 1.3x faster). A mesh triangle is
         // found from its slot's offset in its run (tried tables of slots:
-        // slower, see docs/performance.md, world entries and preparation).
+        // slower, see docs/performance-log.md, world entries and preparation).
         let shape_slots = slot_shapes.len() as u32;
         let slot_entry = |slot: u32| {
             if slot < shape_slots {
@@ -434,7 +434,7 @@ impl<'a> World<'a> {
         );
         // Gathered straight from the objects, in parallel, in the order the
         // queries name them (tried copying them in slot order first: slower,
-        // see docs/performance.md).
+        // see docs/performance-log.md).
         let order = accel.leaf_order();
         let count = order.map_or(boxes.len(), <[u32]>::len);
         let entries: Vec<Entry> = (0..count)

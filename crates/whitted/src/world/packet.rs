@@ -18,7 +18,7 @@
 //! each hit as [`leaf_hit`] ends it, so each gets what its own loop would
 //! get. Not in worlds of meshes of 200k triangles or more, whose
 //! triangles, under a pixel, seldom meet several lanes: the test across
-//! them was slower there (docs/performance.md).
+//! them was slower there (docs/performance-log.md).
 
 #[cfg(target_arch = "x86_64")]
 use std::ops::Range;

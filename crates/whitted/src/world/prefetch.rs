@@ -1,6 +1,6 @@
 //! Loading what the surfaces of hits will read before they are shaded,
 //! where that is likely a cache miss: the triangles of meshes too big for
-//! the caches (docs/performance.md, big meshes' surfaces prefetched).
+//! the caches (docs/performance-log.md, big meshes' surfaces prefetched).
 
 use crate::mesh::TriangleMesh;
 use crate::world::{Hit, PrimitiveRef, World};

@@ -139,7 +139,7 @@ impl<'a> World<'a> {
         let wide = K::ISA >= Isa::Avx;
         if self.instance_count == 0 {
             // One level, no instance walk to count apart (tried one path for
-            // both: slower, see docs/performance.md).
+            // both: slower, see docs/performance-log.md).
             let leaves = AnyInLeaves::<false> {
                 world: self,
                 definitions,

@@ -121,7 +121,7 @@ impl Bins {
     ) -> Option<Plane> {
         // Small nodes need fewer bins to find their planes: fewer bins
         // save build time and barely change the SAH cost (figures in
-        // docs/performance.md, BVH build).
+        // docs/performance-log.md, BVH build).
         let bins = bins.min(2 * boxes.len());
         let binning = Binning::new(centroid_bounds, bins);
         self.fill(boxes, &binning);
@@ -173,7 +173,7 @@ impl Bins {
     /// pass per axis took more instructions).
     ///
     /// Tried binning large nodes in parallel chunks: no faster, see
-    /// docs/performance.md (BVH build).
+    /// docs/performance-log.md (BVH build).
     fn fill(&mut self, boxes: &[FBox], binning: &Binning) {
         let bins = binning.bins;
         for axis in 0..3 {

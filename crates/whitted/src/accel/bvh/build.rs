@@ -249,7 +249,7 @@ impl Builder {
             if let Some((cost, halves)) = found {
                 // Costs times the parent's half area: traversal step 1,
                 // primitive test 1.
-                // Tried a step of 0.5: no faster, see docs/performance.md.
+                // Tried a step of 0.5: no faster, see docs/performance-log.md.
                 // Tried pricing leaves by blocks of four triangles: slower.
                 let area = bounds.half_area();
                 if !must_split && cost + area >= n as f32 * area {

@@ -8,7 +8,7 @@
 //! its parent is filled, so a subtree's nodes lie close together.
 //!
 //! Tried collapsing subtrees of up to four triangles into one leaf: no
-//! faster, see docs/performance.md (eight-wide BVH).
+//! faster, see docs/performance-log.md (eight-wide BVH).
 
 use super::node::{BinaryNode, BvhNode, WIDTH};
 

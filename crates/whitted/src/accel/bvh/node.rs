@@ -107,7 +107,7 @@ impl BinaryNode {
     /// allocator hands out zeroed: the system maps its pages in as the
     /// build first writes them, on the threads that write them, and never
     /// those of slots no subtree uses. `vec!` would fill every slot on one
-    /// thread before the build started (see docs/performance.md, BVH build).
+    /// thread before the build started (see docs/performance-log.md, BVH build).
     pub fn zeroed_vec(len: usize) -> Vec<Self> {
         let Ok(layout) = Layout::array::<Self>(len) else {
             panic!("{len} BVH build nodes do not fit in memory");

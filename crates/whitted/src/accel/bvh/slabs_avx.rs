@@ -91,7 +91,7 @@ impl Avx {
     /// [`Planes::new`](super::slabs::Planes::new) bit for bit, computed for
     /// the three axes at once and kept in registers, so that no wide load
     /// reads them back from narrower stores ([`coordinates_apart`]; through
-    /// a `Planes`: slower, see docs/performance.md).
+    /// a `Planes`: slower, see docs/performance-log.md).
     #[target_feature(enable = "avx")]
     #[inline]
     fn prepare(ray: &Ray) -> Self {

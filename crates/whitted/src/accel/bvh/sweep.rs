@@ -6,7 +6,7 @@
 //! few primitives it holds, and most nodes of a tree are small, so nodes of
 //! up to [`SWEEP_MAX`] primitives are swept exactly instead, which takes
 //! fewer instructions (figures, and other limits tried, in
-//! docs/performance.md, BVH build). The exact sweep also prices every
+//! docs/performance-log.md, BVH build). The exact sweep also prices every
 //! plane the bins would, so its choice is never worse.
 
 use super::build::Halves;
@@ -81,7 +81,7 @@ pub(super) fn best_split(prims: &mut Prims) -> Option<(f32, Halves)> {
 
 /// `order` becomes `0..order.len()` sorted by centre along `axis`, stably,
 /// by insertion (the lists are short). Tried placing each by its rank,
-/// counted without branches: slower, see docs/performance.md (BVH build).
+/// counted without branches: slower, see docs/performance-log.md (BVH build).
 fn sort_by_centre(order: &mut [usize], centres: &[Vec3A], axis: usize) {
     for i in 0..order.len() {
         let key = centres[i][axis];

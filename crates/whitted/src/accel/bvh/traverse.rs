@@ -78,7 +78,7 @@
 //! read through rows chosen once per ray, not by a branch per axis and
 //! node.
 //!
-//! The figures behind these choices are in docs/performance.md (eight-wide
+//! The figures behind these choices are in docs/performance-log.md (eight-wide
 //! BVH). Not kept, with their figures there too:
 //! - Tried testing a binary node's two children at once in SIMD: slower.
 //! - Tried sorting the hit children in an array, then copying: slower.
@@ -385,7 +385,7 @@ impl Bvh {
                 if mask != 0 {
                     // The last slot hit goes on, the others wait on the
                     // stack in slot order, unsorted: any hit will do. Tried
-                    // nearest first: slower, see docs/performance.md.
+                    // nearest first: slower, see docs/performance-log.md.
                     let last = 31 - mask.leading_zeros();
                     let mut bits = mask & !(1 << last);
                     while bits != 0 {

@@ -73,7 +73,7 @@
 //! branches are well predicted and skip most of the arithmetic that a step
 //! of the descent always does.
 //!
-//! The figures behind these choices are in docs/performance.md (kd-tree
+//! The figures behind these choices are in docs/performance-log.md (kd-tree
 //! walk; kd-tree descent to the origin's leaf). Tried and not kept, with
 //! their figures there too (more at the spots in `traverse.rs`):
 //! - Tried any-hit rays without the mailbox, one call a primitive: no gain.
@@ -99,7 +99,7 @@ use node::KdNode;
 /// Options of the kd-tree build.
 ///
 /// Tried other cost constants and depth limits: none faster, see
-/// docs/performance.md (kd-tree build parameters).
+/// docs/performance-log.md (kd-tree build parameters).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct KdTreeBuildParams {
     /// Cost of one traversal step.

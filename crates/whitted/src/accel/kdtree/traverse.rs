@@ -20,7 +20,7 @@
 //! A primitive lies in every leaf its box overlaps, so a ray meets it
 //! again leaf after leaf: the shared mailbox (`accel/mailbox.rs`) tests it
 //! once per ray, which saves primitive tests and instructions (figures in
-//! docs/performance.md, kd-tree walk). The queries in leaf order (closest
+//! docs/performance-log.md, kd-tree walk). The queries in leaf order (closest
 //! and any hit) go without it and hand over whole leaves (see `mod.rs`): a
 //! repeated test finds nothing new, and the caller takes a leaf in one
 //! call, testing an any-hit ray against its triangles several at a time.
@@ -241,7 +241,7 @@ impl KdTree {
     /// [`Self::walk`] with a stack of `N` entries, at least the tree's
     /// depth.
     ///
-    /// Not kept (figures in docs/performance.md, kd-tree walk):
+    /// Not kept (figures in docs/performance-log.md, kd-tree walk):
     /// - Tried prefetching a node's above child, or the far child: slower.
     /// - Tried loading both children before the branches: no faster.
     #[inline(always)]
@@ -352,7 +352,7 @@ impl KdTree {
     /// The side chosen only orders the cells, so the call's condition (the
     /// point at `ray.t_min`, not the origin, inside the root) is for speed.
     ///
-    /// Not kept (figures in docs/performance.md, kd-tree descent to the
+    /// Not kept (figures in docs/performance-log.md, kd-tree descent to the
     /// origin's leaf):
     /// - Tried pushing the other child whenever it is stored: no faster.
     /// - Tried comparing the origin's side as integer keys: slower.
@@ -450,7 +450,7 @@ impl Axes {
 /// walk compiles to branches without it today, but small changes to
 /// [`children`] made the compiler pick the below child and the near side
 /// with conditional moves, so every node's load waited for the previous
-/// node's: slower, see docs/performance.md (kd-tree walk).
+/// node's: slower, see docs/performance-log.md (kd-tree walk).
 ///
 /// Tried choosing the next node by selects on purpose: slower too.
 #[inline(always)]
@@ -497,7 +497,7 @@ fn at_least(a: f64, b: f64) -> bool {
 /// side first.
 ///
 /// Tried scaling the inverse direction once per ray: missed a box (see
-/// docs/performance.md, kd-tree walk).
+/// docs/performance-log.md, kd-tree walk).
 #[inline(always)]
 fn crossing(axis: usize, split: f32, ray: &Axes) -> (f64, f64, bool) {
     let inv_dir = ray.inv_dir[axis];
@@ -513,7 +513,7 @@ fn crossing(axis: usize, split: f32, ray: &Axes) -> (f64, f64, bool) {
 /// the node's range). `[below, above]` are the children's indices (a node
 /// with one stored child goes to [`stored_side`] instead).
 ///
-/// Not kept (figures in docs/performance.md, kd-tree walk):
+/// Not kept (figures in docs/performance-log.md, kd-tree walk):
 /// - Tried one branch per node on both met/not-met tests: slower.
 /// - Tried picking the near child by a select on a per-ray mask: slower.
 /// - Tried the met tests against a range widened by 4γ(3): no faster.
@@ -553,7 +553,7 @@ fn children(
 /// Which end of the range the crossing clips depends on the ray's
 /// direction, but here, unlike at a node with two children, the direction
 /// does not choose the next node, so the end is picked by a select: as a
-/// branch it was mispredicted (figures in docs/performance.md, kd-tree
+/// branch it was mispredicted (figures in docs/performance-log.md, kd-tree
 /// walk). At nodes with two children the same selects were slower.
 #[inline(always)]
 fn stored_side(

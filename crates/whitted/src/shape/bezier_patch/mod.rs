@@ -34,7 +34,7 @@
 //! each leaf in the scene's acceleration structure as a shape of its own
 //! ([`BezierPatch::pieces`]), so the scene's BVH does the walking (with the
 //! changes to the leaves' test, 1.5 to 1.9 times the rays per second on
-//! the teapot: docs/performance.md, "Bézier patches against their
+//! the teapot: docs/performance-log.md, "Bézier patches against their
 //! tessellation").
 //!
 //! Chosen over Bézier clipping because the work per ray is small and
@@ -170,7 +170,7 @@ impl BezierPatch {
     /// the leaf's box as bounds, reporting hits and surfaces in the whole
     /// patch's (u, v); together they are the patch. Many pieces of many
     /// patches under the scene's acceleration structure are walked faster
-    /// than one hierarchy per patch (docs/performance.md, "Bézier patches
+    /// than one hierarchy per patch (docs/performance-log.md, "Bézier patches
     /// against their tessellation").
     pub fn pieces(&self) -> impl Iterator<Item = BezierPatch> + '_ {
         let nodes = &self.data.hierarchy.nodes;

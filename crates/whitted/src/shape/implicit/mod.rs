@@ -17,7 +17,7 @@
 //! regula falsi (Illinois steps, a bisection whenever two of them have not
 //! halved the bracket) then closes to adjacent floating-point numbers, as
 //! bisection alone did, in fewer evaluations of `f` where it is smooth
-//! (docs/performance.md). Where `f` grows faster than `L`
+//! (docs/performance-log.md). Where `f` grows faster than `L`
 //! between two steps, the largest such rate is kept
 //! ([`Implicit::largest_gradient_seen`]) so the render can warn that
 //! the bound is too small. A value that is NaN (outside the function's

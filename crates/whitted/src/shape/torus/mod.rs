@@ -35,7 +35,7 @@
 //! quadratic second derivative) cut the chord into monotone pieces, each
 //! holding at most one root, found by Newton's method kept inside its
 //! bracket, which cannot miss a simple root or return one outside the
-//! chord. Measured on the same quartics and rays (docs/performance.md,
+//! chord. Measured on the same quartics and rays (docs/performance-log.md,
 //! "Torus solvers"), the checked closed form is as accurate as the
 //! monotone solver alone (largest relative error in `t` 1.5e-12 against the
 //! dense-sampling reference, on grazing rays; 1.9e-15 from a camera 1e4
@@ -132,7 +132,7 @@ impl Torus {
     /// The closest hit found by recursive derivative intervals alone
     /// instead of [`Torus::intersect`]'s checked closed form, on the same
     /// moved-origin quartic: for measurement and as the tests' second
-    /// opinion (the solver comparison in docs/performance.md), not used
+    /// opinion (the solver comparison in docs/performance-log.md), not used
     /// when rendering.
     #[doc(hidden)]
     pub fn intersect_by_monotone(&self, ray: &Ray) -> Option<ShapeHit> {

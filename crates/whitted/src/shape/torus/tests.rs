@@ -469,7 +469,7 @@ fn grazing_ray(torus: &Torus, rng: &mut Rng) -> Ray {
 /// Accuracy of the shipped solver (Ferrari's closed form, polished and
 /// checked) and of the recursive derivative intervals alone (its fallback)
 /// on the same rays, against the dense-sampling reference: the table in
-/// docs/performance.md ("Torus solvers"); `--nocapture` shows it.
+/// docs/performance-log.md ("Torus solvers"); `--nocapture` shows it.
 #[test]
 #[allow(
     clippy::print_stderr,
