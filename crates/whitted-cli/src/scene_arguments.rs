@@ -79,6 +79,13 @@ pub struct SceneArgs {
     #[arg(long)]
     no_packets: bool,
 
+    /// Trace every ray by the plain closest-hit or any-hit query, without
+    /// the fast paths (camera-ray packets, the shadow cache, shadow rays
+    /// through glass answered from one walk, rays inside glass spheres):
+    /// the same picture, the reference they are checked against.
+    #[arg(long)]
+    no_fast_paths: bool,
+
     /// Put the camera's eye here (replaces the scene's).
     #[arg(long, value_name = "X,Y,Z", value_parser = arguments::vec3, allow_hyphen_values = true)]
     eye: Option<Vec3>,
@@ -191,6 +198,7 @@ impl SceneArgs {
         settings.aa = self.aa.apply(settings.aa)?;
         settings.texture_filter = self.texture_filter.unwrap_or(settings.texture_filter);
         settings.packets &= !self.no_packets;
+        settings.fast_paths &= !self.no_fast_paths;
         Ok(scene)
     }
 }

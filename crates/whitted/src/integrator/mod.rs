@@ -115,6 +115,15 @@ impl<'a> Integrator<'a> {
         }
     }
 
+    /// Takes the fast paths or, with `fast` false, the plain closest-hit
+    /// and any-hit queries for every ray (the same picture and ray
+    /// counts: see [`crate::render::RenderSettings::fast_paths`]).
+    pub fn with_fast_paths(self, fast: bool) -> Self {
+        match self {
+            Integrator::Whitted(w) => Integrator::Whitted(w.with_fast_paths(fast)),
+        }
+    }
+
     /// The world it traces in.
     pub fn world(&self) -> &'a World<'a> {
         match self {

@@ -94,6 +94,10 @@ pub struct Whitted<'a> {
     caustics: Option<&'a CausticMap>,
     /// Per material, whether shading reads (u, v) ([`Material::reads_uv`]).
     reads_uv: Vec<bool>,
+    /// Whether rays take the fast paths (the shadow cache, `opaque`'s
+    /// classifying walk and crossings, `interiors`), or every ray the
+    /// plain closest-hit or any-hit query.
+    fast_paths: bool,
 }
 
 impl<'a> Whitted<'a> {
@@ -113,6 +117,18 @@ impl<'a> Whitted<'a> {
             interiors: world.interiors(|m| shading.materials[m.0 as usize].is_transmissive()),
             caustics: None,
             reads_uv: shading.materials.iter().map(Material::reads_uv).collect(),
+            fast_paths: true,
+        }
+    }
+
+    /// Takes the fast paths or, with `fast` false, the plain closest-hit
+    /// and any-hit queries for every secondary and shadow ray: the same
+    /// picture and ray counts, the reference the fast paths are checked
+    /// against.
+    pub fn with_fast_paths(self, fast: bool) -> Self {
+        Self {
+            fast_paths: fast,
+            ..self
         }
     }
 
@@ -260,7 +276,12 @@ impl<'a> Whitted<'a> {
         media: &MediumStack,
         tally: &mut SampleTally<'_, O>,
     ) -> Color {
-        match self.world.intersect_from(ray, from, &self.interiors) {
+        let hit = if self.fast_paths {
+            self.world.intersect_from(ray, from, &self.interiors)
+        } else {
+            self.world.intersect(ray)
+        };
+        match hit {
             None => {
                 tally.observer.ray_hit(ray, None);
                 self.shading.background
@@ -488,7 +509,11 @@ impl<'a> Whitted<'a> {
         };
         let ray = shadow_segment(origin, to_light, (target, distance));
         if !self.any_transmissive {
-            let blocked = shadow_cache::occluded(self.world, &ray, index);
+            let blocked = if self.fast_paths {
+                shadow_cache::occluded(self.world, &ray, index)
+            } else {
+                self.world.occluded(&ray)
+            };
             tally
                 .observer
                 .shadow_ray(&ray, ShadowStep::AnyHit { blocked });
@@ -513,7 +538,7 @@ impl<'a> Whitted<'a> {
         // cross surfaces letting light through, it lists them, and the
         // surface-to-surface walk tests only those.
         let mut passed = PassedEntries::UNLISTED;
-        if let Some(opaque) = &self.opaque {
+        if let Some(opaque) = self.opaque.as_ref().filter(|_| self.fast_paths) {
             match shadow_cache::shadow_path(self.world, ray, opaque, index) {
                 ShadowPath::Crossed(entries) => {
                     let crossings = self.world.shadow_crossings(ray, &entries);

@@ -179,7 +179,8 @@ impl<'s> Explainer<'s> {
         let shading = shading_of(scene);
         let limits = limits_of(settings);
         let integrator = Integrator::new(settings.integrator, world, shading, limits)
-            .with_caustics(self.caustics.as_ref());
+            .with_caustics(self.caustics.as_ref())
+            .with_fast_paths(settings.fast_paths);
         let mut counts = RayCounts::default();
         let (pixel, samples) = match settings.aa {
             AntiAliasing::Stratified => {

@@ -398,7 +398,8 @@ fn trace_pixels(
         shading_of(scene),
         limits,
     )
-    .with_caustics(caustics.map(|(map, _)| map));
+    .with_caustics(caustics.map(|(map, _)| map))
+    .with_fast_paths(settings.fast_paths);
     let total = selection.pixel_count();
     let done = AtomicU64::new(0);
     let mut films = Films {
@@ -417,7 +418,10 @@ fn trace_pixels(
         films.aovs.iter_mut().for_each(|(_, film)| film.map_pages());
     });
     let films = Mutex::new(films);
-    let on_image = WorldOnImage::new(camera, width, height, &prepared.world);
+    let on_image = settings
+        .fast_paths
+        .then(|| WorldOnImage::new(camera, width, height, &prepared.world))
+        .flatten();
     let clock = trace_timing::TraceClock::start();
     // Each worker takes the next tile from a shared counter until none is
     // left: a thread that finishes early takes more, so both cores stay
@@ -655,7 +659,7 @@ impl<'w> RowSamples<'w> {
     ) {
         let spp = settings.samples_per_pixel;
         let world = integrator.world();
-        let packets = settings.packets && world.walks_packets();
+        let packets = settings.packets && settings.fast_paths && world.walks_packets();
         // The hits are this row's only where `find_hits` filled them.
         let prefetch = packets && world.prefetches_surfaces() && selection.has_row(y);
         // The selection, asked once for the row rather than per pixel.

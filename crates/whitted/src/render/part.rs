@@ -110,6 +110,7 @@ impl PartHeader {
         let settings = super::RenderSettings {
             threads: None,
             packets: true,
+            fast_paths: true,
             ..scene.settings.clone()
         };
         Self {

@@ -129,6 +129,15 @@ pub struct RenderSettings {
     /// the world allows it ([`crate::world::World::intersect_packet`]);
     /// the picture is the same either way, only the time differs.
     pub packets: bool,
+    /// Whether rays take the fast paths: camera-ray packets (as
+    /// `packets`) and the culling of camera rays that miss the world's
+    /// image, the shadow cache, shadow rays through clear surfaces answered
+    /// by one classifying walk and their crossings, and rays inside glass
+    /// spheres tested against what reaches in. The picture and the ray
+    /// counts are the same either way; off, every ray takes the plain
+    /// closest-hit or any-hit query: the reference the tests compare
+    /// against.
+    pub fast_paths: bool,
     /// Per-pixel data to produce alongside the colour.
     pub aovs: Vec<Aov>,
 }
@@ -170,6 +179,7 @@ impl Default for RenderSettings {
             texture_filter: TextureFilter::None,
             threads: None,
             packets: true,
+            fast_paths: true,
             aovs: Vec::new(),
         }
     }
