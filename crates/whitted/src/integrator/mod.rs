@@ -116,8 +116,8 @@ impl<'a> Integrator<'a> {
     }
 
     /// Takes the fast paths or, with `fast` false, the plain closest-hit
-    /// and any-hit queries for every ray (the same picture and ray
-    /// counts: see [`crate::render::RenderSettings::fast_paths`]).
+    /// and any-hit queries for every ray: the same picture, the reference
+    /// the fast paths are checked against ([`Whitted::with_fast_paths`]).
     pub fn with_fast_paths(self, fast: bool) -> Self {
         match self {
             Integrator::Whitted(w) => Integrator::Whitted(w.with_fast_paths(fast)),

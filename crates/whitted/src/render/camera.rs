@@ -174,8 +174,8 @@ impl Camera {
             rays.len()
         );
         #[cfg(target_arch = "x86_64")]
-        if is_x86_feature_detected!("avx") {
-            // SAFETY: the processor has AVX.
+        if crate::accel::Backend::current().has_avx() {
+            // SAFETY: the processor has AVX (the current backend does).
             return unsafe { self.rays_avx(width, height, positions, rays) };
         }
         for (p, ray) in positions.iter().zip(rays) {

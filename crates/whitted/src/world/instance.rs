@@ -117,10 +117,7 @@ mod tests {
         let boxes: Vec<Aabb> = (0..mesh.len() as u32)
             .map(|t| mesh.triangle_bounds(t))
             .collect();
-        #[cfg(target_arch = "x86_64")]
-        let avx = is_x86_feature_detected!("avx");
-        #[cfg(not(target_arch = "x86_64"))]
-        let avx = false;
+        let avx = crate::accel::Backend::current().has_avx();
         let oracle = MeshStructure::build(&mesh, AccelKind::Linear);
         let mut hits = 0;
         for kind in AccelKind::ALL {

@@ -142,9 +142,9 @@ pub struct World<'a> {
     /// the ray's shear up front.
     has_triangles: bool,
     /// Whether the current backend has AVX ([`Backend::current`]), so the
-    /// leaf tests of the walks not yet entered through a kernel (packets,
-    /// shadow paths) cull runs of spheres four at a time, and shadow rays
-    /// test runs of triangles four at a time.
+    /// leaf tests of the walks not entered through a kernel (the packet
+    /// walks, an instance's any-hit walk) cull runs of spheres four at a
+    /// time, and shadow rays test runs of triangles four at a time.
     wide: bool,
     /// The unbounded shapes (infinite planes) and instances of definitions
     /// holding one, tested beside the structure.

@@ -8,7 +8,10 @@
 //! met ([`PassedEntries`]): each step of that walk then tests those alone
 //! instead of walking the whole structure again.
 
-use crate::accel::{AccelerationStructure, QueryContext};
+use std::ops::Range;
+
+use crate::accel::kernel::{self, Kernel, KernelTask};
+use crate::accel::{AnyLeaves, Backend, Isa, QueryContext};
 use crate::math::Ray;
 use crate::shape::{Shape, ShapeHit};
 use crate::world::entry::{Entry, EntryKind, Query, leaf_meets};
@@ -256,31 +259,37 @@ impl World<'_> {
                 }
             }
         }
-        let mut ctx = QueryContext::default();
-        let blocked = self.accel.occluded_in_leaf_order(ray, &mut ctx, |range| {
-            let blocker = leaf_meets(
-                &self.entries,
-                range,
-                &query,
-                self.wide,
-                |e, rest| self.rest_occludes(e.number, &query, rest),
-                |entry| match opaque.entries[entry as usize] {
-                    Passage::Stops => true,
-                    Passage::Listed => {
-                        passed.push(entry, &self.entries);
-                        false
-                    }
-                    Passage::Searched => {
-                        passed = PassedEntries::UNLISTED;
-                        false
-                    }
-                },
-            );
-            if let Some(entry) = blocker {
-                *hint = ShadowHint(entry);
+        /// The walk as a kernel's task.
+        struct Walk<'q, 'a> {
+            world: &'q World<'a>,
+            ray: &'q Ray,
+            leaves: PassingLeaves<'q, 'a>,
+        }
+        impl KernelTask for Walk<'_, '_> {
+            type Output = bool;
+            #[inline(always)]
+            fn run<K: Kernel>(mut self) -> bool {
+                self.leaves.wide = K::ISA >= Isa::Avx;
+                let mut ctx = QueryContext::default();
+                self.world
+                    .accel
+                    .any_with::<K>(self.ray, &mut ctx, self.leaves)
             }
-            blocker.is_some()
-        });
+        }
+        let leaves = PassingLeaves {
+            world: self,
+            query: &query,
+            opaque,
+            wide: false,
+            passed: &mut passed,
+            hint,
+        };
+        let walk = Walk {
+            world: self,
+            ray,
+            leaves,
+        };
+        let blocked = kernel::run(Backend::current(), walk);
         if blocked {
             ShadowPath::Blocked
         } else if !passed.is_empty() {
@@ -527,6 +536,49 @@ fn set_bits(mut bits: u32) -> impl Iterator<Item = usize> {
             i
         })
     })
+}
+
+/// The leaves of [`World::shadow_path`]'s walk: every entry found in the
+/// interval is told apart by `opaque`; one that stops light ends the walk
+/// (and is left in `hint`), the others are listed in `passed`.
+struct PassingLeaves<'q, 'a> {
+    world: &'q World<'a>,
+    query: &'q Query<'q>,
+    opaque: &'q OpaqueEntries,
+    /// Whether the kernel has AVX's `f64` lanes.
+    wide: bool,
+    passed: &'q mut PassedEntries,
+    hint: &'q mut ShadowHint,
+}
+
+impl AnyLeaves for PassingLeaves<'_, '_> {
+    #[inline(always)]
+    fn occludes(&mut self, range: Range<u32>) -> bool {
+        let (world, query, opaque) = (self.world, self.query, self.opaque);
+        let passed = &mut *self.passed;
+        let blocker = leaf_meets(
+            &world.entries,
+            range,
+            query,
+            self.wide,
+            |e, rest| world.rest_occludes(e.number, query, rest),
+            |entry| match opaque.entries[entry as usize] {
+                Passage::Stops => true,
+                Passage::Listed => {
+                    passed.push(entry, &world.entries);
+                    false
+                }
+                Passage::Searched => {
+                    *passed = PassedEntries::UNLISTED;
+                    false
+                }
+            },
+        );
+        if let Some(entry) = blocker {
+            *self.hint = ShadowHint(entry);
+        }
+        blocker.is_some()
+    }
 }
 
 #[cfg(test)]

@@ -92,9 +92,9 @@ impl Bvh {
             return None;
         }
         #[cfg(target_arch = "x86_64")]
-        if is_x86_feature_detected!("avx") {
+        if crate::accel::Backend::current().has_avx() {
             use super::traverse::{MIDDLE, SHALLOW, stack_size};
-            // SAFETY: the processor has AVX.
+            // SAFETY: the processor has AVX (the current backend does).
             let lanes = unsafe { avx::Lanes::new(rays) }?;
             // SAFETY: the processor has AVX.
             return Some(unsafe {

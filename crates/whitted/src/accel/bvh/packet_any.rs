@@ -45,9 +45,9 @@ impl Bvh {
             return Some(0);
         }
         #[cfg(target_arch = "x86_64")]
-        if is_x86_feature_detected!("avx") {
+        if crate::accel::Backend::current().has_avx() {
             use super::traverse::{MIDDLE, SHALLOW, stack_size};
-            // SAFETY: the processor has AVX.
+            // SAFETY: the processor has AVX (the current backend does).
             let packet = unsafe { super::packet::avx::Lanes::new(rays) }?;
             // SAFETY: the processor has AVX.
             return Some(unsafe {
@@ -333,7 +333,7 @@ mod tests {
             bvh.occluded_packet_by_leaf(&[towards(0.1)], 0, &mut counters, none),
             Some(0)
         );
-        if is_x86_feature_detected!("avx") {
+        if crate::accel::Backend::current().has_avx() {
             // Directions of both signs along x are not walked together.
             let mixed = [towards(0.1), towards(-0.1)];
             assert_eq!(
