@@ -21,7 +21,10 @@
 //! Culling must be conservative: a structure may skip a primitive only when
 //! the ray provably cannot meet its box within the interval, so every
 //! structure returns exactly the closest hit the brute-force [`Linear`]
-//! returns (ties at equal `t` may pick either primitive).
+//! returns. A structure never skips a primitive hit at exactly the closest
+//! `t` so far either (its walk goes on into a cell or child that starts
+//! there), so a caller that keeps the lower-numbered of a tie, as the
+//! world's leaf tests do, gets the same primitive from every structure.
 
 pub mod bvh;
 mod context;

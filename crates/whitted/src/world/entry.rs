@@ -279,8 +279,9 @@ pub(super) fn intersect_triangle(
     watertight(*p0, *p1, *p2, &ray, &query.shear())
 }
 
-/// The closest of `entries[range]` hit by the query's ray closer than
-/// `t_max`: triangles and spheres here, other entries by
+/// The closest of `entries[range]` hit by the query's ray before `best`,
+/// the closest hit so far (its `t`, and its number or `u32::MAX`; see
+/// [`nearer`]): triangles and spheres here, other entries by
 /// `other(entry, t_max, rest)` (what the test in place left, [`Rest`]),
 /// which returns the number to report and the hit.
 /// `found(number, hit)` is told of each nearer hit; returns the closest `t`.
@@ -295,27 +296,33 @@ pub(super) fn leaf_hit(
     entries: &[Entry],
     range: Range<u32>,
     query: &Query,
-    mut t_max: f64,
+    best: (f64, u32),
     wide: bool,
     mut other: impl FnMut(&Entry, f64, Rest) -> Option<(u32, ShapeHit)>,
     mut found: impl FnMut(u32, ShapeHit),
 ) -> Option<f64> {
+    let (mut t_max, mut number_so_far) = best;
     let mut closest = None;
+    // Tested to one ulp past the closest hit, so that a tie is seen and
+    // goes to the lower number ([`nearer`]).
+    let mut bound = t_max.next_up();
     let mut entry = range.start;
     while entry < range.end {
         let e = &entries[entry as usize];
         #[cfg(target_arch = "x86_64")]
         if wide
             && e.kind == EntryKind::Sphere
-            && let Some((run, mut mask)) = sphere_run(entries, entry, range.end, query, t_max)
+            && let Some((run, mut mask)) = sphere_run(entries, entry, range.end, query, bound)
         {
             while mask != 0 {
                 let e = &entries[(entry + mask.trailing_zeros()) as usize];
                 let mut ray = *query.ray;
-                ray.t_max = t_max;
-                if let Some(h) = e.as_sphere().intersect(&ray) {
+                ray.t_max = bound;
+                if let Some(h) = e.as_sphere().intersect(&ray)
+                    && nearer((h.t, e.number), (t_max, number_so_far))
+                {
                     found(e.number, h);
-                    t_max = h.t;
+                    (t_max, number_so_far, bound) = (h.t, e.number, h.t.next_up());
                     closest = Some(h.t);
                 }
                 mask &= mask - 1;
@@ -323,19 +330,31 @@ pub(super) fn leaf_hit(
             entry += run;
             continue;
         }
-        let hit = match e.test_in_place(query, t_max) {
+        let hit = match e.test_in_place(query, bound) {
             Ok(hit) => hit.map(|h| (e.number, h)),
-            Err(rest) => other(e, t_max, rest),
+            Err(rest) => other(e, bound, rest),
         };
-        if let Some((number, h)) = hit {
+        if let Some((number, h)) = hit
+            && nearer((h.t, number), (t_max, number_so_far))
+        {
             found(number, h);
-            t_max = h.t;
+            (t_max, number_so_far, bound) = (h.t, number, h.t.next_up());
             closest = Some(h.t);
         }
         entry += 1;
     }
     let _ = wide;
     closest
+}
+
+/// Whether a hit at `t` on primitive `number` comes before the closest so
+/// far: nearer, or at the same parameter with a lower number. The closest
+/// hit is then the least `(t, number)` whatever order a structure visits
+/// primitives in, so every structure finds the same one (brute force, in
+/// number order, keeps the first of a tie).
+#[inline(always)]
+pub(super) fn nearer((t, number): (f64, u32), (closest, closest_number): (f64, u32)) -> bool {
+    t < closest || (t == closest && number < closest_number)
 }
 
 /// An entry of `entries[range]` that lies in the query's ray interval (the
@@ -524,7 +543,7 @@ mod tests {
                     &entries,
                     range.clone(),
                     &query,
-                    ray.t_max,
+                    (ray.t_max, u32::MAX),
                     wide,
                     other,
                     |n, h| found.push((n, h.t.to_bits())),

@@ -77,11 +77,12 @@ impl MeshStructure {
         let mut best = None;
         self.accel
             .intersect_in_leaf_order(&clipped, ctx, |range, t_max| {
+                let number = best.map_or(u32::MAX, |(triangle, _)| triangle);
                 leaf_hit(
                     &self.entries,
                     range,
                     &query,
-                    t_max,
+                    (t_max, number),
                     false,
                     |_, _, _| None,
                     |triangle, hit| best = Some((triangle, hit)),

@@ -29,7 +29,7 @@ use crate::math::Ray;
 #[cfg(target_arch = "x86_64")]
 use crate::shape::{LANES, RayLanes4, RayShear, ShapeHit, watertight_rays4};
 
-use super::entry::{EntryKind, Query, Rest, leaf_hit};
+use super::entry::{EntryKind, Query, Rest, leaf_hit, nearer};
 use super::{Hit, PrimitiveId, World};
 
 /// The most rays a packet holds.
@@ -167,11 +167,12 @@ impl<'a> World<'a> {
                 bits &= bits - 1;
                 let query = queries[lane]
                     .get_or_insert_with(|| Query::new(&rays[lane], self.has_triangles));
+                let number = hits[lane].map_or(u32::MAX, |h| h.primitive.0);
                 let closest = leaf_hit(
                     &self.entries,
                     range.clone(),
                     query,
-                    t_max[lane],
+                    (t_max[lane], number),
                     self.wide,
                     |e, t_max, rest| {
                         self.intersect_other(definitions, e, (query, t_max, rest), &mut inner)
@@ -204,9 +205,10 @@ impl<'a> World<'a> {
     }
 
     /// The leaf `range` of triangles tested for the `lanes` of a packet
-    /// whose rays are `across`, each lane's interval ending at
-    /// `t_max[lane]`: per lane, the triangles in order, each hit closer
-    /// than the last written to `hits` and ending the interval, as
+    /// whose rays are `across`, each lane's closest hit so far at
+    /// `t_max[lane]` (on the primitive `hits[lane]` names, if any): per
+    /// lane, the triangles in order, each hit before the last
+    /// ([`nearer`]) written to `hits` and ending the interval, as
     /// [`leaf_hit`] does for one ray. Returns the lanes that hit, with
     /// their closest `t` left in `t_max`.
     ///
@@ -232,14 +234,19 @@ impl<'a> World<'a> {
                 if mask == 0 {
                     continue;
                 }
-                let ends = [0, 1, 2, 3].map(|i| t_max[first + i]);
+                // One ulp past each lane's closest hit, to see ties.
+                let ends = [0, 1, 2, 3].map(|i| t_max[first + i].next_up());
                 let h = watertight_rays4(&e.corners, rays, ends);
                 mask &= h.mask;
-                found |= mask << first;
                 while mask != 0 {
                     let i = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
                     let lane = first + i;
+                    let number = hits[lane].map_or(u32::MAX, |h| h.primitive.0);
+                    if !nearer((h.t[i], e.number), (t_max[lane], number)) {
+                        continue;
+                    }
+                    found |= 1 << lane;
                     t_max[lane] = h.t[i];
                     hits[lane] = Some(Hit {
                         primitive: PrimitiveId(e.number),
@@ -606,7 +613,7 @@ pub(super) mod tests {
                             &world.entries,
                             range.clone(),
                             queries[lane].as_ref().unwrap(),
-                            ends[lane],
+                            (ends[lane], u32::MAX),
                             false,
                             |_, _, _| unreachable!("triangles only"),
                             |primitive, shape_hit| {

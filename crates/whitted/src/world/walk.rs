@@ -182,11 +182,12 @@ impl ClosestLeaves for ClosestInLeaves<'_, '_> {
         let (world, definitions, query) = (self.world, self.definitions, self.query);
         let inner = &mut *self.inner;
         let best = &mut *self.best;
+        let number = best.map_or(u32::MAX, |h| h.primitive.0);
         leaf_hit(
             &world.entries,
             range,
             query,
-            t_max,
+            (t_max, number),
             self.wide,
             |e, t_max, rest| world.intersect_other(definitions, e, (query, t_max, rest), inner),
             |primitive, shape_hit| {
@@ -239,7 +240,7 @@ mod tests {
     use crate::math::{Ray, Transform, Vec3};
     use crate::mesh::TriangleMesh;
     use crate::world::packet::tests::closed_form_scene;
-    use crate::world::{MaterialId, ShadowHint, World};
+    use crate::world::{MaterialId, Objects, ShadowHint, World};
 
     /// Every backend this processor runs finds the same closest hits (the
     /// primitive and `t` bit for bit), the same any-hit answers and the
@@ -292,5 +293,79 @@ mod tests {
             }
         }
         assert!(compared >= 8 * 400, "{compared}");
+    }
+
+    /// Primitives hit at exactly the same parameter (the same sphere twice,
+    /// the same triangle three times over, scattered among others): every
+    /// structure, the single walk and the packet walk alike, name the
+    /// lowest-numbered of them.
+    #[test]
+    fn a_tie_goes_to_the_lowest_number_on_every_structure() {
+        use crate::shape::{Shape, Sphere};
+        let mut rng = Rng::new(7);
+        let mut objects = Objects::default();
+        // The first of each group of copies, and the later ones.
+        let (mut firsts, mut later) = (Vec::new(), Vec::new());
+        let m = MaterialId(0);
+        for _ in 0..40 {
+            let centre = rng.point_in(Vec3::splat(-4.0), Vec3::splat(4.0));
+            let sphere = Sphere::new(centre, rng.range(0.1, 0.6)).unwrap();
+            let number = objects.primitives.len() as u32;
+            objects.add_primitive(Shape::Sphere(sphere), m, Transform::IDENTITY);
+            if rng.below(3) == 0 {
+                // A twin a few numbers later, another sphere between.
+                let lone = Sphere::new(centre + Vec3::X * 9.0, 0.2).unwrap();
+                objects.add_primitive(Shape::Sphere(lone), m, Transform::IDENTITY);
+                objects.add_primitive(Shape::Sphere(sphere), m, Transform::IDENTITY);
+                firsts.push(number);
+                later.push(number + 2);
+            }
+        }
+        let shapes = objects.primitives.len() as u32;
+        let mut positions = Vec::new();
+        let mut triangles = Vec::new();
+        for i in 0..60 {
+            let corners = [0, 1, 2].map(|_| rng.point_in(Vec3::splat(-4.0), Vec3::splat(4.0)));
+            let base = positions.len() as u32;
+            positions.extend(corners);
+            let copies = if i % 5 == 0 { 3 } else { 1 };
+            let number = shapes + triangles.len() as u32;
+            if copies > 1 {
+                firsts.push(number);
+                later.extend([number + 1, number + 2]);
+            }
+            for _ in 0..copies {
+                triangles.push([base, base + 1, base + 2]);
+            }
+        }
+        let mesh = objects.add_mesh(TriangleMesh::new(positions, triangles).unwrap());
+        objects.add_mesh_instance(mesh, m, Transform::IDENTITY);
+        let mut ties = 0;
+        for kind in AccelKind::ALL {
+            let world = World::build(&objects, kind);
+            for _ in 0..2000 {
+                let origin = rng.point_in(Vec3::splat(-9.0), Vec3::splat(9.0));
+                let towards = rng.point_in(Vec3::splat(-4.0), Vec3::splat(4.0)) - origin;
+                let rays: Vec<Ray> = (0..8)
+                    .map(|_| {
+                        let wobble = rng.point_in(Vec3::splat(-0.3), Vec3::splat(0.3));
+                        Ray::new(origin, towards + wobble)
+                    })
+                    .collect();
+                let mut packed = [None; 8];
+                world.intersect_packet(&rays, &mut QueryContext::default(), &mut packed);
+                for (ray, packed) in rays.iter().zip(packed) {
+                    let hit = world.intersect(ray);
+                    let key =
+                        |h: Option<crate::world::Hit>| h.map(|h| (h.primitive.0, h.t().to_bits()));
+                    assert_eq!(key(packed), key(hit), "{kind:?} packet {ray:?}");
+                    if let Some((number, _)) = key(hit) {
+                        assert!(!later.contains(&number), "{kind:?}: {number} {ray:?}");
+                        ties += usize::from(firsts.contains(&number));
+                    }
+                }
+            }
+        }
+        assert!(ties > 400, "{ties}");
     }
 }

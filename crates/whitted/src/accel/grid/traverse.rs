@@ -41,8 +41,10 @@ impl Grid {
                 }
             }
             // A primitive of this cell may be hit beyond it, where a
-            // primitive of a later cell may be hit closer still.
-            if clipped.t_max <= t_exit {
+            // primitive of a later cell may be hit closer still; one hit
+            // at the cell's very end may tie with one of the next cell,
+            // which the caller may prefer (a lower number).
+            if clipped.t_max < t_exit {
                 break;
             }
         }
@@ -150,8 +152,9 @@ mod tests {
         });
         assert_eq!(t, Some(6.0));
         assert_eq!(ctx.counters.primitives, 2);
+        // Up to the cell that starts at the hit, where a tie may lie.
         let cells_to_the_hit = DdaCells::new(&grid.lattice, &ray)
-            .take_while(|c| c.1 < 6.0)
+            .take_while(|c| c.1 <= 6.0)
             .count();
         assert_eq!(ctx.counters.nodes, cells_to_the_hit as u64);
     }
