@@ -228,6 +228,23 @@ fn run_avx2<T: KernelTask>(task: T) -> T::Output {
     task.run::<Avx2Kernel>()
 }
 
+/// For tests of the walks that only the AVX backends take (the packet
+/// walks): true when the current backend has AVX. A backend narrowed on
+/// purpose (`WHITTED_ISA`) skips them, saying so; a processor without AVX
+/// fails them unless skipping is allowed (`math::test_support`).
+#[cfg(test)]
+#[allow(
+    clippy::print_stderr,
+    reason = "a skipped test says so in the test harness's output"
+)]
+pub(crate) fn walks_with_avx_or_skip() -> bool {
+    if Isa::widest() >= Isa::Avx && !Backend::current().has_avx() {
+        eprintln!("skipped: {ISA_VARIABLE} asks for a backend without AVX");
+        return false;
+    }
+    crate::math::test_support::has_avx_or_skip_allowed()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -741,7 +741,7 @@ mod tests {
 
     #[test]
     fn packets_find_the_single_walks_closest_hits() {
-        if !crate::math::test_support::has_avx_or_skip_allowed() {
+        if !crate::accel::kernel::walks_with_avx_or_skip() {
             return;
         }
         let mut rng = Rng::new(21);
@@ -787,7 +787,7 @@ mod tests {
 
     #[test]
     fn lanes_with_tied_hits_are_left_to_the_single_walk() {
-        if !crate::math::test_support::has_avx_or_skip_allowed() {
+        if !crate::accel::kernel::walks_with_avx_or_skip() {
             return;
         }
         // Boxes across the plane z = 0, each hit where the ray crosses the
@@ -853,7 +853,7 @@ mod tests {
 
     #[test]
     fn mixed_signs_and_axis_parallel_rays_are_not_walked_together() {
-        if !crate::math::test_support::has_avx_or_skip_allowed() {
+        if !crate::accel::kernel::walks_with_avx_or_skip() {
             return;
         }
         let forward = Ray::new(Vec3::ZERO, Vec3::new(1.0, 0.5, 0.25).normalize());

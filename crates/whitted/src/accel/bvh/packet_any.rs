@@ -209,7 +209,7 @@ mod tests {
 
     #[test]
     fn packets_find_each_lane_occluded_as_its_single_walk_does() {
-        if !crate::math::test_support::has_avx_or_skip_allowed() {
+        if !crate::accel::kernel::walks_with_avx_or_skip() {
             return;
         }
         let mut rng = Rng::new(31);
@@ -267,7 +267,7 @@ mod tests {
 
     #[test]
     fn a_lane_ending_just_short_of_a_box_enters_it_as_its_single_walk_does() {
-        if !crate::math::test_support::has_avx_or_skip_allowed() {
+        if !crate::accel::kernel::walks_with_avx_or_skip() {
             return;
         }
         // Unit cubes in a row, each its own leaf's; rays along the row end
