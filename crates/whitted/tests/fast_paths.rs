@@ -9,14 +9,16 @@
 //! ray, where the surface-to-surface walk casts one more from each clear
 //! surface it passes before it reaches the blocker.
 
+mod scene_files;
 mod shared_folder;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use whitted::integrator::RayKind;
 use whitted::render::{Scene, render};
 use whitted::scene::load_any;
 
+use scene_files::{example_scenes, files};
 use shared_folder::shared_path;
 
 /// Renders `scene` at `width` x `height` with the fast paths and without,
@@ -49,17 +51,6 @@ fn differences(name: &str, mut scene: Scene, (width, height): (u32, u32)) -> Vec
     found
 }
 
-/// The files in `folder` whose extension is `extension`, sorted.
-fn files(folder: &Path, extension: &str) -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(folder)
-        .unwrap_or_else(|e| panic!("{}: {e}", folder.display()))
-        .map(|entry| entry.unwrap().path())
-        .filter(|path| path.extension().is_some_and(|e| e == extension))
-        .collect();
-    files.sort();
-    files
-}
-
 /// Every scene of `paths`, rendered both ways; fails with every difference.
 fn assert_same_both_ways(paths: &[PathBuf], size: (u32, u32)) {
     let mut found = Vec::new();
@@ -73,10 +64,7 @@ fn assert_same_both_ways(paths: &[PathBuf], size: (u32, u32)) {
 
 #[test]
 fn every_example_scene_renders_the_same_without_the_fast_paths() {
-    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
-    let scenes = files(&folder, "toml");
-    assert!(scenes.len() >= 10, "too few scenes in {}", folder.display());
-    assert_same_both_ways(&scenes, (64, 48));
+    assert_same_both_ways(&example_scenes(), (64, 48));
 }
 
 #[test]

@@ -12,14 +12,16 @@
 //! of `patches.toml` with the kd-tree, and which piece the id names at a
 //! few pixels of the scenes holding patches).
 
+mod scene_files;
 mod shared_folder;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use whitted::accel::AccelKind;
 use whitted::render::{Aov, Scene, render};
 use whitted::scene::load_any;
 
+use scene_files::{example_scenes, files};
 use shared_folder::shared_path;
 
 /// The picture's bits and the id AOV's of `scene` rendered with `kind` at
@@ -33,17 +35,6 @@ fn rendered(scene: &Scene, kind: AccelKind) -> (Vec<u32>, Vec<u32>) {
     let output = render(&scene, &|_| {}).unwrap();
     let bits = |data: &[f32]| data.iter().map(|v| v.to_bits()).collect();
     (bits(output.image.data()), bits(output.aovs[0].1.data()))
-}
-
-/// The files in `folder` whose extension is `extension`, sorted.
-fn files(folder: &Path, extension: &str) -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(folder)
-        .unwrap_or_else(|e| panic!("{}: {e}", folder.display()))
-        .map(|entry| entry.unwrap().path())
-        .filter(|path| path.extension().is_some_and(|e| e == extension))
-        .collect();
-    files.sort();
-    files
 }
 
 /// Every scene of `paths` at `width` x `height` with every structure;
@@ -89,10 +80,7 @@ const KNOWN: [&str; 7] = [
 
 #[test]
 fn every_example_scene_renders_the_same_with_every_structure() {
-    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
-    let scenes = files(&folder, "toml");
-    assert!(scenes.len() >= 10, "too few scenes in {}", folder.display());
-    assert_structures_agree(&scenes, (96, 72));
+    assert_structures_agree(&example_scenes(), (96, 72));
 }
 
 #[test]
