@@ -13,6 +13,7 @@ pub mod photon_map;
 mod ray_counts;
 mod ray_tree;
 mod shadow_cache;
+mod visibility;
 mod whitted;
 
 pub use observer::{FirstHit, RayObserver, ShadowStep, Unobserved};

@@ -25,28 +25,20 @@
 //!   ([`super::SECONDARY_RAY_BUDGET`]); the sample then says at which
 //!   material it was cut.
 
+use std::ops::ControlFlow::{Break, Continue};
+
 use crate::integrator::observer::{RayObserver, ShadowStep, Unobserved};
 use crate::integrator::photon_map::{self, CausticMap};
-use crate::integrator::shadow_cache;
+use crate::integrator::visibility::{SegmentStep, Visibility, shadow_segment};
 use crate::integrator::{PrimarySample, RayCounts, RayKind, RecursionLimits, Shading};
-use crate::math::{DVec2, Ray, RayOrigins, Vec3, offset_ray_origin};
+use crate::math::{DVec2, Ray, RayOrigins, Vec3};
 use crate::shading::differential::Bend;
 use crate::shading::optics::reflect;
 use crate::shading::{
     Color, Crossing, Light, Lobes, Material, MediumStack, RayDifferential, Weights, direct_samples,
     phong, shading_normal,
 };
-use crate::shape::ShapeHit;
-use crate::world::{
-    Hit, Interiors, MaterialId, OpaqueEntries, PassedEntries, PrimitiveId, ShadowCrossings,
-    ShadowPath, Surface, World,
-};
-
-/// Longest chain of transmissive surfaces one shadow ray passes through.
-const MAX_SHADOW_CROSSINGS: usize = 64;
-
-// A shadow ray answered from its crossings never meets the walk's limit.
-const _: () = assert!(ShadowCrossings::CAPACITY < MAX_SHADOW_CROSSINGS);
+use crate::world::{Hit, MaterialId, PrimitiveId, Surface, World};
 
 /// What one camera sample has traced so far: its rays by kind, the
 /// secondary rays it may still trace, and where it was cut; and who
@@ -82,22 +74,9 @@ pub struct Whitted<'a> {
     world: &'a World<'a>,
     shading: Shading<'a>,
     limits: RecursionLimits,
-    any_transmissive: bool,
-    /// In a world with transmissive surfaces, which entries stop shadow
-    /// rays outright, so that most shadow rays need one any-hit walk
-    /// ([`World::shadow_path`]); `None` without such surfaces, or for a
-    /// world with instances.
-    opaque: Option<OpaqueEntries>,
-    /// What a ray starting inside a sphere that lets light in can meet
-    /// first ([`World::interiors`]).
-    interiors: Interiors,
+    /// The questions every ray asks of the world.
+    visibility: Visibility<'a>,
     caustics: Option<&'a CausticMap>,
-    /// Per material, whether shading reads (u, v) ([`Material::reads_uv`]).
-    reads_uv: Vec<bool>,
-    /// Whether rays take the fast paths (the shadow cache, `opaque`'s
-    /// classifying walk and crossings, `interiors`), or every ray the
-    /// plain closest-hit or any-hit query.
-    fast_paths: bool,
 }
 
 impl<'a> Whitted<'a> {
@@ -107,17 +86,13 @@ impl<'a> Whitted<'a> {
     /// Prepares to trace in `world`, shading with `shading`, within
     /// `limits`.
     pub fn new(world: &'a World<'a>, shading: Shading<'a>, limits: RecursionLimits) -> Self {
-        let any_transmissive = shading.materials.iter().any(Material::is_transmissive);
+        let stops = stops_shadow_rays(shading.materials, None);
         Self {
             world,
             shading,
             limits,
-            any_transmissive,
-            opaque: opaque_entries(world, shading.materials, None),
-            interiors: world.interiors(|m| shading.materials[m.0 as usize].is_transmissive()),
+            visibility: Visibility::new(world, shading.materials).with_stops(&stops),
             caustics: None,
-            reads_uv: shading.materials.iter().map(Material::reads_uv).collect(),
-            fast_paths: true,
         }
     }
 
@@ -127,7 +102,7 @@ impl<'a> Whitted<'a> {
     /// against.
     pub fn with_fast_paths(self, fast: bool) -> Self {
         Self {
-            fast_paths: fast,
+            visibility: self.visibility.with_fast_paths(fast),
             ..self
         }
     }
@@ -138,14 +113,15 @@ impl<'a> Whitted<'a> {
     pub fn with_caustics(self, caustics: Option<&'a CausticMap>) -> Self {
         // Which entries stop shadow rays depends only on whether there is
         // a map: kept when that does not change (a pass over every entry).
-        let opaque = if caustics.is_some() == self.caustics.is_some() {
-            self.opaque
+        let visibility = if caustics.is_some() == self.caustics.is_some() {
+            self.visibility
         } else {
-            opaque_entries(self.world, self.shading.materials, caustics)
+            let stops = stops_shadow_rays(self.shading.materials, caustics);
+            self.visibility.with_stops(&stops)
         };
         Self {
             caustics,
-            opaque,
+            visibility,
             ..self
         }
     }
@@ -171,7 +147,7 @@ impl<'a> Whitted<'a> {
     ) -> PrimarySample {
         self.shade_camera_hit(
             ray,
-            self.world.intersect(ray),
+            self.visibility.closest(ray),
             differential,
             counts,
             observer,
@@ -258,7 +234,7 @@ impl<'a> Whitted<'a> {
     /// The surface at `hit`, with (u, v) and tangents only where the
     /// material or the observer reads them.
     fn surface<O: RayObserver>(&self, ray: &Ray, hit: &Hit) -> Surface {
-        let reads_uv: &[bool] = if O::READS_UV { &[] } else { &self.reads_uv };
+        let reads_uv = self.visibility.reads_uv(O::READS_UV);
         self.world.surface_for(ray, hit, reads_uv)
     }
 
@@ -276,12 +252,7 @@ impl<'a> Whitted<'a> {
         media: &MediumStack,
         tally: &mut SampleTally<'_, O>,
     ) -> Color {
-        let hit = if self.fast_paths {
-            self.world.intersect_from(ray, from, &self.interiors)
-        } else {
-            self.world.intersect(ray)
-        };
-        match hit {
+        match self.visibility.closest_from(ray, from) {
             None => {
                 tally.observer.ray_hit(ray, None);
                 self.shading.background
@@ -508,12 +479,8 @@ impl<'a> Whitted<'a> {
             Light::Area(_) => Some(s.point + distance * to_light),
         };
         let ray = shadow_segment(origin, to_light, (target, distance));
-        if !self.any_transmissive {
-            let blocked = if self.fast_paths {
-                shadow_cache::occluded(self.world, &ray, index)
-            } else {
-                self.world.occluded(&ray)
-            };
+        if !self.visibility.lets_light_through() {
+            let blocked = self.visibility.blocked(&ray, index);
             tally
                 .observer
                 .shadow_ray(&ray, ShadowStep::AnyHit { blocked });
@@ -524,8 +491,10 @@ impl<'a> Whitted<'a> {
 
     /// How much light passes along the shadow ray `ray` towards light
     /// number `index` (ending as [`shadow_segment`] says with `end`), in a
-    /// world where some surfaces let light through. Kept out of line: the
-    /// shadow rays of worlds without such surfaces then take a short path.
+    /// world where some surfaces let light through: the product of what
+    /// each surface crossed lets through, each crossing a shadow ray
+    /// counted. Kept out of line: the shadow rays of worlds without such
+    /// surfaces then take a short path.
     #[inline(never)]
     fn light_through<O: RayObserver>(
         &self,
@@ -534,96 +503,40 @@ impl<'a> Whitted<'a> {
         end: (Option<Vec3>, f64),
         tally: &mut SampleTally<'_, O>,
     ) -> Color {
-        // One any-hit walk tells most shadow rays apart; for those that
-        // cross surfaces letting light through, it lists them, and the
-        // surface-to-surface walk tests only those.
-        let mut passed = PassedEntries::UNLISTED;
-        if let Some(opaque) = self.opaque.as_ref().filter(|_| self.fast_paths) {
-            match shadow_cache::shadow_path(self.world, ray, opaque, index) {
-                ShadowPath::Crossed(entries) => {
-                    let crossings = self.world.shadow_crossings(ray, &entries);
-                    if let Some(through) =
-                        crossings.and_then(|c| self.light_through_crossings(ray, &c, tally))
-                    {
-                        return through;
+        let mut through = Color::ONE;
+        let answer = self
+            .visibility
+            .passing(ray, index, end, O::READS_UV, |step| match step {
+                SegmentStep::Answered { blocked } => {
+                    let step = ShadowStep::AnyHit { blocked };
+                    tally.observer.shadow_ray(ray, step);
+                    Break(if blocked { Color::ZERO } else { Color::ONE })
+                }
+                SegmentStep::Reached { segment } => {
+                    let step = ShadowStep::Closest { blocker: None };
+                    tally.observer.shadow_ray(&segment, step);
+                    Break(through)
+                }
+                SegmentStep::Crossed {
+                    segment,
+                    hit,
+                    material,
+                    uv,
+                } => {
+                    let step = ShadowStep::Closest {
+                        blocker: Some(&hit),
+                    };
+                    tally.observer.shadow_ray(&segment, step);
+                    through *= self.pass_through(material, uv);
+                    if through.max_element() <= 0.0 {
+                        return Break(Color::ZERO);
                     }
-                    passed = entries;
+                    tally.counts[RayKind::Shadow] += 1;
+                    Continue(())
                 }
-                path => {
-                    let blocked = path == ShadowPath::Blocked;
-                    tally
-                        .observer
-                        .shadow_ray(ray, ShadowStep::AnyHit { blocked });
-                    return if blocked { Color::ZERO } else { Color::ONE };
-                }
-            }
-        }
-        let mut ray = *ray;
-        let mut through = Color::ONE;
-        for _ in 0..MAX_SHADOW_CROSSINGS {
-            let Some(hit) = self.world.intersect_passed(&ray, &passed) else {
-                let step = ShadowStep::Closest { blocker: None };
-                tally.observer.shadow_ray(&ray, step);
-                return through;
-            };
-            let blocker = self.surface::<O>(&ray, &hit);
-            let step = ShadowStep::Closest {
-                blocker: Some(&hit),
-            };
-            tally.observer.shadow_ray(&ray, step);
-            through *= self.pass_through(blocker.material, blocker.uv);
-            if through.max_element() <= 0.0 {
-                return Color::ZERO;
-            }
-            tally.counts[RayKind::Shadow] += 1;
-            let origin =
-                offset_ray_origin(blocker.point, blocker.point_error, blocker.normal, ray.dir);
-            ray = shadow_segment(origin, ray.dir, end);
-        }
-        Color::ZERO
-    }
-
-    /// What a shadow ray along `ray` lets through, from its `crossings`
-    /// (nearest first): the product, in the same order, of what the
-    /// surface-to-surface walk would find at each, and the same shadow
-    /// rays counted. `None` when a crossed material reads (u, v): the walk
-    /// then finds each point.
-    fn light_through_crossings<O: RayObserver>(
-        &self,
-        ray: &Ray,
-        crossings: &ShadowCrossings,
-        tally: &mut SampleTally<'_, O>,
-    ) -> Option<Color> {
-        if crossings
-            .iter()
-            .any(|c| self.reads_uv[c.material.0 as usize])
-        {
-            return None;
-        }
-        // The observer is shown the steps as segments from each crossing
-        // on, as the walk would have made them.
-        let from = |t: f64| Ray::segment(ray.at(t), ray.dir, ray.t_max - t);
-        let mut through = Color::ONE;
-        let mut last = 0.0;
-        for c in crossings.iter() {
-            let hit = Hit {
-                primitive: c.primitive,
-                shape_hit: ShapeHit::at(c.t - last),
-            };
-            let step = ShadowStep::Closest {
-                blocker: Some(&hit),
-            };
-            tally.observer.shadow_ray(&from(last), step);
-            through *= self.pass_through(c.material, DVec2::ZERO);
-            if through.max_element() <= 0.0 {
-                return Some(Color::ZERO);
-            }
-            tally.counts[RayKind::Shadow] += 1;
-            last = c.t;
-        }
-        let step = ShadowStep::Closest { blocker: None };
-        tally.observer.shadow_ray(&from(last), step);
-        Some(through)
+            });
+        // Past the longest chain of crossings, no light arrives.
+        answer.unwrap_or(Color::ZERO)
     }
 
     /// What a shadow ray lets through a surface of `material` at `uv`.
@@ -636,29 +549,11 @@ impl<'a> Whitted<'a> {
     }
 }
 
-/// The shadow ray from `origin` along `to_light` (unit) towards a light at
-/// `target`, or `distance` away where there is none (a directional
-/// light).
-#[inline(always)]
-fn shadow_segment(origin: Vec3, to_light: Vec3, (target, distance): (Option<Vec3>, f64)) -> Ray {
-    let t_max = target.map_or(distance, |p| (p - origin).dot(to_light));
-    Ray::segment(origin, to_light, t_max)
-}
-
-/// Which entries of `world` stop shadow rays outright, when some material
-/// lets light through: those of materials that let none through (with
-/// `caustics`, also those that bend light, whose light the map carries).
-/// `None` when no material lets light through (shadow rays then take the
-/// plain any-hit query) or for a world with instances.
-fn opaque_entries(
-    world: &World<'_>,
-    materials: &[Material],
-    caustics: Option<&CausticMap>,
-) -> Option<OpaqueEntries> {
-    if !materials.iter().any(Material::is_transmissive) {
-        return None;
-    }
+/// Per material, whether its surfaces stop shadow rays outright: those
+/// that let no light through and, with `caustics`, those that bend light,
+/// whose light the map carries.
+fn stops_shadow_rays(materials: &[Material], caustics: Option<&CausticMap>) -> Vec<bool> {
     let stops =
         |m: &Material| !m.is_transmissive() || (caustics.is_some() && photon_map::bends_light(m));
-    world.opaque_entries(&materials.iter().map(stops).collect::<Vec<_>>())
+    materials.iter().map(stops).collect()
 }

@@ -43,7 +43,7 @@ pub(super) fn build(
         return Ok(None);
     }
     let start = Instant::now();
-    let map = CausticMap::build(world, shading, &settings.photons)?;
+    let map = CausticMap::build(world, shading, &settings.photons, settings.fast_paths)?;
     let report = PhotonReport {
         emitted: map.emitted(),
         stored: map.photons().len(),

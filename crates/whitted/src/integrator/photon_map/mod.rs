@@ -50,6 +50,7 @@ use std::f64::consts::PI;
 use rayon::prelude::*;
 
 use crate::integrator::Shading;
+use crate::integrator::visibility::Visibility;
 use crate::limits::{MemoryBudget, MemoryError};
 use crate::math::{DVec2, Vec3};
 use crate::shading::{Color, Material};
@@ -122,12 +123,15 @@ thread_local! {
 
 impl CausticMap {
     /// Runs the photon pass over `world` (on the current rayon pool) with
-    /// `shading`'s lights and materials, and builds the map. Refuses a
-    /// count whose photons could exceed the memory budget.
+    /// `shading`'s lights and materials, and builds the map. Photons find
+    /// their hits by the fast paths, or with `fast_paths` false by the
+    /// plain closest-hit query (the same map). Refuses a count whose
+    /// photons could exceed the memory budget.
     pub fn build(
         world: &World<'_>,
         shading: &Shading<'_>,
         settings: &PhotonSettings,
+        fast_paths: bool,
     ) -> Result<Self, MemoryError> {
         let bytes = settings
             .count
@@ -140,6 +144,7 @@ impl CausticMap {
         let bounds = world.bounds();
         let aimed = aim::caustic_bounds(world.objects(), shading.materials, bounds);
         let emitters = trace::share(shading.lights, &aimed, settings.count);
+        let visibility = Visibility::new(world, shading.materials).with_fast_paths(fast_paths);
         let tasks = settings.count.div_ceil(PHOTONS_PER_TASK);
         let parts: Vec<Vec<Photon>> = (0..tasks)
             .into_par_iter()
@@ -147,7 +152,8 @@ impl CausticMap {
                 let start = task * PHOTONS_PER_TASK;
                 let end = (start + PHOTONS_PER_TASK).min(settings.count);
                 let mut kept = Vec::new();
-                trace::shoot(world, shading, &emitters, &aimed, start..end, &mut kept);
+                let sources = (&emitters[..], &aimed);
+                trace::shoot(&visibility, shading, sources, start..end, &mut kept);
                 kept
             })
             .collect();

@@ -43,7 +43,7 @@ impl Setup {
             gather,
             radius: Some(radius),
         };
-        CausticMap::build(&world, &shading, &settings).unwrap()
+        CausticMap::build(&world, &shading, &settings, true).unwrap()
     }
 }
 

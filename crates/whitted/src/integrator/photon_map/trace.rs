@@ -17,10 +17,10 @@
 use std::ops::Range;
 
 use crate::integrator::Shading;
+use crate::integrator::visibility::Visibility;
 use crate::math::random::{Rng, hash64};
 use crate::math::{Aabb, Ray, offset_ray_origin};
 use crate::shading::{Color, Light, Material, MediumStack, ScatterKind, shading_normal};
-use crate::world::World;
 
 use super::Photon;
 
@@ -87,10 +87,9 @@ pub(super) fn share<'l>(lights: &'l [Light], bounds: &Aabb, total: u64) -> Vec<E
 /// Traces the photons numbered `photons` and appends those it keeps to
 /// `out`.
 pub(super) fn shoot(
-    world: &World<'_>,
+    visibility: &Visibility<'_>,
     shading: &Shading<'_>,
-    emitters: &[Emitter<'_>],
-    bounds: &Aabb,
+    (emitters, bounds): (&[Emitter<'_>], &Aabb),
     photons: Range<u64>,
     out: &mut Vec<Photon>,
 ) {
@@ -108,7 +107,7 @@ pub(super) fn shoot(
         };
         let mut rng = Rng::new(hash64(j ^ SCATTER_SEED));
         follow(
-            world,
+            visibility,
             shading,
             Ray::new(ray.origin, ray.direction),
             emitter.photon_power,
@@ -122,7 +121,7 @@ pub(super) fn shoot(
 /// scattering, keeping it where it lands on a diffuse surface after at
 /// least one bend.
 fn follow(
-    world: &World<'_>,
+    visibility: &Visibility<'_>,
     shading: &Shading<'_>,
     mut ray: Ray,
     mut power: Color,
@@ -131,11 +130,17 @@ fn follow(
 ) {
     let mut media = MediumStack::default();
     let mut specular = false;
+    let mut from = None;
     for _ in 0..MAX_BOUNCES {
-        let Some(hit) = world.intersect(&ray) else {
+        let hit = match from {
+            None => visibility.closest(&ray),
+            Some(from) => visibility.closest_from(&ray, from),
+        };
+        let Some(hit) = hit else {
             return;
         };
-        let s = world.surface(&ray, &hit);
+        from = Some(hit.primitive);
+        let s = visibility.world().surface(&ray, &hit);
         let m = &shading.materials[s.material.0 as usize];
         let incident = ray.dir;
         let entering = incident.dot(s.normal) < 0.0;
