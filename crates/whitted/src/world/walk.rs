@@ -21,23 +21,8 @@ impl<'a> World<'a> {
         ray: &Ray,
         ctx: &mut QueryContext,
     ) -> Option<Hit> {
-        /// The query as a kernel's task.
-        struct Closest<'q, 'a> {
-            world: &'q World<'a>,
-            definitions: &'q [World<'a>],
-            ray: &'q Ray,
-            ctx: &'q mut QueryContext,
-        }
-        impl KernelTask for Closest<'_, '_> {
-            type Output = Option<Hit>;
-            #[inline(always)]
-            fn run<K: Kernel>(self) -> Option<Hit> {
-                self.world
-                    .closest_with::<K>(self.definitions, self.ray, self.ctx)
-            }
-        }
         let backend = ctx.backend;
-        let task = Closest {
+        let task = Task::<false> {
             world: self,
             definitions,
             ray,
@@ -90,23 +75,8 @@ impl<'a> World<'a> {
     /// True when anything lies in the ray's interval in this level, its
     /// instances placing `definitions`.
     pub(super) fn any(&self, definitions: &[World<'a>], ray: &Ray, ctx: &mut QueryContext) -> bool {
-        /// The query as a kernel's task.
-        struct Any<'q, 'a> {
-            world: &'q World<'a>,
-            definitions: &'q [World<'a>],
-            ray: &'q Ray,
-            ctx: &'q mut QueryContext,
-        }
-        impl KernelTask for Any<'_, '_> {
-            type Output = bool;
-            #[inline(always)]
-            fn run<K: Kernel>(self) -> bool {
-                self.world
-                    .any_with::<K>(self.definitions, self.ray, self.ctx)
-            }
-        }
         let backend = ctx.backend;
-        let task = Any {
+        let task = Task::<true> {
             world: self,
             definitions,
             ray,
@@ -161,6 +131,33 @@ impl<'a> World<'a> {
         let occluded = self.accel.any_with::<K>(ray, ctx, leaves);
         ctx.counters += inner.counters;
         occluded
+    }
+}
+
+/// A query of one level as a kernel's task: any hit with `ANY`, the
+/// closest otherwise.
+struct Task<'q, 'a, const ANY: bool> {
+    world: &'q World<'a>,
+    definitions: &'q [World<'a>],
+    ray: &'q Ray,
+    ctx: &'q mut QueryContext,
+}
+
+impl KernelTask for Task<'_, '_, false> {
+    type Output = Option<Hit>;
+    #[inline(always)]
+    fn run<K: Kernel>(self) -> Option<Hit> {
+        self.world
+            .closest_with::<K>(self.definitions, self.ray, self.ctx)
+    }
+}
+
+impl KernelTask for Task<'_, '_, true> {
+    type Output = bool;
+    #[inline(always)]
+    fn run<K: Kernel>(self) -> bool {
+        self.world
+            .any_with::<K>(self.definitions, self.ray, self.ctx)
     }
 }
 
