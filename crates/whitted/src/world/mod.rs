@@ -51,8 +51,7 @@ pub use shadow_hint::ShadowHint;
 pub use shadow_path::{OpaqueEntries, PassedEntries, ShadowCrossing, ShadowCrossings, ShadowPath};
 
 use crate::accel::{
-    AccelKind, AccelerationStructure, Accelerator, Backend, Clipper, KdTree, KdTreeBuildParams,
-    QueryContext,
+    AccelKind, AccelerationStructure, Accelerator, Clipper, KdTree, KdTreeBuildParams, QueryContext,
 };
 use crate::math::{Aabb, Ray, Transform, Vec3};
 use crate::shape::{Shape, ShapeHit, clipped_triangle_bounds};
@@ -141,11 +140,6 @@ pub struct World<'a> {
     /// Whether some entry of `entries` is a triangle, so queries compute
     /// the ray's shear up front.
     has_triangles: bool,
-    /// Whether the current backend has AVX ([`Backend::current`]), so the
-    /// leaf tests of the walks not entered through a kernel (the packet
-    /// walks, an instance's any-hit walk) cull runs of spheres four at a
-    /// time, and shadow rays test runs of triangles four at a time.
-    wide: bool,
     /// The unbounded shapes (infinite planes) and instances of definitions
     /// holding one, tested beside the structure.
     unbounded: Vec<Entry>,
@@ -447,7 +441,6 @@ impl<'a> World<'a> {
             .iter()
             .filter(|e| e.kind == EntryKind::Placed)
             .count();
-        let wide = Backend::current().has_avx();
         let mut world = Self {
             objects,
             shapes: &objects.primitives,
@@ -459,7 +452,6 @@ impl<'a> World<'a> {
             bounds,
             entries,
             has_triangles,
-            wide,
             unbounded,
             instance_count: slot_instances.len() + slot_placed.len() + unbounded_placed,
             primitive_count: n,
@@ -652,7 +644,7 @@ impl<'a> World<'a> {
         match e.kind {
             EntryKind::Instance => {
                 let (structure, local) = self.instance_ray(e.number, query.ray);
-                structure.occluded(&local, self.wide, inner)
+                structure.occluded(&local, inner.backend.has_avx(), inner)
             }
             EntryKind::Placed => {
                 let (definition, local) = self.placed_ray(definitions, e.number, query.ray);

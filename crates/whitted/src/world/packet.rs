@@ -24,7 +24,7 @@
 use std::ops::Range;
 
 use crate::accel::bvh::PACKET_LANES;
-use crate::accel::{Accelerator, Bvh, QueryContext};
+use crate::accel::{Accelerator, Backend, Bvh, QueryContext};
 use crate::math::Ray;
 #[cfg(target_arch = "x86_64")]
 use crate::shape::{LANES, RayLanes4, RayShear, ShapeHit, watertight_rays4};
@@ -41,20 +41,25 @@ pub const PACKET_SIZE: usize = PACKET_LANES;
 const ACROSS_FROM: u32 = 2;
 
 impl<'a> World<'a> {
-    /// True when [`Self::intersect_packet`] walks packets together (else
-    /// it walks their rays one at a time, and callers may as well).
+    /// True when [`Self::intersect_packet`] walks packets together under
+    /// the default backend ([`Backend::current`]; else it walks their rays
+    /// one at a time, and callers may as well).
     pub fn walks_packets(&self) -> bool {
-        self.packet_walk
+        self.walks_packets_with(Backend::current())
     }
 
-    /// Whether packets of rays may walk this world's structure together:
-    /// a BVH whose entries all report parameters that do not depend on the
-    /// interval they are tested with (see the module documentation), on a
-    /// processor with AVX.
+    /// True when [`Self::intersect_packet`] walks packets together with a
+    /// query context of `backend`: the walk needs AVX.
+    pub(super) fn walks_packets_with(&self, backend: Backend) -> bool {
+        self.packet_walk && backend.has_avx()
+    }
+
+    /// Whether packets of rays may walk this world's structure together
+    /// (on a backend with AVX): a BVH whose entries all report parameters
+    /// that do not depend on the interval they are tested with (see the
+    /// module documentation).
     pub(super) fn packets_allowed(&self) -> bool {
-        // The walk runs on AVX, which `wide` says the processor has.
-        self.wide
-            && matches!(self.accel, Accelerator::Bvh(_))
+        matches!(self.accel, Accelerator::Bvh(_))
             && self.entries.iter().all(|e| match e.kind {
                 EntryKind::Triangle | EntryKind::Sphere | EntryKind::Polygon | EntryKind::Axial => {
                     true
@@ -78,7 +83,7 @@ impl<'a> World<'a> {
         let hits = &mut hits[..rays.len()];
         let all = (1u32 << rays.len()) - 1;
         let mut alone = match &self.accel {
-            Accelerator::Bvh(bvh) if self.packet_walk && !rays.is_empty() => {
+            Accelerator::Bvh(bvh) if self.walks_packets_with(ctx.backend) && !rays.is_empty() => {
                 self.closest_packet(bvh, rays, ctx, hits)
             }
             _ => all,
@@ -138,59 +143,69 @@ impl<'a> World<'a> {
         // leaf needs them, `Some(None)` when a set is not).
         #[cfg(target_arch = "x86_64")]
         let mut across: Option<Option<[RayLanes4; 2]>> = None;
-        let tied = bvh.intersect_packet_by_leaf(rays, &mut ctx.counters, |lanes, range, t_max| {
-            let mut found = 0;
-            // The lanes left to test one by one.
-            let mut alone = lanes;
-            #[cfg(target_arch = "x86_64")]
-            if !self.big_meshes && crowded_halves(lanes) != 0 && self.all_triangles(range.clone()) {
-                let across = across.get_or_insert_with(|| {
-                    for (lane, ray) in rays.iter().enumerate() {
-                        queries[lane].get_or_insert_with(|| Query::new(ray, self.has_triangles));
+        let (backend, wide) = (ctx.backend, ctx.backend.has_avx());
+        let tied = bvh.intersect_packet_by_leaf(
+            rays,
+            backend,
+            &mut ctx.counters,
+            |lanes, range, t_max| {
+                let mut found = 0;
+                // The lanes left to test one by one.
+                let mut alone = lanes;
+                #[cfg(target_arch = "x86_64")]
+                if !self.big_meshes
+                    && crowded_halves(lanes) != 0
+                    && self.all_triangles(range.clone())
+                {
+                    let across = across.get_or_insert_with(|| {
+                        for (lane, ray) in rays.iter().enumerate() {
+                            queries[lane]
+                                .get_or_insert_with(|| Query::new(ray, self.has_triangles));
+                        }
+                        // SAFETY: packets are walked together only where the
+                        // processor has AVX (`packets_allowed`).
+                        unsafe { ray_lanes(rays, &queries) }
+                    });
+                    if let Some(across) = across {
+                        let together = lanes & crowded_halves(lanes);
+                        // SAFETY: as above.
+                        found = unsafe {
+                            self.triangles_across(range.clone(), together, t_max, across, hits)
+                        };
+                        alone &= !together;
                     }
-                    // SAFETY: packets are walked together only where the
-                    // processor has AVX (`packets_allowed`).
-                    unsafe { ray_lanes(rays, &queries) }
-                });
-                if let Some(across) = across {
-                    let together = lanes & crowded_halves(lanes);
-                    // SAFETY: as above.
-                    found = unsafe {
-                        self.triangles_across(range.clone(), together, t_max, across, hits)
-                    };
-                    alone &= !together;
                 }
-            }
-            let mut bits = alone;
-            while bits != 0 {
-                let lane = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                let query = queries[lane]
-                    .get_or_insert_with(|| Query::new(&rays[lane], self.has_triangles));
-                let number = hits[lane].map_or(u32::MAX, |h| h.primitive.0);
-                let closest = leaf_hit(
-                    &self.entries,
-                    range.clone(),
-                    query,
-                    (t_max[lane], number),
-                    self.wide,
-                    |e, t_max, rest| {
-                        self.intersect_other(definitions, e, (query, t_max, rest), &mut inner)
-                    },
-                    |primitive, shape_hit| {
-                        hits[lane] = Some(Hit {
-                            primitive: PrimitiveId(primitive),
-                            shape_hit,
-                        })
-                    },
-                );
-                if let Some(t) = closest {
-                    t_max[lane] = t;
-                    found |= 1 << lane;
+                let mut bits = alone;
+                while bits != 0 {
+                    let lane = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    let query = queries[lane]
+                        .get_or_insert_with(|| Query::new(&rays[lane], self.has_triangles));
+                    let number = hits[lane].map_or(u32::MAX, |h| h.primitive.0);
+                    let closest = leaf_hit(
+                        &self.entries,
+                        range.clone(),
+                        query,
+                        (t_max[lane], number),
+                        wide,
+                        |e, t_max, rest| {
+                            self.intersect_other(definitions, e, (query, t_max, rest), &mut inner)
+                        },
+                        |primitive, shape_hit| {
+                            hits[lane] = Some(Hit {
+                                primitive: PrimitiveId(primitive),
+                                shape_hit,
+                            })
+                        },
+                    );
+                    if let Some(t) = closest {
+                        t_max[lane] = t;
+                        found |= 1 << lane;
+                    }
                 }
-            }
-            found
-        });
+                found
+            },
+        );
         ctx.counters += inner.counters;
         tied.unwrap_or(all)
     }
@@ -308,7 +323,7 @@ fn ray_lanes(rays: &[Ray], queries: &[Option<Query>; PACKET_SIZE]) -> Option<[Ra
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
-    use crate::accel::AccelKind;
+    use crate::accel::{AccelKind, Isa};
     use crate::math::random::Rng;
     use crate::math::{Transform, Vec3};
     use crate::mesh::TriangleMesh;
@@ -383,6 +398,17 @@ pub(super) mod tests {
             let mut ctx = QueryContext::default();
             let mut found = [None; PACKET_SIZE];
             world.intersect_packet(rays, &mut ctx, &mut found);
+            // Every backend gives the same hits (those without AVX walk the
+            // rays one by one).
+            for backend in Isa::ALL.into_iter().filter_map(Backend::new) {
+                let mut narrowed = QueryContext {
+                    backend,
+                    ..QueryContext::default()
+                };
+                let mut again = [None; PACKET_SIZE];
+                world.intersect_packet(rays, &mut narrowed, &mut again);
+                assert_eq!(again, found, "{backend:?}");
+            }
             if let Accelerator::Bvh(bvh) = &world.accel
                 && !rays.is_empty()
             {
@@ -411,7 +437,7 @@ pub(super) mod tests {
         let mut rng = Rng::new(5);
         for floor in [false, true] {
             let objects = closed_form_scene(&mut rng, floor);
-            assert_eq!(World::new(&objects).packet_walk, has_avx());
+            assert_eq!(World::new(&objects).walks_packets(), has_avx());
             let mut packets = camera_packets(&mut rng, 400, 0.002);
             packets.extend(camera_packets(&mut rng, 200, 0.05));
             let (together, hits) = assert_packets_agree(&objects, &packets);
@@ -596,43 +622,54 @@ pub(super) mod tests {
             // Every leaf the packet reaches, tested across a random subset
             // of its lanes with random interval ends, against each lane's
             // own loop.
-            bvh.intersect_packet_by_leaf(&rays, &mut counters, |lanes, range, _| {
-                let chosen = lanes & rng.below(256);
-                let ends: [f64; PACKET_SIZE] = std::array::from_fn(|_| rng.range(0.0, 20.0));
-                let mut t_max = ends;
-                let mut hits = [None; PACKET_SIZE];
-                // SAFETY: as above.
-                let found = unsafe {
-                    world.triangles_across(range.clone(), chosen, &mut t_max, &across, &mut hits)
-                };
-                for lane in 0..PACKET_SIZE {
-                    let mut own = None;
-                    let mut closest = None;
-                    if chosen & 1 << lane != 0 {
-                        closest = leaf_hit(
-                            &world.entries,
+            bvh.intersect_packet_by_leaf(
+                &rays,
+                Backend::current(),
+                &mut counters,
+                |lanes, range, _| {
+                    let chosen = lanes & rng.below(256);
+                    let ends: [f64; PACKET_SIZE] = std::array::from_fn(|_| rng.range(0.0, 20.0));
+                    let mut t_max = ends;
+                    let mut hits = [None; PACKET_SIZE];
+                    // SAFETY: as above.
+                    let found = unsafe {
+                        world.triangles_across(
                             range.clone(),
-                            queries[lane].as_ref().unwrap(),
-                            (ends[lane], u32::MAX),
-                            false,
-                            |_, _, _| unreachable!("triangles only"),
-                            |primitive, shape_hit| {
-                                own = Some(Hit {
-                                    primitive: PrimitiveId(primitive),
-                                    shape_hit,
-                                })
-                            },
-                        );
+                            chosen,
+                            &mut t_max,
+                            &across,
+                            &mut hits,
+                        )
+                    };
+                    for lane in 0..PACKET_SIZE {
+                        let mut own = None;
+                        let mut closest = None;
+                        if chosen & 1 << lane != 0 {
+                            closest = leaf_hit(
+                                &world.entries,
+                                range.clone(),
+                                queries[lane].as_ref().unwrap(),
+                                (ends[lane], u32::MAX),
+                                false,
+                                |_, _, _| unreachable!("triangles only"),
+                                |primitive, shape_hit| {
+                                    own = Some(Hit {
+                                        primitive: PrimitiveId(primitive),
+                                        shape_hit,
+                                    })
+                                },
+                            );
+                        }
+                        assert_eq!(found & 1 << lane != 0, closest.is_some(), "lane {lane}");
+                        assert_eq!(hits[lane], own, "lane {lane}");
+                        let end = closest.unwrap_or(ends[lane]);
+                        assert_eq!(t_max[lane].to_bits(), end.to_bits(), "lane {lane}");
+                        lanes_hit += usize::from(closest.is_some());
                     }
-                    assert_eq!(found & 1 << lane != 0, closest.is_some(), "lane {lane}");
-                    assert_eq!(hits[lane], own, "lane {lane}");
-                    let end = closest.unwrap_or(ends[lane]);
-                    assert_eq!(t_max[lane].to_bits(), end.to_bits(), "lane {lane}");
-                    lanes_hit += usize::from(closest.is_some());
-                }
-                leaves += 1;
-                0
-            });
+                    leaves += 1;
+                    0
+                },
+            );
         }
         assert!(
             leaves > 500 && lanes_hit > 200,
@@ -644,7 +681,7 @@ pub(super) mod tests {
     fn searched_shapes_and_instances_keep_single_walks() {
         let mut rng = Rng::new(8);
         let mut objects = closed_form_scene(&mut rng, false);
-        assert_eq!(World::new(&objects).packet_walk, has_avx());
+        assert_eq!(World::new(&objects).walks_packets(), has_avx());
         assert!(!World::build(&objects, AccelKind::KdTree).packet_walk);
         let torus = Torus::new(1.0, 0.3).unwrap();
         objects.add_primitive(Shape::Torus(torus), MaterialId(0), Transform::IDENTITY);

@@ -28,7 +28,7 @@ impl World<'_> {
     pub fn occluded_packet(&self, rays: &[Ray], ctx: &mut QueryContext) -> u32 {
         assert!(rays.len() <= PACKET_SIZE, "{} rays in a packet", rays.len());
         let together = match &self.accel {
-            Accelerator::Bvh(bvh) if self.packet_walk && !rays.is_empty() => {
+            Accelerator::Bvh(bvh) if self.walks_packets_with(ctx.backend) && !rays.is_empty() => {
                 self.occluded_together(bvh, rays, ctx)
             }
             _ => None,
@@ -61,9 +61,10 @@ impl World<'_> {
                 }
             }
         }
+        let wide = ctx.backend.has_avx();
         let walked = bvh.occluded_packet_by_leaf(
             rays,
-            all & !occluded,
+            (all & !occluded, ctx.backend),
             &mut ctx.counters,
             |lanes, range| {
                 let mut found = 0;
@@ -74,7 +75,7 @@ impl World<'_> {
                     let query = queries[lane]
                         .get_or_insert_with(|| Query::new(&rays[lane], self.has_triangles));
                     let meets =
-                        leaf_occludes(&self.entries, range.clone(), query, self.wide, |e, rest| {
+                        leaf_occludes(&self.entries, range.clone(), query, wide, |e, rest| {
                             self.rest_occludes(e.number, query, rest)
                         });
                     if meets.is_some() {
@@ -96,7 +97,7 @@ impl World<'_> {
 mod tests {
     use super::super::packet::tests::{closed_form_scene, has_avx, triangles_only};
     use super::*;
-    use crate::accel::AccelKind;
+    use crate::accel::{AccelKind, Backend, Isa};
     use crate::math::Vec3;
     use crate::math::random::Rng;
     use crate::world::Objects;
@@ -131,6 +132,13 @@ mod tests {
         for rays in packets {
             let mut ctx = QueryContext::default();
             let occluded = world.occluded_packet(rays, &mut ctx);
+            for backend in Isa::ALL.into_iter().filter_map(Backend::new) {
+                let mut narrowed = QueryContext {
+                    backend,
+                    ..QueryContext::default()
+                };
+                assert_eq!(world.occluded_packet(rays, &mut narrowed), occluded);
+            }
             if let Accelerator::Bvh(bvh) = &world.accel {
                 counts[0] += usize::from(world.occluded_together(bvh, rays, &mut ctx).is_some());
             }
@@ -153,7 +161,7 @@ mod tests {
             closed_form_scene(&mut rng, true),
             triangles_only(&mut rng, 24),
         ] {
-            assert_eq!(World::new(&objects).packet_walk, has_avx());
+            assert_eq!(World::new(&objects).walks_packets(), has_avx());
             let mut packets = shadow_packets(&mut rng, 300, 0.05);
             packets.extend(shadow_packets(&mut rng, 300, 1.0));
             let [together, occluded, clear] = assert_shadow_packets_agree(&objects, &packets);

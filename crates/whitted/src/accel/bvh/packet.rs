@@ -40,7 +40,8 @@
 
 use std::ops::Range;
 
-use crate::accel::TraversalCounters;
+use crate::accel::kernel::{self, Kernel, KernelTask};
+use crate::accel::{Backend, Isa, TraversalCounters};
 use crate::math::Ray;
 
 use super::Bvh;
@@ -54,14 +55,16 @@ impl Bvh {
     /// ray as [`Self::intersect_in_leaf_order`] does (the closest hit among
     /// the entries closer than `t_max`, if any). Returns the lanes that
     /// must be walked again alone (ties, see the module documentation), or
-    /// `None` when the packet cannot be walked together at all.
+    /// `None` when the packet cannot be walked together at all (always
+    /// with a `backend` without AVX).
     pub fn intersect_packet_in_leaf_order(
         &self,
         rays: &[Ray],
+        backend: Backend,
         counters: &mut TraversalCounters,
         mut hit: impl FnMut(usize, Range<u32>, f64) -> Option<f64>,
     ) -> Option<u32> {
-        self.intersect_packet_by_leaf(rays, counters, |lanes, range, t_max| {
+        self.intersect_packet_by_leaf(rays, backend, counters, |lanes, range, t_max| {
             let mut found = 0;
             let mut bits = lanes;
             while bits != 0 {
@@ -81,34 +84,68 @@ impl Bvh {
     /// across them: `hit(lanes, entries, t_max)` does for each lane whose
     /// bit is set in `lanes` what `hit` of that method does with
     /// `t_max[lane]`, and where that finds a hit, sets the lane's bit in
-    /// the mask it returns and leaves the hit's `t` in `t_max[lane]`.
+    /// the mask it returns and leaves the hit's `t` in `t_max[lane]`. The
+    /// walk and `hit` run as one task of `backend`'s kernel
+    /// ([`kernel::run`]).
     pub fn intersect_packet_by_leaf(
         &self,
         rays: &[Ray],
+        backend: Backend,
         counters: &mut TraversalCounters,
         hit: impl FnMut(u32, Range<u32>, &mut [f64; PACKET_LANES]) -> u32,
     ) -> Option<u32> {
+        /// The walk as a kernel's task.
+        struct Packet<'q, L> {
+            bvh: &'q Bvh,
+            rays: &'q [Ray],
+            counters: &'q mut TraversalCounters,
+            hit: L,
+        }
+        impl<L: FnMut(u32, Range<u32>, &mut [f64; PACKET_LANES]) -> u32> KernelTask for Packet<'_, L> {
+            type Output = Option<u32>;
+            #[inline(always)]
+            fn run<K: Kernel>(self) -> Option<u32> {
+                if K::ISA < Isa::Avx {
+                    return None;
+                }
+                #[cfg(target_arch = "x86_64")]
+                {
+                    use super::traverse::{MIDDLE, SHALLOW, stack_size};
+                    let Self {
+                        bvh,
+                        rays,
+                        counters,
+                        hit,
+                    } = self;
+                    // SAFETY: the kernel has AVX, so the processor does.
+                    let lanes = unsafe { avx::Lanes::new(rays) }?;
+                    // SAFETY: as above.
+                    Some(unsafe {
+                        if bvh.max_depth <= SHALLOW {
+                            bvh.packet::<{ stack_size(SHALLOW) }>(&lanes, rays, counters, hit)
+                        } else if bvh.max_depth <= MIDDLE {
+                            bvh.packet::<{ stack_size(MIDDLE) }>(&lanes, rays, counters, hit)
+                        } else {
+                            bvh.packet::<{ stack_size(super::MAX_DEPTH) }>(
+                                &lanes, rays, counters, hit,
+                            )
+                        }
+                    })
+                }
+                #[cfg(not(target_arch = "x86_64"))]
+                None
+            }
+        }
         if rays.is_empty() || rays.len() > PACKET_LANES || self.nodes.is_empty() {
             return None;
         }
-        #[cfg(target_arch = "x86_64")]
-        if crate::accel::Backend::current().has_avx() {
-            use super::traverse::{MIDDLE, SHALLOW, stack_size};
-            // SAFETY: the processor has AVX (the current backend does).
-            let lanes = unsafe { avx::Lanes::new(rays) }?;
-            // SAFETY: the processor has AVX.
-            return Some(unsafe {
-                if self.max_depth <= SHALLOW {
-                    self.packet::<{ stack_size(SHALLOW) }>(&lanes, rays, counters, hit)
-                } else if self.max_depth <= MIDDLE {
-                    self.packet::<{ stack_size(MIDDLE) }>(&lanes, rays, counters, hit)
-                } else {
-                    self.packet::<{ stack_size(super::MAX_DEPTH) }>(&lanes, rays, counters, hit)
-                }
-            });
-        }
-        let _ = (counters, hit);
-        None
+        let task = Packet {
+            bvh: self,
+            rays,
+            counters,
+            hit,
+        };
+        kernel::run(backend, task)
     }
 
     /// The walk of [`Self::intersect_packet_by_leaf`] with a stack of
@@ -754,6 +791,7 @@ mod tests {
                 let mut counters = TraversalCounters::default();
                 let alone = bvh.intersect_packet_in_leaf_order(
                     &rays,
+                    crate::accel::Backend::current(),
                     &mut counters,
                     |lane, range, t_max| {
                         let mut r = rays[lane];
@@ -817,6 +855,7 @@ mod tests {
             let mut counters = TraversalCounters::default();
             let Some(alone) = bvh.intersect_packet_in_leaf_order(
                 &rays,
+                crate::accel::Backend::current(),
                 &mut counters,
                 |lane, range, mut t_max| {
                     let mut best = None;
@@ -869,7 +908,12 @@ mod tests {
         let bvh = Bvh::build(&[Aabb::new(Vec3::splat(1.0), Vec3::splat(2.0))]);
         let mut counters = TraversalCounters::default();
         let walk = |rays: &[Ray], counters: &mut TraversalCounters| {
-            bvh.intersect_packet_in_leaf_order(rays, counters, |_, _, _| None)
+            bvh.intersect_packet_in_leaf_order(
+                rays,
+                crate::accel::Backend::current(),
+                counters,
+                |_, _, _| None,
+            )
         };
         assert_eq!(walk(&[forward, back], &mut counters), None);
         assert_eq!(walk(&[], &mut counters), None);

@@ -16,7 +16,8 @@
 
 use std::ops::Range;
 
-use crate::accel::TraversalCounters;
+use crate::accel::kernel::{self, Kernel, KernelTask};
+use crate::accel::{Backend, Isa, TraversalCounters};
 use crate::math::Ray;
 
 use super::{Bvh, PACKET_LANES};
@@ -27,16 +28,65 @@ impl Bvh {
     /// `occludes(lanes, entries)` telling which of the lanes `lanes` meet
     /// one of the leaf's entries (as [`Self::occluded_in_leaf_order`]'s
     /// test tells it for one ray): the mask of the occluded lanes, or
-    /// `None` when the packet cannot be walked together (see `packet`).
-    /// With no lane asked for, or an empty hierarchy, that is `Some(0)`
-    /// whatever the rays.
+    /// `None` when the packet cannot be walked together (see `packet`;
+    /// always with a `backend` without AVX). With no lane asked for, or an
+    /// empty hierarchy, that is `Some(0)` whatever the rays. The walk and
+    /// `occludes` run as one task of `backend`'s kernel ([`kernel::run`]).
     pub fn occluded_packet_by_leaf(
         &self,
         rays: &[Ray],
-        lanes: u32,
+        (lanes, backend): (u32, Backend),
         counters: &mut TraversalCounters,
         occludes: impl FnMut(u32, Range<u32>) -> u32,
     ) -> Option<u32> {
+        /// The walk as a kernel's task.
+        struct Packet<'q, L> {
+            bvh: &'q Bvh,
+            rays: &'q [Ray],
+            lanes: u32,
+            counters: &'q mut TraversalCounters,
+            occludes: L,
+        }
+        impl<L: FnMut(u32, Range<u32>) -> u32> KernelTask for Packet<'_, L> {
+            type Output = Option<u32>;
+            #[inline(always)]
+            fn run<K: Kernel>(self) -> Option<u32> {
+                if K::ISA < Isa::Avx {
+                    return None;
+                }
+                #[cfg(target_arch = "x86_64")]
+                {
+                    use super::traverse::{MIDDLE, SHALLOW, stack_size};
+                    let Self {
+                        bvh,
+                        rays,
+                        lanes,
+                        counters,
+                        occludes,
+                    } = self;
+                    // SAFETY: the kernel has AVX, so the processor does.
+                    let packet = unsafe { super::packet::avx::Lanes::new(rays) }?;
+                    // SAFETY: as above.
+                    Some(unsafe {
+                        if bvh.max_depth <= SHALLOW {
+                            bvh.occluded_walk::<{ stack_size(SHALLOW) }>(
+                                &packet, rays, lanes, counters, occludes,
+                            )
+                        } else if bvh.max_depth <= MIDDLE {
+                            bvh.occluded_walk::<{ stack_size(MIDDLE) }>(
+                                &packet, rays, lanes, counters, occludes,
+                            )
+                        } else {
+                            bvh.occluded_walk::<{ stack_size(super::MAX_DEPTH) }>(
+                                &packet, rays, lanes, counters, occludes,
+                            )
+                        }
+                    })
+                }
+                #[cfg(not(target_arch = "x86_64"))]
+                None
+            }
+        }
         if rays.is_empty() || rays.len() > PACKET_LANES {
             return None;
         }
@@ -44,30 +94,14 @@ impl Bvh {
         if self.nodes.is_empty() || lanes == 0 {
             return Some(0);
         }
-        #[cfg(target_arch = "x86_64")]
-        if crate::accel::Backend::current().has_avx() {
-            use super::traverse::{MIDDLE, SHALLOW, stack_size};
-            // SAFETY: the processor has AVX (the current backend does).
-            let packet = unsafe { super::packet::avx::Lanes::new(rays) }?;
-            // SAFETY: the processor has AVX.
-            return Some(unsafe {
-                if self.max_depth <= SHALLOW {
-                    self.occluded_walk::<{ stack_size(SHALLOW) }>(
-                        &packet, rays, lanes, counters, occludes,
-                    )
-                } else if self.max_depth <= MIDDLE {
-                    self.occluded_walk::<{ stack_size(MIDDLE) }>(
-                        &packet, rays, lanes, counters, occludes,
-                    )
-                } else {
-                    self.occluded_walk::<{ stack_size(super::MAX_DEPTH) }>(
-                        &packet, rays, lanes, counters, occludes,
-                    )
-                }
-            });
-        }
-        let _ = (counters, occludes);
-        None
+        let task = Packet {
+            bvh: self,
+            rays,
+            lanes,
+            counters,
+            occludes,
+        };
+        kernel::run(backend, task)
     }
 
     /// The walk of [`Self::occluded_packet_by_leaf`] with a stack of `N`
@@ -209,6 +243,7 @@ mod tests {
 
     #[test]
     fn packets_find_each_lane_occluded_as_its_single_walk_does() {
+        let backend = crate::accel::Backend::current();
         if !crate::accel::kernel::walks_with_avx_or_skip() {
             return;
         }
@@ -222,8 +257,11 @@ mod tests {
                 let lanes = rng.below(1 << PACKET_LANES) | 1;
                 let mut counters = TraversalCounters::default();
                 let mut done = 0;
-                let found =
-                    bvh.occluded_packet_by_leaf(&rays, lanes, &mut counters, |asked, range| {
+                let found = bvh.occluded_packet_by_leaf(
+                    &rays,
+                    (lanes, backend),
+                    &mut counters,
+                    |asked, range| {
                         // Only lanes asked for and not yet found occluded.
                         assert_eq!(asked & !lanes, 0);
                         assert_eq!(asked & done, 0);
@@ -238,7 +276,8 @@ mod tests {
                         }
                         done |= hit;
                         hit
-                    });
+                    },
+                );
                 let Some(found) = found else { continue };
                 together += 1;
                 assert!(counters.nodes > 0);
@@ -267,6 +306,7 @@ mod tests {
 
     #[test]
     fn a_lane_ending_just_short_of_a_box_enters_it_as_its_single_walk_does() {
+        let backend = crate::accel::Backend::current();
         if !crate::accel::kernel::walks_with_avx_or_skip() {
             return;
         }
@@ -293,9 +333,14 @@ mod tests {
             // being entered alone decides.
             let holds = |range: Range<u32>| range.into_iter().any(|e| bvh.indices[e as usize] == k);
             let mut counters = TraversalCounters::default();
-            let found = bvh.occluded_packet_by_leaf(&rays, 0xff, &mut counters, |asked, range| {
-                if holds(range) { asked } else { 0 }
-            });
+            let found = bvh.occluded_packet_by_leaf(
+                &rays,
+                (0xff, backend),
+                &mut counters,
+                |asked, range| {
+                    if holds(range) { asked } else { 0 }
+                },
+            );
             let Some(found) = found else { continue };
             for (lane, ray) in rays.iter().enumerate() {
                 let single =
@@ -311,6 +356,7 @@ mod tests {
 
     #[test]
     fn packets_that_cannot_be_walked_together_are_refused() {
+        let backend = crate::accel::Backend::current();
         let bvh = Bvh::build(&[Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0))]);
         let mut counters = TraversalCounters::default();
         let towards = |x: f64| {
@@ -322,28 +368,28 @@ mod tests {
         };
         let none = |_: u32, _: Range<u32>| -> u32 { panic!("no leaf is tested") };
         assert_eq!(
-            bvh.occluded_packet_by_leaf(&[], 1, &mut counters, none),
+            bvh.occluded_packet_by_leaf(&[], (1, backend), &mut counters, none),
             None
         );
         assert_eq!(
-            bvh.occluded_packet_by_leaf(&[towards(0.1); 9], 1, &mut counters, none),
+            bvh.occluded_packet_by_leaf(&[towards(0.1); 9], (1, backend), &mut counters, none),
             None
         );
         assert_eq!(
-            bvh.occluded_packet_by_leaf(&[towards(0.1)], 0, &mut counters, none),
+            bvh.occluded_packet_by_leaf(&[towards(0.1)], (0, backend), &mut counters, none),
             Some(0)
         );
         if crate::accel::Backend::current().has_avx() {
             // Directions of both signs along x are not walked together.
             let mixed = [towards(0.1), towards(-0.1)];
             assert_eq!(
-                bvh.occluded_packet_by_leaf(&mixed, 0b11, &mut counters, none),
+                bvh.occluded_packet_by_leaf(&mixed, (0b11, backend), &mut counters, none),
                 None
             );
             let same = [towards(0.1), towards(0.2)];
             let all = |lanes: u32, _: Range<u32>| lanes;
             assert_eq!(
-                bvh.occluded_packet_by_leaf(&same, 0b11, &mut counters, all),
+                bvh.occluded_packet_by_leaf(&same, (0b11, backend), &mut counters, all),
                 Some(0b11)
             );
         }
