@@ -5,9 +5,10 @@
 //! directional light) are `null`.
 //!
 //! The tree is written straight from the explanation through serde's
-//! derived serializers (no JSON value is built first: a tree of thousands
-//! of rays is written several times faster). The keys of each object are
-//! in byte order, as they always were.
+//! derived serializers, with no JSON value built first (building one is
+//! far slower on big trees: docs/performance-log.md, `explain --json` on
+//! big trees). The keys of each object are in byte order, as they always
+//! were.
 
 use std::path::Path;
 
@@ -659,8 +660,8 @@ mod tests {
         for (name, spp) in cases {
             let (path, mut scene) = scene(name, spp);
             // The glass ball's tree doubles at every bounce: a few bounces
-            // are enough here (the built value takes seconds per thousand
-            // rays, the reason for the writer).
+            // are enough here (the built value is slow on big trees, the
+            // reason for the writer).
             scene.settings.max_depth = scene.settings.max_depth.min(7);
             let explainer = Explainer::new(&scene).unwrap();
             for pixel in [(20, 15), (3, 27), (35, 4)] {

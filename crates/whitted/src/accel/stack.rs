@@ -1,7 +1,7 @@
 //! The traversal stack the BVH and the kd-tree walk with: a fixed array
 //! whose slots are written before they are read, so nothing is cleared per
-//! ray (clearing took 4% of the BVH's instructions on the bunny and, for
-//! the kd-tree's 1.5 kB stack, more than the walk of a short ray).
+//! ray and a ray pays only for the entries it pushes, however deep the
+//! tree (measured: docs/performance-log.md, eight-wide BVH).
 
 use std::mem::MaybeUninit;
 
@@ -58,7 +58,7 @@ impl<T: Copy, const N: usize> Stack<T, N> {
     /// top: with entries above `floor` pushed this way, those for which it
     /// holds stay on top of it. Sorting in place: building the entries in a
     /// separate array and copying them over stalled on store forwarding
-    /// (16% of the BVH walk's samples on the bunny).
+    /// (see docs/performance-log.md, eight-wide BVH).
     #[inline(always)]
     pub fn insert_above(&mut self, floor: usize, entry: T, goes_under: impl Fn(&T, &T) -> bool) {
         let mut j = self.len;

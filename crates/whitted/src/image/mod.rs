@@ -204,9 +204,9 @@ impl Film {
     /// rayon pool. A new film's memory is mapped page by page on its first
     /// write; a render maps it here, before the trace and on all its
     /// threads, rather than at each tile's first write, which is made
-    /// under the lock that gathers the tiles (a fifth of the threads' time
-    /// on a quick render, docs/performance-log.md). Where the system has them,
-    /// the film asks for 2 MiB pages first ([`advise_huge_pages`]).
+    /// under the lock that gathers the tiles (see docs/performance-log.md,
+    /// `Film::map_pages`). Where the system has them, the film asks for
+    /// 2 MiB pages first ([`advise_huge_pages`]).
     pub fn map_pages(&mut self) {
         /// One 4 KiB page of values.
         const PAGE: usize = 4096 / size_of::<f32>();
@@ -397,10 +397,10 @@ pub fn encode_to_partial(
 
 /// Asks Linux to back the part of `values` that covers whole 2 MiB pages
 /// with such pages (transparent huge pages, where the system lets a
-/// program ask for them): a 1024x1024 film then takes about 2,200 page
-/// faults instead of 4,800, and mapping it 1.3 to 2.7 ms instead of 5 to
-/// 7 ms. Only advice: where the system refuses, the pages are the usual
-/// ones and nothing else changes.
+/// program ask for them), so that mapping a film takes fewer page faults
+/// (measured: docs/performance-log.md, "The films' fixed cost"). Only
+/// advice: where the system refuses, the pages are the usual ones and
+/// nothing else changes.
 #[cfg(target_os = "linux")]
 fn advise_huge_pages(values: &mut [f32]) {
     const HUGE_PAGE: usize = 2 << 20;

@@ -75,8 +75,8 @@ pub enum IntegratorKind {
 
 /// The result of tracing one camera ray. Small, so that returning it
 /// copies a few words: the first hit, which the per-pixel data needs, is
-/// kept by a [`FirstHit`] observer when asked for (as part of this, a
-/// 250-byte copy per pixel cost jacks about 10% of its render).
+/// kept by a [`FirstHit`] observer when asked for, not copied out of
+/// every sample (see docs/performance-log.md, the `FirstHit` observer).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PrimarySample {
     /// The colour seen.

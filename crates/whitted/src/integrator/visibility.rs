@@ -189,8 +189,8 @@ impl<'a> Visibility<'a> {
     /// ([`Visibility::reads_uv`]); crossings found at once, which have no
     /// (u, v), serve only segments whose surfaces' materials do not read
     /// it. A visitor rather than an iterator: an iterator's state (the
-    /// crossings, the entries met) copied out per shadow ray made
-    /// soft-shadows.toml 8% slower.
+    /// crossings, the entries met) copied out per shadow ray was slower
+    /// (docs/performance-log.md, figures moved out of doc comments).
     #[inline]
     pub(super) fn passing<B>(
         &self,

@@ -178,9 +178,9 @@ pub(super) struct AdaptivePixels<'a> {
     color_space: ColorSpace,
     adaptive: Adaptive,
     /// Traced corners by their position on the fine grid of the image
-    /// (`2^depth` steps per pixel). Fx hashing: SipHash took 8% of an
-    /// adaptive render's instructions, and these keys need no protection
-    /// from collisions chosen by an attacker.
+    /// (`2^depth` steps per pixel). Fx hashing, cheaper than SipHash (see
+    /// docs/performance-log.md, "The corner cache's hashing"): these keys
+    /// need no protection from collisions chosen by an attacker.
     corners: FxHashMap<(u32, u32), Corner>,
 }
 

@@ -426,8 +426,9 @@ fn trace_pixels(
     // Each worker takes the next tile from a shared counter until none is
     // left: a thread that finishes early takes more, so both cores stay
     // busy to the last tile. (Rayon's `for_each` over the list splits it
-    // into a few long runs up front: on mount one thread sat idle for a
-    // third of the render, see docs/performance-log.md.)
+    // into a few long runs up front, and where the costly tiles sit
+    // together one thread sits idle: see docs/performance-log.md, "Tile
+    // scheduling".)
     let next_tile = AtomicUsize::new(0);
     pool.broadcast(|_| {
         while let Some(&index) = tiles.get(next_tile.fetch_add(1, Ordering::Relaxed)) {
@@ -611,9 +612,9 @@ type Centre = (Ray, Option<(Hit, Surface)>);
 /// A tile's stratified samples, a row at a time: the row's camera rays
 /// for one sample index are made before any is traced, four at a time
 /// ([`Camera::rays`]), so that their square roots and divisions overlap
-/// rather than each waiting for the previous pixel's trace (jacks at
-/// 1024x1024 on one thread: 1.16x, and 1.07x for the four lanes); in
-/// worlds that walk packets, their closest hits are then found
+/// rather than each waiting for the previous pixel's trace (measured:
+/// docs/performance-log.md, `RowSamples` and "A row's camera rays four at
+/// a time"); in worlds that walk packets, their closest hits are then found
 /// [`PACKET_SIZE`] rays at a time ([`World::intersect_packet`]), before
 /// each is shaded.
 struct RowSamples<'w> {

@@ -1,8 +1,9 @@
 //! The render's last guard, pixels whose colour came out infinite or NaN,
 //! counted tile by tile by the worker that traced the tile (its colours
 //! still in cache, outside the lock that gathers the tiles) rather than by
-//! one scan of the whole film after the trace: that scan was 4 to 5 ms of
-//! a 1024x1024 render on one thread while the others waited.
+//! one scan of the whole film after the trace, on one thread while the
+//! others waited (measured: docs/performance-log.md, "The films' fixed
+//! cost").
 
 use super::RenderError;
 

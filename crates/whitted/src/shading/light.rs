@@ -260,8 +260,9 @@ impl<'l> Iterator for SamplesAhead<'l> {
 
     /// The first sample of each batch goes out as it is made, in
     /// registers: stored with the others and read back at once, its read
-    /// waited on those stores (a third of `Whitted::shade`'s own time on
-    /// `tree`). The others are read a shadow ray later, from the cache.
+    /// waited on those stores (see docs/performance-log.md, "Light samples
+    /// handed out in registers"). The others are read a shadow ray later,
+    /// from the cache.
     #[inline(always)]
     fn next(&mut self) -> Option<Self::Item> {
         if let Some(slot) = self.ready.get_mut(self.next) {

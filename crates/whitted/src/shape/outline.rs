@@ -15,11 +15,10 @@
 //! holds every edge that can count, in the same order, and the same
 //! arithmetic decides each one.
 //!
-//! Measured on the SPD `gears` scene (128 polygons of 144 vertices among
-//! 9,217 quadrilaterals), 256x256, 1 thread, interleaved runs: 0.34 s
-//! with the loop over all edges of the 3D vertices (the polygon test was 47%
-//! of the time), 0.23 s with the 2D points, the repeated first point (no
-//! modulo) and the bands; the same picture to the bit.
+//! The bands, the 2D points and the repeated first point (no modulo) make
+//! the test cheaper than a loop over all edges of the 3D vertices
+//! (measured, with the same picture to the bit: docs/performance-log.md,
+//! figures moved out of doc comments).
 //!
 //! # Cells no edge comes near
 //!

@@ -8,9 +8,10 @@
 //! operations in the same order (IEEE arithmetic is exact per operation,
 //! Rust never fuses a multiply and an add, and the comparisons are the
 //! ordered ones, false for NaN, as Rust's). The caller then tests only the
-//! candidates, one by one. Where spheres overlap (the SPD `shells`: some 60
-//! sphere tests per primary ray, most culled), the four culls run side by
-//! side with no branch to mispredict.
+//! candidates, one by one. Where spheres overlap (a ray then tests many
+//! and culls most), the four culls run side by side with no branch to
+//! mispredict (measured: docs/performance-log.md, "Spheres four at a
+//! time").
 //!
 //! A lane culled for `t_max` stays culled for any smaller end: each
 //! quantity the cull compares moves monotonically with `t_max`, and
@@ -34,8 +35,8 @@ use crate::math::{Ray, Vec3, gamma};
 ///
 /// The spheres come by reference so that their numbers are read where they
 /// lie: copied into an array just before the call, they were read back
-/// across two stores each, which the processor cannot forward (a fifth of
-/// the time of `shells`).
+/// across two stores each, which the processor cannot forward (see
+/// docs/performance-log.md, "Spheres four at a time").
 ///
 /// # Safety
 ///

@@ -35,9 +35,9 @@ pub(super) enum EntryKind {
     /// A polygon without a transform, its first vertex and unit normal in
     /// the entry: a ray that does not cross its plane in the interval is
     /// turned away right there, sparing the trip to the vertices and
-    /// outline, three allocations away, for most rays that reach its leaf
-    /// (gears: 9,345 polygons); for the others, the tables test only the
-    /// outline, at the plane's `t` found here ([`Polygon::hit_on_plane`]).
+    /// outline, three allocations away, for most rays that reach its leaf;
+    /// for the others, the tables test only the outline, at the plane's
+    /// `t` found here ([`Polygon::hit_on_plane`]).
     Polygon,
     /// A cylinder or a cone, in the entry as the ends of its axis and a
     /// bound on its points' distance from the axis: a ray whose line
@@ -184,8 +184,8 @@ impl Entry {
     /// direction are never turned away: there the cross product below is
     /// mostly rounding, which the margin would not cover. Spares the trip
     /// through the primitive and transform tables for most rays that reach
-    /// a slanted cylinder's loose box (rings: 4,200 cylinders, a third of
-    /// the render in their test).
+    /// a slanted cylinder's loose box (measured: docs/performance-log.md,
+    /// "polygons, cylinders and cones turned away in place").
     #[inline(always)]
     fn axis_missed(&self, ray: &Ray) -> bool {
         let [base, axis, fixed] = self.corners;

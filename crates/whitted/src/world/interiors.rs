@@ -140,8 +140,8 @@ impl<'a> World<'a> {
     ///
     /// The spheres are sorted by their lowest x and each entry is measured
     /// only against those whose x range can meet its box: one box per
-    /// entry when the spheres are few and small (a few milliseconds for a
-    /// million triangles), nothing at all without candidates.
+    /// entry when the spheres are few and small, nothing at all without
+    /// candidates.
     pub fn interiors(&self, candidate: impl Fn(MaterialId) -> bool) -> Interiors {
         let mut balls: Vec<Ball> = self
             .shapes

@@ -370,10 +370,11 @@ impl<'a> World<'a> {
         // What structure slot `slot` names. A triangle shape without a
         // transform takes the mesh triangles' path: the same watertight
         // test on the same corners; a sphere without one is tested in
-        // place too, with no trip to the primitive table (shells, some 60
-        // sphere tests per camera ray: 1.3x faster). A mesh triangle is
-        // found from its slot's offset in its run (tried tables of slots:
-        // slower, see docs/performance-log.md, world entries and preparation).
+        // place too, with no trip to the primitive table (measured:
+        // docs/performance-log.md, spheres without a transform tested in
+        // place). A mesh triangle is found from its slot's offset in its
+        // run (tried tables of slots: slower, see docs/performance-log.md,
+        // world entries and preparation).
         let shape_slots = slot_shapes.len() as u32;
         let slot_entry = |slot: u32| {
             if slot < shape_slots {

@@ -6,9 +6,9 @@ use crate::mesh::TriangleMesh;
 use crate::world::{Hit, PrimitiveRef, World};
 
 /// Triangles placed directly from which [`World::prefetches_surfaces`]:
-/// about 8 MB of corner indices, positions and normals, beyond the caches
-/// of the machines measured (the dragon's 871k gain 1.09x; the bunny's 69k
-/// and the small SPD meshes lose 1 to 3% to the prefetch's own work).
+/// about 8 MB of corner indices, positions and normals, beyond the caches.
+/// Below it the prefetch's own work costs more than the misses it saves
+/// (measured: docs/performance-log.md, big meshes' surfaces prefetched).
 pub(super) const BIG_MESHES: usize = 200_000;
 
 impl World<'_> {

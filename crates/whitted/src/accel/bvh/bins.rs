@@ -57,9 +57,9 @@ impl Binning {
         // start half a bin early, for the binning and the partition alike.
         // Below 2²³ (`x` < ½) the sum is not rounded: the maximum makes it
         // bin 0, as it does a NaN (`maxps` keeps its second operand), from
-        // an overflowed difference on an axis without spread. Rust's
-        // saturating float-to-integer casts, one per lane, took a third of
-        // the binning's instructions.
+        // an overflowed difference on an axis without spread. Tried Rust's
+        // saturating float-to-integer casts, one per lane: more
+        // instructions, see docs/performance-log.md (BVH build).
         let rounded = ((c - self.low) * self.scale + Vec3A::splat(ROUND))
             .max(Vec3A::splat(ROUND_BASE))
             .min(self.last);
@@ -197,9 +197,9 @@ impl Plane {
     /// The loop has no branch on the side: every primitive is swapped
     /// with the first one known to go right (or with itself), and only the
     /// count of those going left moves on its side. Which side a primitive
-    /// goes to is as good as random, and the mispredicted branch of the
-    /// usual two-ended partition took an eighth of the build's time on the
-    /// bunny. The centroid boxes are gathered after, in order.
+    /// goes to is as good as random, so the usual two-ended partition's
+    /// branch on it is mispredicted (figures in docs/performance-log.md,
+    /// BVH build). The centroid boxes are gathered after, in order.
     pub(super) fn partition(&self, prims: &mut Prims) -> Halves {
         let mut mid = 0;
         for i in 0..prims.len() {

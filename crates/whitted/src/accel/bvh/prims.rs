@@ -1,8 +1,8 @@
 //! A subtree's primitives during the build: their indices and their `f32`
 //! boxes in two arrays reordered together, so binning and partitioning read
-//! the boxes in order. Reading them through the index array instead (one
-//! scattered load per primitive per level) gave the build's hottest
-//! instructions on the bunny.
+//! the boxes in order. Reading them through the index array instead costs
+//! one scattered load per primitive per level (figures in
+//! docs/performance-log.md, BVH build).
 
 use super::fbox::FBox;
 

@@ -212,8 +212,10 @@ const FREE_PIXELS: u64 = 1 << 20;
 
 /// Beyond [`FREE_PIXELS`], the most pixels a JPEG may claim per byte of
 /// file. zune-jpeg fills what a truncated file lacks, so without this a
-/// 640-byte file claiming 16000×16000 pixels decoded, in 39 s, into 3.7 GB
-/// of texels. Baseline JPEG needs at least two bits per 8×8 block and
+/// file of a few hundred bytes is decoded into as many texels as its
+/// header claims, taking the time and memory of a real image that size
+/// (figures in docs/performance-log.md, figures moved out of doc
+/// comments). Baseline JPEG needs at least two bits per 8×8 block and
 /// channel (about 256 pixels per byte); only a progressive file of nearly
 /// one flat colour could exceed this, and such a texture can be smaller.
 const MAX_PIXELS_PER_BYTE: u64 = 4096;

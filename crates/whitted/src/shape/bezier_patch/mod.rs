@@ -32,10 +32,9 @@
 //!
 //! A file of patches (`shape = "patches"`, `whitted render FILE.bpt`) puts
 //! each leaf in the scene's acceleration structure as a shape of its own
-//! ([`BezierPatch::pieces`]), so the scene's BVH does the walking (with the
-//! changes to the leaves' test, 1.5 to 1.9 times the rays per second on
-//! the teapot: docs/performance-log.md, "Bézier patches against their
-//! tessellation").
+//! ([`BezierPatch::pieces`]), so the scene's BVH does the walking, faster
+//! than each patch's own hierarchy (measured: docs/performance-log.md,
+//! "Bézier patches against their tessellation").
 //!
 //! Chosen over Bézier clipping because the work per ray is small and
 //! bounded (at most 16 iterations per leaf met, no allocation), the

@@ -15,9 +15,11 @@
 //!   one root if its ends differ in sign, none otherwise; the root is then
 //!   refined by the Illinois variant of regula falsi to a few ulps, the
 //!   third step of every three a bisection when the first two have not
-//!   halved the bracket (measured on 20,000 random rays, this takes a
-//!   quarter fewer evaluations of `f` than bisecting every third step
-//!   regardless; the Anderson–Björck variant took more);
+//!   halved the bracket, so it takes at most three times bisection's
+//!   steps (tried bisecting every third step regardless, and the
+//!   Anderson–Björck variant: more evaluations of `f`, see
+//!   docs/performance-log.md, "The new shapes against meshes of the same
+//!   look");
 //! - any other stretch is halved, the near half searched first, down to
 //!   [`RESOLUTION`] of the clipped ray: a stretch that small that is still
 //!   neither is a tangent touch or a part thinner than that, kept when its

@@ -35,16 +35,11 @@
 //! quadratic second derivative) cut the chord into monotone pieces, each
 //! holding at most one root, found by Newton's method kept inside its
 //! bracket, which cannot miss a simple root or return one outside the
-//! chord. Measured on the same quartics and rays (docs/performance-log.md,
-//! "Torus solvers"), the checked closed form is as accurate as the
-//! monotone solver alone (largest relative error in `t` 1.5e-12 against the
-//! dense-sampling reference, on grazing rays; 1.9e-15 from a camera 1e4
-//! sizes away, none of those rays needing the fallback) and about 2.5
-//! times faster per ray (1.4 to 1.5 times the primary rays per second on
-//! 125 random tori);
-//! the monotone solver alone was shipped first, and is kept as the
-//! fallback and as the tests' second opinion. Sturm sequences (as POV-Ray)
-//! were not implemented.
+//! chord. The checked closed form is as accurate as the monotone solver
+//! alone and faster per ray (measured: docs/performance-log.md, "Torus
+//! solvers"); the monotone solver alone was shipped first, and is kept as
+//! the fallback and as the tests' second opinion. Sturm sequences (as
+//! POV-Ray) were not implemented.
 //!
 //! **(u, v)** are the natural angles: `u = φ / 2π` around the y axis and
 //! `v = θ / 2π` around the tube, with
