@@ -86,7 +86,7 @@ impl Bvh {
     /// `t_max[lane]`, and where that finds a hit, sets the lane's bit in
     /// the mask it returns and leaves the hit's `t` in `t_max[lane]`. The
     /// walk and `hit` run as one task of `backend`'s kernel
-    /// ([`kernel::run`]).
+    /// (`accel/kernel.rs`).
     pub fn intersect_packet_by_leaf(
         &self,
         rays: &[Ray],

@@ -31,7 +31,7 @@ impl Bvh {
     /// `None` when the packet cannot be walked together (see `packet`;
     /// always with a `backend` without AVX). With no lane asked for, or an
     /// empty hierarchy, that is `Some(0)` whatever the rays. The walk and
-    /// `occludes` run as one task of `backend`'s kernel ([`kernel::run`]).
+    /// `occludes` run as one task of `backend`'s kernel (`accel/kernel.rs`).
     pub fn occluded_packet_by_leaf(
         &self,
         rays: &[Ray],
