@@ -169,6 +169,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
     let status = Status::new(args.quiet || args.json);
     status.set(format!("loading {}", args.scene.display()));
     let scene = load(&args.scene, args.width, args.height)?;
+    whitted::render::check_objects(&scene.objects).map_err(|e| e.to_string())?;
     let all_threads = std::thread::available_parallelism().map_or(1, usize::from);
 
     let (sets, references): (Vec<RaySet>, Vec<Option<TraceResults>>) = match &args.rays {

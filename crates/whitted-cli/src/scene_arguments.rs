@@ -168,11 +168,14 @@ impl SceneArgs {
                     for warning in &loaded.warnings {
                         note!("{warning}\n");
                     }
+                    let primitives = match loaded.scene.objects.checked_primitive_count() {
+                        Some(count) => count.to_string(),
+                        None => format!("more than {}", usize::MAX),
+                    };
                     note!(
-                        "{}: read in {:.3} s, {} primitives",
+                        "{}: read in {:.3} s, {primitives} primitives",
                         path.display(),
                         start.elapsed().as_secs_f64(),
-                        loaded.scene.objects.primitive_count()
                     );
                 }
                 loaded.scene

@@ -374,3 +374,48 @@ fn a_glass_ball_in_a_mirror_box_is_cut_at_the_ray_budget_with_one_warning() {
     assert!(p.stderr.contains("with max_depth 40"), "{}", p.stderr);
     assert!(elapsed < Duration::from_secs(10), "{elapsed:?}");
 }
+
+#[test]
+fn placements_that_multiply_past_any_count_are_refused_not_wrapped() {
+    // Seven definitions, each placing the one before 256 times, placed 256
+    // times (eight levels, the most allowed): 256⁸ = 2⁶⁴ spheres, and a
+    // plane beside them. The count once wrapped to 0 and the render traced
+    // for ever.
+    let mut scene = sphere_scene("0.5");
+    scene.push_str(
+        "[[objects]]\nshape = \"plane\"\npoint = [0, -1, 0]\nnormal = [0, 1, 0]\nmaterial = \"ball\"\n",
+    );
+    scene.push_str(
+        "[definitions.d0]\nobjects = [{ shape = \"sphere\", radius = 0.1, material = \"ball\" }]\n",
+    );
+    for level in 1..=7 {
+        let placements = vec![format!("{{ instance = \"d{}\" }}", level - 1); 256].join(", ");
+        scene.push_str(&format!(
+            "[definitions.d{level}]\nobjects = [{placements}]\n"
+        ));
+    }
+    scene.push_str(&"[[objects]]\ninstance = \"d7\"\n".repeat(256));
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "s.toml", scene);
+    // Every command that builds a world refuses it (bench once panicked).
+    for args in [
+        &["render", "s.toml", "-o", "out.png"][..],
+        &["explain", "s.toml", "--pixel", "1,1"],
+        &["bench", "s.toml"],
+    ] {
+        let start = Instant::now();
+        let p = probe(args, dir.path());
+        assert_eq!(p.code(), Some(1), "{args:?}: {}", p.stderr);
+        assert!(
+            p.stderr.contains(
+                "the scene has more than 18446744073709551615 primitives (every placement of a \
+                 mesh counted): at most 4294967295 are allowed"
+            ),
+            "{args:?}: {}",
+            p.stderr
+        );
+        assert!(!p.stderr.contains("panicked"), "{}", p.stderr);
+        assert!(start.elapsed() < Duration::from_secs(20));
+    }
+    assert!(!dir.path().join("out.png").exists());
+}

@@ -26,7 +26,7 @@ use crate::render::sample_ray::{
 use crate::render::shading_of;
 use crate::render::{AntiAliasing, Camera, RenderError, RenderSettings, Scene};
 use crate::shading::Color;
-use crate::world::{MAX_PRIMITIVES, World};
+use crate::world::World;
 
 /// The ray tree of one sample of one pixel, and the pixel it ends in.
 #[derive(Clone, Debug, PartialEq)]
@@ -120,11 +120,7 @@ impl<'s> Explainer<'s> {
     pub fn new(scene: &'s Scene) -> Result<Self, ExplainError> {
         let settings = &scene.settings;
         settings.check()?;
-        scene.objects.check_instances().map_err(RenderError::from)?;
-        let primitives = scene.objects.primitive_count();
-        if primitives > MAX_PRIMITIVES {
-            return Err(RenderError::TooManyPrimitives(primitives).into());
-        }
+        super::check_objects(&scene.objects)?;
         // As `render` builds them.
         let world = super::build_world(scene);
         let caustics = on_deep_stack(settings.max_depth, || {

@@ -68,6 +68,34 @@ const TILE_SIZE: u32 = 16;
 /// surface of a camera ray's hit ([`World::prefetch_surface`]).
 const SURFACES_AHEAD: usize = 2;
 
+/// A primitive count as a message gives it: [`Objects::primitive_count`]'s
+/// `usize::MAX` stands for a count that overflowed.
+///
+/// [`Objects::primitive_count`]: crate::world::Objects::primitive_count
+fn count_in_words(count: usize) -> String {
+    if count == usize::MAX {
+        format!("more than {}", usize::MAX)
+    } else {
+        count.to_string()
+    }
+}
+
+/// Checks what building a world of `objects` relies on
+/// ([`World::build_levels`]): instances that
+/// [`Objects::check_instances`] accepts, and at most [`MAX_PRIMITIVES`]
+/// primitives, every placement counted. Every command checks a scene so
+/// before it builds a world.
+///
+/// [`Objects::check_instances`]: crate::world::Objects::check_instances
+pub fn check_objects(objects: &crate::world::Objects) -> Result<(), RenderError> {
+    objects.check_instances()?;
+    let primitives = objects.primitive_count();
+    if primitives > MAX_PRIMITIVES {
+        return Err(RenderError::TooManyPrimitives(primitives));
+    }
+    Ok(())
+}
+
 /// The world of `scene`, its structures of the kinds its settings ask for
 /// (shared by [`render`] and [`explain_pixel`], which must trace the same).
 fn build_world(scene: &Scene) -> World<'_> {
@@ -157,7 +185,8 @@ pub enum RenderError {
     /// More primitives (every placement of a mesh counted) than a world
     /// numbers.
     #[error(
-        "the scene has {0} primitives (every placement of a mesh counted): at most {MAX_PRIMITIVES} are allowed"
+        "the scene has {} primitives (every placement of a mesh counted): at most {MAX_PRIMITIVES} are allowed",
+        count_in_words(*.0)
     )]
     TooManyPrimitives(usize),
     /// The photon settings are out of range.

@@ -19,7 +19,7 @@ use crate::render::photon_pass::{self, PhotonReport};
 use crate::render::{
     Aov, Camera, PixelSelection, Progress, RenderError, RenderOutput, RenderSettings, Scene,
 };
-use crate::world::{MAX_PRIMITIVES, World};
+use crate::world::World;
 
 /// What may change from one pass of a prepared scene to the next.
 #[derive(Clone, Debug, PartialEq)]
@@ -77,11 +77,7 @@ impl<'s> Prepared<'s> {
     pub fn new(scene: &'s Scene) -> Result<Self, RenderError> {
         let settings = &scene.settings;
         settings.check()?;
-        scene.objects.check_instances()?;
-        let primitives = scene.objects.primitive_count();
-        if primitives > MAX_PRIMITIVES {
-            return Err(RenderError::TooManyPrimitives(primitives));
-        }
+        super::check_objects(&scene.objects)?;
         super::resources::check_memory(settings, MemoryBudget::current())?;
         let start = Instant::now();
         let world = super::build_world(scene);

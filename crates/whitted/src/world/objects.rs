@@ -127,8 +127,17 @@ impl Objects {
     /// How many primitives there are: the shapes, the triangles of every
     /// mesh instance and the primitives of every instance of a definition,
     /// counted once per placement (a definition naming one not before it
-    /// counts it as empty: see [`Self::check_instances`]).
+    /// counts it as empty: see [`Self::check_instances`]); `usize::MAX`
+    /// where the count does not fit in a `usize` (nested placements
+    /// multiply), far more than a world numbers
+    /// ([`crate::world::MAX_PRIMITIVES`]).
     pub fn primitive_count(&self) -> usize {
+        self.checked_primitive_count().unwrap_or(usize::MAX)
+    }
+
+    /// [`Self::primitive_count`], `None` where it does not fit in a
+    /// `usize`: every sum and product checked.
+    pub fn checked_primitive_count(&self) -> Option<usize> {
         let mut counts = Vec::with_capacity(self.definitions.len());
         for definition in &self.definitions {
             let count = definition.count_with(&counts);
@@ -137,21 +146,19 @@ impl Objects {
         self.count_with(&counts)
     }
 
-    /// The primitives here, given those of the definitions before.
-    fn count_with(&self, definitions: &[usize]) -> usize {
-        let instanced = self.instances.iter().map(|i| {
-            definitions
-                .get(i.definition.0 as usize)
-                .copied()
-                .unwrap_or(0)
-        });
-        self.primitives.len()
-            + self
-                .mesh_instances
-                .iter()
-                .map(|m| self.meshes[m.mesh.0 as usize].len())
-                .chain(instanced)
-                .fold(0usize, usize::saturating_add)
+    /// The primitives here, given those of the definitions before (`None`
+    /// for a count that overflowed).
+    fn count_with(&self, definitions: &[Option<usize>]) -> Option<usize> {
+        let mut count = self.primitives.len();
+        for m in &self.mesh_instances {
+            count = count.checked_add(self.meshes[m.mesh.0 as usize].len())?;
+        }
+        for i in &self.instances {
+            // A definition not before this one counts as empty.
+            let placed = definitions.get(i.definition.0 as usize).copied();
+            count = count.checked_add(placed.unwrap_or(Some(0))?)?;
+        }
+        Some(count)
     }
 
     /// Checks what [`crate::world::World::build`] relies on: every instance
@@ -294,6 +301,34 @@ mod tests {
         }
         assert_eq!(world.primitive_count(), 1 + 3 * 2);
         assert_eq!(world.check_instances(), Ok(()));
+    }
+
+    #[test]
+    fn a_count_past_the_range_of_usize_is_none_not_wrapped() {
+        // Seven definitions each placing the one before 256 times, placed
+        // 256 times: 256⁸ = 2⁶⁴ spheres, one more than a `usize` holds; the
+        // sphere beside them took a wrapping sum to 0.
+        let mut world = sphere();
+        let mut inner = world.add_definition(sphere());
+        for _ in 1..8 {
+            let mut many = Objects::default();
+            for _ in 0..256 {
+                many.add_instance(inner, None, Transform::IDENTITY);
+            }
+            inner = world.add_definition(many);
+        }
+        let mut top = world.clone();
+        for _ in 0..256 {
+            top.add_instance(inner, None, Transform::IDENTITY);
+        }
+        assert_eq!(top.checked_primitive_count(), None);
+        assert_eq!(top.primitive_count(), usize::MAX);
+        // One placement fewer fits: 255 · 2⁵⁶ + 1.
+        let mut fits = world;
+        for _ in 0..255 {
+            fits.add_instance(inner, None, Transform::IDENTITY);
+        }
+        assert_eq!(fits.checked_primitive_count(), Some(255 * (1 << 56) + 1));
     }
 
     #[test]
