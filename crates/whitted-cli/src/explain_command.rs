@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use whitted::image::encode_text;
+use whitted::image::{check_text_destination, encode_text};
 use whitted::render::{PixelExplanation, Scene, explain_pixel, render};
 use whitted::scene::parse_whole_number;
 
@@ -13,6 +13,7 @@ use crate::explain_json::explanation_json;
 use crate::explain_svg::svg_drawing;
 use crate::explain_text::explanation_text;
 use crate::progress::ProgressReport;
+use crate::render_command::refuse_writing_inputs;
 use crate::report::{note, results};
 use crate::scene_arguments::SceneArgs;
 
@@ -82,7 +83,15 @@ fn sample_index(text: &str) -> Result<u32, String> {
 /// Runs the command.
 pub fn run(args: &ExplainArgs) -> Result<(), String> {
     args.scene.check()?;
+    let mut outputs = Vec::new();
+    if let Some(path) = &args.svg {
+        let drawing = check_text_destination(path, "svg").map_err(|e| e.to_string())?;
+        outputs.push((format!("--svg {}", path.display()), drawing));
+    }
+    let scene_file: Vec<&std::path::Path> = args.scene.scene.as_deref().into_iter().collect();
+    refuse_writing_inputs(&outputs, &scene_file)?;
     let scene = args.scene.load(args.quiet)?;
+    refuse_writing_inputs(&outputs, &[])?;
     let explanation = explain_pixel(&scene, args.pixel, args.sample).map_err(|e| e.to_string())?;
     let file = args.scene.scene.as_deref();
     let text = if args.json {

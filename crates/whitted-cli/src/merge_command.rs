@@ -9,7 +9,7 @@ use whitted::image::ImageFormat;
 use whitted::limits::MemoryBudget;
 use whitted::render::merge_parts;
 
-use crate::render_command::{check_destinations, parse_aov};
+use crate::render_command::{check_destinations, parse_aov, refuse_writing_inputs};
 use crate::report::note;
 
 /// Merge the parts of a split render into the full image.
@@ -63,8 +63,11 @@ pub fn run(args: &MergeArgs) -> Result<(), String> {
         .iter()
         .map(|s| parse_aov(s))
         .collect::<Result<Vec<_>, _>>()?;
-    check_destinations(&args.output, &aov_outputs, args.quiet)?;
+    let outputs = check_destinations(&args.output, &aov_outputs, args.quiet)?;
+    let parts: Vec<&std::path::Path> = args.parts.iter().map(PathBuf::as_path).collect();
+    refuse_writing_inputs(&outputs, &parts)?;
     let merged = merge_parts(&args.parts).map_err(|e| e.to_string())?;
+    refuse_writing_inputs(&outputs, &[])?;
     let held: Vec<&str> = merged.aovs.iter().map(|(a, _)| a.name()).collect();
     let mut aovs = Vec::new();
     for (aov, path) in &aov_outputs {

@@ -4,7 +4,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::Args;
-use whitted::image::{ImageError, ImageFormat, check_destination};
+use whitted::image::{Destination, ImageError, ImageFormat, check_destination};
+use whitted::limits::{InputFile, identify_input, inputs_read};
 use whitted::render::{Aov, Share, Window, render, render_selected};
 
 use crate::arguments;
@@ -98,11 +99,13 @@ pub fn parse_aov(spec: &str) -> Result<(Aov, PathBuf), String> {
 /// unwritable folders, files the user may not write) and two outputs to
 /// the same file (by canonical path and by file identity); unless `quiet`,
 /// says what the user should know about the files that will be replaced.
+/// Returns the outputs, each with the option that named it, for
+/// [`refuse_writing_inputs`].
 pub fn check_destinations(
     output: &Path,
     aovs: &[(Aov, PathBuf)],
     quiet: bool,
-) -> Result<(), String> {
+) -> Result<Vec<(String, Destination)>, String> {
     let image = check_destination(output).map_err(|e| e.to_string())?;
     let mut checked = vec![(format!("-o {}", output.display()), image)];
     for (aov, path) in aovs {
@@ -123,6 +126,30 @@ pub fn check_destinations(
             note!("warning: {warning}");
         }
     }
+    Ok(checked)
+}
+
+/// Refuses an output (each with the option that named it) that is a file
+/// this run reads, whatever the name or link it is reached by: one of
+/// `named` (inputs named on the command line, compared before they are
+/// read) or one read so far ([`inputs_read`]: the scene, its models,
+/// material libraries, patches and textures, the parts). Called before
+/// the inputs are read and again once they are, before any rendering.
+pub fn refuse_writing_inputs(
+    outputs: &[(String, Destination)],
+    named: &[&Path],
+) -> Result<(), String> {
+    let mut inputs: Vec<InputFile> = named.iter().filter_map(|p| identify_input(p)).collect();
+    inputs.extend(inputs_read());
+    for (option, destination) in outputs {
+        if let Some(input) = inputs.iter().find(|i| destination.is_input(i)) {
+            return Err(format!(
+                "{option}: that file is an input of this run ({}); writing it would destroy \
+                 it, so give the output another name",
+                input.path.display()
+            ));
+        }
+    }
     Ok(())
 }
 
@@ -138,9 +165,12 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             .map(|s| parse_aov(s))
             .collect::<Result<Vec<_>, _>>()?,
     };
-    check_destinations(&args.output, &aov_outputs, args.quiet)?;
+    let outputs = check_destinations(&args.output, &aov_outputs, args.quiet)?;
+    let scene_file: Vec<&Path> = args.scene.scene.as_deref().into_iter().collect();
+    refuse_writing_inputs(&outputs, &scene_file)?;
     let load_start = Instant::now();
     let mut scene = args.scene.load(args.quiet)?;
+    refuse_writing_inputs(&outputs, &[])?;
     let load_seconds = load_start.elapsed().as_secs_f64();
 
     scene.settings.threads = args.threads;

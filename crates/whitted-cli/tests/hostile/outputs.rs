@@ -429,3 +429,124 @@ fn another_users_file_in_a_sticky_folder_is_refused_before_the_render() {
     );
     assert_eq!(fs::read(&theirs).unwrap(), b"theirs");
 }
+
+/// A sphere whose colour is the image `tex.png`, and a floor of the model
+/// `floor.obj` (with its material library `floor.mtl`).
+const TEXTURED_SCENE: &str = "[render]\nwidth = 8\nheight = 6\n\
+    [camera]\neye = [0, 0, -5]\nlook_at = [0, 0, 0]\nfov = 45\n\
+    [materials.painted]\ndiffuse = { image = \"tex.png\" }\n\
+    [[lights]]\ntype = \"point\"\nposition = [2, 3, -4]\n\
+    [[objects]]\nshape = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"painted\"\n\
+    [definitions.floor]\nmesh = \"floor.obj\"\n\
+    [[objects]]\ninstance = \"floor\"\n";
+
+#[test]
+fn no_output_is_written_over_a_file_the_run_reads() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    fs::write(d.join("s.toml"), TEXTURED_SCENE).unwrap();
+    fs::write(
+        d.join("floor.obj"),
+        "mtllib floor.mtl\nv -2 -1 -2\nv 2 -1 -2\nv 0 -1 2\nusemtl grey\nf 1 2 3\n",
+    )
+    .unwrap();
+    fs::write(d.join("floor.mtl"), "newmtl grey\nKd 0.5 0.5 0.5\n").unwrap();
+    let p = tiny_render(&["-o", "tex.png"], d);
+    assert_eq!(p.code(), Some(0), "{}", p.stderr);
+    symlink("s.toml", d.join("scene-link.png")).unwrap();
+    symlink("floor.obj", d.join("model-link.pfm")).unwrap();
+    fs::hard_link(d.join("floor.mtl"), d.join("library.exr")).unwrap();
+    let kept = |name: &str| fs::read(d.join(name)).unwrap();
+    let before: Vec<Vec<u8>> = ["s.toml", "tex.png", "floor.obj", "floor.mtl"]
+        .iter()
+        .map(|n| kept(n))
+        .collect();
+    let refused = |args: &[&str], option: &str, input: &str| {
+        let p = probe(args, d);
+        assert_eq!(p.code(), Some(1), "{args:?}: {}", p.stderr);
+        // Files found from the scene are named by the path they were read
+        // by (joined to the scene's folder).
+        let message = format!("error: {option}: that file is an input of this run (");
+        let input =
+            format!("{input}); writing it would destroy it, so give the output another name\n");
+        assert!(
+            p.stderr.contains(&message) && p.stderr.ends_with(&input),
+            "{args:?}: {}",
+            p.stderr
+        );
+    };
+    // The texture, the scene through a link, the model through a link, the
+    // material library through a second name; an AOV too.
+    refused(
+        &["render", "s.toml", "-o", "tex.png"],
+        "-o tex.png",
+        "tex.png",
+    );
+    refused(
+        &["render", "s.toml", "-o", "scene-link.png"],
+        "-o scene-link.png",
+        "s.toml",
+    );
+    refused(
+        &[
+            "render",
+            "s.toml",
+            "-o",
+            "a.png",
+            "--aov",
+            "depth=model-link.pfm",
+        ],
+        "--aov depth=model-link.pfm",
+        "floor.obj",
+    );
+    refused(
+        &["render", "s.toml", "-o", "library.exr"],
+        "-o library.exr",
+        "floor.mtl",
+    );
+    // A drawing over the scene, through its own name.
+    symlink("s.toml", d.join("drawing.svg")).unwrap();
+    refused(
+        &[
+            "explain",
+            "s.toml",
+            "--pixel",
+            "1,1",
+            "--svg",
+            "drawing.svg",
+        ],
+        "--svg drawing.svg",
+        "s.toml",
+    );
+    // A drawing under an image's name is refused before any work.
+    let p = probe(
+        &["explain", "s.toml", "--pixel", "1,1", "--svg", "x.png"],
+        d,
+    );
+    assert_eq!(p.code(), Some(1), "{}", p.stderr);
+    assert_eq!(
+        p.stderr,
+        "error: x.png: this output is an .svg file; give a name ending in .svg\n"
+    );
+    assert!(!d.join("x.png").exists());
+    // A merged image over one of its parts.
+    for (i, tile) in ["0/2", "1/2"].iter().enumerate() {
+        let part = format!("p{i}.wpart");
+        let p = tiny_render(&["s.toml", "--tile", tile, "-o", &part], d);
+        assert_eq!(p.code(), Some(0), "{}", p.stderr);
+    }
+    symlink("p0.wpart", d.join("merged.png")).unwrap();
+    let part = kept("p0.wpart");
+    refused(
+        &["merge", "p0.wpart", "p1.wpart", "-o", "merged.png"],
+        "-o merged.png",
+        "p0.wpart",
+    );
+    assert_eq!(kept("p0.wpart"), part);
+    let after: Vec<Vec<u8>> = ["s.toml", "tex.png", "floor.obj", "floor.mtl"]
+        .iter()
+        .map(|n| kept(n))
+        .collect();
+    assert!(before == after, "an input changed");
+    assert!(partial_files(d).is_empty());
+}

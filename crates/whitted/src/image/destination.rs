@@ -34,7 +34,8 @@ pub struct Destination {
     path: PathBuf,
     target: PathBuf,
     canonical: PathBuf,
-    format: ImageFormat,
+    /// The image format, `None` for a text file ([`check_text_destination`]).
+    format: Option<ImageFormat>,
     existing: Option<ExistingFile>,
 }
 
@@ -55,6 +56,25 @@ pub(crate) struct ExistingFile {
 /// refuse bad destinations before doing the work.
 pub fn check_destination(path: &Path) -> Result<Destination, ImageError> {
     let format = ImageFormat::from_path(path)?;
+    check_writable(path, Some(format))
+}
+
+/// [`check_destination`] for a text file of the kind `extension` names
+/// (such as `svg`, compared without regard to case): the name must end
+/// in it, so that no drawing is written under an image's name.
+pub fn check_text_destination(path: &Path, extension: &str) -> Result<Destination, ImageError> {
+    let given = path.extension().and_then(|e| e.to_str());
+    if !given.is_some_and(|e| e.eq_ignore_ascii_case(extension)) {
+        return Err(refused(
+            path,
+            format!("this output is an .{extension} file; give a name ending in .{extension}"),
+        ));
+    }
+    check_writable(path, None)
+}
+
+/// The rest of [`check_destination`] for a file of `format`.
+fn check_writable(path: &Path, format: Option<ImageFormat>) -> Result<Destination, ImageError> {
     let (target, existing) = resolve(path)?;
     let folder = folder_of(&target);
     // The truest test that the folder takes a new file is to make one.
@@ -99,8 +119,8 @@ impl Destination {
         &self.target
     }
 
-    /// The format the name asks for.
-    pub fn format(&self) -> ImageFormat {
+    /// The image format the name asks for (`None` for a text file).
+    pub fn format(&self) -> Option<ImageFormat> {
         self.format
     }
 
@@ -112,6 +132,14 @@ impl Destination {
             _ => false,
         };
         same_inode || self.canonical == other.canonical
+    }
+
+    /// Whether the file that will be replaced is `input`, a file read
+    /// ([`crate::limits::inputs_read`]): the same device and inode, by
+    /// whatever name or link.
+    pub fn is_input(&self, input: &crate::limits::InputFile) -> bool {
+        self.existing
+            .is_some_and(|e| (e.device, e.inode) == (input.device, input.inode))
     }
 
     /// What the user should know before the file is replaced, one sentence
@@ -449,10 +477,38 @@ mod tests {
     }
 
     #[test]
+    fn a_drawing_must_be_named_as_one_and_knows_the_files_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let svg = dir.path().join("tree.SVG");
+        let d = check_text_destination(&svg, "svg").unwrap();
+        assert_eq!(d.format(), None);
+        let png = dir.path().join("tree.png");
+        let error = check_text_destination(&png, "svg").unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            format!(
+                "{}: this output is an .svg file; give a name ending in .svg",
+                png.display()
+            )
+        );
+        // An existing file read as input is recognised by any name.
+        std::fs::write(&svg, "old").unwrap();
+        std::fs::hard_link(&svg, dir.path().join("other.svg")).unwrap();
+        let input = crate::limits::identify_input(&dir.path().join("other.svg")).unwrap();
+        assert!(
+            check_text_destination(&svg, "svg")
+                .unwrap()
+                .is_input(&input)
+        );
+        let fresh = check_text_destination(&dir.path().join("new.svg"), "svg").unwrap();
+        assert!(!fresh.is_input(&input));
+    }
+
+    #[test]
     fn a_new_file_in_an_existing_folder_is_a_destination() {
         let dir = tempfile::tempdir().unwrap();
         let d = check_destination(&dir.path().join("a.exr")).unwrap();
-        assert_eq!(d.format(), ImageFormat::Exr);
+        assert_eq!(d.format(), Some(ImageFormat::Exr));
         assert!(d.notes().is_empty());
         // The folder test leaves nothing behind.
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);

@@ -20,7 +20,7 @@ mod heat_map;
 mod partial;
 
 pub use color_space::{ColorSpace, encode_display8, encode_srgb8};
-pub use destination::{Destination, check_destination};
+pub use destination::{Destination, check_destination, check_text_destination};
 pub use heat_map::{heat_map, ramp};
 pub use partial::{PartialFilesRemoved, remove_partial_files};
 
@@ -583,7 +583,7 @@ mod tests {
             check_destination(&dir.path().join("a.exr"))
                 .unwrap()
                 .format(),
-            ImageFormat::Exr
+            Some(ImageFormat::Exr)
         );
         let missing = check_destination(Path::new("/no/such/folder/a.png")).unwrap_err();
         assert!(

@@ -6,13 +6,86 @@
 //! naming what it is. A file is read no further than the memory budget
 //! ([`MemoryBudget::current`]), whatever its size says (files in `/proc`
 //! say 0), and one larger is refused before it is read.
+//!
+//! Every file read is remembered by its identity ([`inputs_read`]), so
+//! that a command refuses to write an output over a file it read (a scene,
+//! a model, a texture, a part).
 
+use std::collections::HashSet;
 use std::fs::{File, FileType};
 use std::io::{self, Read};
-use std::os::unix::fs::FileTypeExt;
-use std::path::Path;
+use std::os::unix::fs::{FileTypeExt, MetadataExt};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use super::memory::MemoryBudget;
+
+/// A file read as input: the path it was read by, and which file that is
+/// (its device and inode, whatever links led to it).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct InputFile {
+    /// The path as the reader was given it.
+    pub path: PathBuf,
+    /// The file system's device.
+    pub device: u64,
+    /// The file's inode on it.
+    pub inode: u64,
+}
+
+/// The files read so far, in the order first read, and their identities
+/// (a set made at the first file).
+struct Ledger {
+    files: Vec<InputFile>,
+    identities: Option<HashSet<(u64, u64)>>,
+}
+
+/// The files this process has read.
+static INPUTS: Mutex<Ledger> = Mutex::new(Ledger {
+    files: Vec::new(),
+    identities: None,
+});
+
+/// Every file this process has read through [`read_input`] (scenes, models,
+/// material libraries, patches, textures, parts, ray files), each once,
+/// in the order first read.
+pub fn inputs_read() -> Vec<InputFile> {
+    let inputs = INPUTS
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
+    inputs.files.clone()
+}
+
+/// The identity of the file at `path` (its links followed), if there is
+/// one: for a command to compare its outputs with the inputs it names
+/// before it reads them.
+pub fn identify_input(path: &Path) -> Option<InputFile> {
+    let m = std::fs::metadata(path).ok()?;
+    Some(InputFile {
+        path: path.to_path_buf(),
+        device: m.dev(),
+        inode: m.ino(),
+    })
+}
+
+/// Notes that the file at `path`, opened as `file`, is read.
+fn remember(path: &Path, file: &File) -> io::Result<()> {
+    let m = file.metadata()?;
+    let mut inputs = INPUTS
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
+    let Ledger { files, identities } = &mut *inputs;
+    if identities
+        .get_or_insert_with(HashSet::new)
+        .insert((m.dev(), m.ino()))
+    {
+        files.push(InputFile {
+            path: path.to_path_buf(),
+            device: m.dev(),
+            inode: m.ino(),
+        });
+    }
+    Ok(())
+}
 
 /// The bytes of the regular file at `path`, read within the memory budget.
 /// The errors are [`io::Error`]s saying the true cause: "not a regular
@@ -55,6 +128,7 @@ fn read_within(path: &Path, budget: MemoryBudget) -> io::Result<Vec<u8>> {
         return Err(error);
     }
     let file = File::open(path)?;
+    remember(path, &file)?;
     let mut bytes = Vec::with_capacity(metadata.len() as usize);
     // One byte past the budget tells a file that grew beyond it.
     file.take(budget.bytes.saturating_add(1))
@@ -85,6 +159,29 @@ fn kind_of(file_type: FileType) -> &'static str {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_file_read_is_remembered_once_by_identity() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("read.txt");
+        std::fs::write(&path, "x").unwrap();
+        let link = dir.path().join("link.txt");
+        std::os::unix::fs::symlink(&path, &link).unwrap();
+        let named = identify_input(&link).unwrap();
+        assert_eq!(
+            identify_input(&path).map(|i| (i.device, i.inode)),
+            Some((named.device, named.inode))
+        );
+        assert_eq!(identify_input(&dir.path().join("missing")), None);
+        read_input(&path).unwrap();
+        read_input(&link).unwrap();
+        let same = |i: &&InputFile| (i.device, i.inode) == (named.device, named.inode);
+        let read = inputs_read();
+        let found: Vec<&InputFile> = read.iter().filter(same).collect();
+        // Once, under the first path it was read by (here, or in another
+        // test of this process whose deleted file had the same inode).
+        assert_eq!(found.len(), 1, "{read:?}");
+    }
 
     #[test]
     fn a_regular_file_is_read_whole() {

@@ -10,5 +10,5 @@
 mod input;
 mod memory;
 
-pub use input::{read_input, read_input_text};
+pub use input::{InputFile, identify_input, inputs_read, read_input, read_input_text};
 pub use memory::{BudgetOrigin, MemoryBudget, MemoryError, format_bytes, parse_size};
