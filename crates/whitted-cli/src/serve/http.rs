@@ -108,7 +108,14 @@ pub fn read_request(input: &mut impl BufRead) -> Result<Option<Request>, Refusal
         let Some((name, value)) = text.split_once(':') else {
             return Err(Refusal::new(400, format!("`{text}` is not a header")));
         };
-        headers.push((name.trim().to_ascii_lowercase(), value.trim().to_string()));
+        let name = name.trim().to_ascii_lowercase();
+        if name == "host" && headers.iter().any(|(n, _)| n == "host") {
+            return Err(Refusal::new(
+                400,
+                "the request has more than one Host header",
+            ));
+        }
+        headers.push((name, value.trim().to_string()));
     }
     let (path, query) = target.split_once('?').unwrap_or((&target, ""));
     let mut request = Request {
@@ -237,6 +244,14 @@ impl Response {
 
     /// Writes the response.
     pub fn write(&self, out: &mut impl Write) -> io::Result<()> {
+        self.write_head(out)?;
+        out.write_all(&self.body)?;
+        out.flush()
+    }
+
+    /// Writes the response's status and headers only, as the answer to a
+    /// `HEAD` request (the length is the body's).
+    pub fn write_head(&self, out: &mut impl Write) -> io::Result<()> {
         let mut head = format!(
             "HTTP/1.1 {} {}\r\nContent-Type: {}\r\nContent-Length: {}\r\nConnection: close\r\n\
              Cache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\n",
@@ -250,7 +265,6 @@ impl Response {
         }
         head.push_str("\r\n");
         out.write_all(head.as_bytes())?;
-        out.write_all(&self.body)?;
         out.flush()
     }
 }

@@ -31,6 +31,12 @@ const IO_TIMEOUT: Duration = Duration::from_secs(20);
 /// How often an idle event stream sends a comment, to find closed pages.
 const KEEP_ALIVE: Duration = Duration::from_secs(10);
 
+/// How long a refused request's rest is waited for ([`linger`]).
+const LINGER: Duration = Duration::from_secs(1);
+
+/// The most bytes of a refused request's rest read and dropped.
+const MAX_LINGER_BYTES: usize = 1 << 20;
+
 /// Show a scene live in the browser: a progressive render that follows
 /// the scene file, a camera moved with the mouse, the AOVs and
 /// structures, each pixel's ray tree, and saves.
@@ -104,6 +110,7 @@ fn serve_connection(session: &Session, stream: TcpStream, address: SocketAddr) {
         Ok(None) => return,
         Err(refusal) => {
             let _ = Response::refused(&refusal).write(&mut &stream);
+            linger(&stream, &mut reader);
             return;
         }
     };
@@ -120,7 +127,29 @@ fn serve_connection(session: &Session, stream: TcpStream, address: SocketAddr) {
     if response.status >= 500 {
         note!("{} {}: {}", request.method, request.path, response.status);
     }
-    let _ = response.write(&mut &stream);
+    let _ = if request.method == "HEAD" {
+        response.write_head(&mut &stream)
+    } else {
+        response.write(&mut &stream)
+    };
+}
+
+/// Closes a connection answered before its request was read whole (a head
+/// too long, a body refused): the answer is sent, then what the client
+/// still sends is read and dropped, within bounds, so that closing with
+/// unread data does not reset the connection before the client reads the
+/// answer.
+fn linger(stream: &TcpStream, unread: &mut impl std::io::Read) {
+    let _ = stream.shutdown(std::net::Shutdown::Write);
+    let _ = stream.set_read_timeout(Some(LINGER));
+    let mut sink = [0u8; 4096];
+    let mut left = MAX_LINGER_BYTES;
+    while left > 0 {
+        match unread.read(&mut sink) {
+            Ok(0) | Err(_) => break,
+            Ok(n) => left = left.saturating_sub(n),
+        }
+    }
 }
 
 /// Refuses, on a server bound to the loopback address, requests from
@@ -142,10 +171,13 @@ fn check_origin(
         ));
     }
     let port = address.port();
+    // The names of the loopback interface, and the address the server is
+    // bound to (another loopback address, such as 127.0.0.2).
     let hosts = [
         format!("127.0.0.1:{port}"),
         format!("localhost:{port}"),
         format!("[::1]:{port}"),
+        address.to_string(),
     ];
     let host = request.header("host").unwrap_or("");
     if !hosts.iter().any(|h| h == host) {
@@ -238,6 +270,14 @@ mod tests {
             ],
         );
         assert_eq!(check(&own, local), Ok(()));
+        // A server bound to another loopback address answers that name.
+        let other: SocketAddr = "127.0.0.2:7878".parse().unwrap();
+        let named = with_headers("GET", &[("host", "127.0.0.2:7878")]);
+        assert_eq!(
+            check_origin(&named, other, Some(local)).map_err(|e| e.status),
+            Ok(())
+        );
+        assert_eq!(check(&named, local), Err(403));
         let open: SocketAddr = "0.0.0.0:7878".parse().unwrap();
         assert_eq!(
             check_origin(&rebound, open, Some(far)).map_err(|e| e.status),

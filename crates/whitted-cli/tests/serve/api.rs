@@ -273,6 +273,25 @@ fn bad_and_foreign_requests_are_refused_and_the_server_stays_up() {
     assert_eq!(server.raw(&foreign, b"aov=depth").0, 403);
     assert_eq!(server.view("aov=nothing").0, 400);
     assert_eq!(server.view("fov=0").0, 400);
+    // HEAD answers the head alone, with the body's length.
+    let (status, head, body) =
+        server.exchange(&format!("HEAD / HTTP/1.1\r\nHost: 127.0.0.1:{port}"), b"");
+    assert_eq!(status, 200);
+    assert!(body.is_empty(), "{} bytes of body", body.len());
+    let (_, page) = server.get("/");
+    assert!(
+        head.contains(&format!("Content-Length: {}", page.len())),
+        "{head}"
+    );
+    // A second Host header is refused.
+    let twice = format!("GET / HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nHost: evil.example");
+    assert_eq!(server.raw(&twice, b"").0, 400);
+    // A head past 16 KiB is answered 431, not reset.
+    let long = format!(
+        "GET / HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nX-Padding: {}",
+        "a".repeat(40 << 10)
+    );
+    assert_eq!(server.raw(&long, b"").0, 431);
     assert!(server.alive());
     assert_eq!(server.get("/").0, 200);
 }
