@@ -76,6 +76,30 @@ fn out_of_range(keyword: &str, word: &str) -> Option<FactorError> {
     }
 }
 
+/// Why a number of `keyword` that is taken clamped (the dissolve `d` and
+/// transparency `Tr` to 0 to 1, the exponent `Ns` to at least 1) is out of
+/// its range, and what it is taken as; `None` within it. A negative `Ns`
+/// only: 0 to 1 is the MTL's own range, read as 1.
+fn clamped(keyword: &str, value: f64) -> Option<String> {
+    let taken = match keyword {
+        "d" | "Tr" if !(0.0..=1.0).contains(&value) => value.clamp(0.0, 1.0),
+        "Ns" if value < 0.0 => 1.0,
+        _ => return None,
+    };
+    let meaning = match (keyword, taken) {
+        ("d", 0.0) | ("Tr", 1.0) => ": the surface is invisible",
+        _ => "",
+    };
+    Some(format!(
+        "`{keyword}` {value} is out of range ({}); taken as {taken}{meaning}",
+        if keyword == "Ns" {
+            "0 or more"
+        } else {
+            "0 to 1"
+        }
+    ))
+}
+
 fn is_error(d: &Diagnostic) -> bool {
     d.severity == crate::scene::Severity::Error
 }
@@ -118,6 +142,12 @@ fn check(source: &str, path: &Path) -> Vec<Diagnostic> {
                 out_of_range(keyword, word)
                     .map(|error| format!("`{keyword}` {word} is out of range: {error}"))
             };
+            if ok && let Some(message) = word.parse::<f64>().ok().and_then(|v| clamped(keyword, v))
+            {
+                push_limited(&mut diagnostics, Severity::Warning, || {
+                    Diagnostic::warning(path, source, span.clone(), message)
+                });
+            }
             if ok && let Some(message) = problem {
                 push_limited(&mut diagnostics, Severity::Error, || {
                     Diagnostic::new(path, source, span, message)
@@ -402,6 +432,32 @@ mod tests {
 
     fn read(source: &str) -> Library {
         read_library(source, Path::new("m.mtl"), &mut ImageCache::default())
+    }
+
+    #[test]
+    fn dissolves_and_exponents_out_of_range_are_warned_and_clamped() {
+        let lib =
+            read("newmtl a\nd -1\nNs -5\nnewmtl b\nTr 2\nnewmtl c\nd 2\nNs 0\nnewmtl d\nTr -0.5\n");
+        let text: Vec<String> = lib.diagnostics.iter().map(ToString::to_string).collect();
+        let firsts: Vec<&str> = text.iter().map(|t| t.lines().next().unwrap()).collect();
+        assert_eq!(
+            firsts,
+            [
+                "m.mtl:2:3: warning: `d` -1 is out of range (0 to 1); taken as 0: the surface \
+                 is invisible",
+                "m.mtl:3:4: warning: `Ns` -5 is out of range (0 or more); taken as 1",
+                "m.mtl:5:4: warning: `Tr` 2 is out of range (0 to 1); taken as 1: the surface \
+                 is invisible",
+                "m.mtl:7:3: warning: `d` 2 is out of range (0 to 1); taken as 1",
+                "m.mtl:10:4: warning: `Tr` -0.5 is out of range (0 to 1); taken as 0",
+            ]
+        );
+        let m = &lib.materials;
+        assert_eq!(m["a"].opacity, Texture::Constant(Color::ZERO));
+        assert_eq!(m["a"].shininess, 1.0);
+        assert_eq!(m["b"].opacity, Texture::Constant(Color::ZERO));
+        assert_eq!(m["c"].opacity, Texture::Constant(Color::ONE));
+        assert_eq!(m["d"].opacity, Texture::Constant(Color::ONE));
     }
 
     #[test]
