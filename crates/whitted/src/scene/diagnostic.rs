@@ -260,12 +260,55 @@ impl Diagnostic {
             path: path.to_path_buf(),
             line: source[..line_start].matches('\n').count() + 1,
             column,
-            message: message.into(),
-            source_line,
+            message: readable(&message.into()),
+            source_line: source_line.chars().map(visible).collect(),
             shown_from,
             width,
         }
     }
+}
+
+/// `c`, or where it is a control character that a terminal would act on
+/// or hide (a NUL, an escape, a carriage return), its picture from
+/// Unicode's Control Pictures block (`␀`, `␛`, `␍`): one character for one,
+/// so a caret under the line stays in its place. Tabs are kept.
+fn visible(c: char) -> char {
+    match c {
+        '\t' => c,
+        '\u{0}'..='\u{1f}' => char::from_u32(0x2400 + c as u32).unwrap_or('\u{fffd}'),
+        '\u{7f}' => '\u{2421}',
+        _ => c,
+    }
+}
+
+/// A message as shown: control characters as [`visible`] makes them
+/// (line breaks kept), and numbers written out in more than 21 characters
+/// (`-1e300` as 302 digits) in scientific notation, as Rust's shortest
+/// form gives them (`-1e300`).
+fn readable(message: &str) -> String {
+    let mut out = String::with_capacity(message.len());
+    let mut rest = message;
+    while let Some(start) = rest.find(|c: char| c.is_ascii_digit()) {
+        let (before, from) = rest.split_at(start);
+        let length = from
+            .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .unwrap_or(from.len());
+        let (digits, after) = from.split_at(length);
+        out.extend(
+            before
+                .chars()
+                .map(|c| if c == '\n' { c } else { visible(c) }),
+        );
+        match digits.parse::<f64>() {
+            Ok(value) if digits.len() > 21 && value.is_finite() => {
+                out.push_str(&format!("{value:e}"));
+            }
+            _ => out.push_str(digits),
+        }
+        rest = after;
+    }
+    out.extend(rest.chars().map(|c| if c == '\n' { c } else { visible(c) }));
+    out
 }
 
 impl Diagnostic {
@@ -322,6 +365,31 @@ mod tests {
 
     fn at(source: &str, span: Range<usize>) -> Diagnostic {
         Diagnostic::new(Path::new("scenes/bad.toml"), source, span, "oops")
+    }
+
+    #[test]
+    fn control_characters_and_huge_numbers_are_shown_readably() {
+        let source = "fov = 3\u{0}\u{1b}[2J\n";
+        let d = Diagnostic::new(
+            Path::new("s.toml"),
+            source,
+            6..10,
+            format!(
+                "expected a number, found `3\u{0}\u{1b}`; got {} and {} and {}",
+                -1e300, 1e20, 0.000_000_1
+            ),
+        );
+        assert_eq!(
+            d.message,
+            "expected a number, found `3␀␛`; got -1e300 and 100000000000000000000 and 0.0000001"
+        );
+        assert_eq!(d.source_line, "fov = 3␀␛[2J");
+        let shown = d.to_string();
+        assert!(
+            shown.ends_with("1 | fov = 3␀␛[2J\n  |       ^^^^"),
+            "{shown}"
+        );
+        assert!(!shown.contains('\u{0}') && !shown.contains('\u{1b}'));
     }
 
     #[test]
