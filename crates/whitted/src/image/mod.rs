@@ -329,7 +329,26 @@ impl Film {
             .write()
             .non_parallel()
             .to_buffered(BufWriter::new(out))
-            .map_err(std::io::Error::other)
+            .map_err(exr_io_error)
+    }
+}
+
+/// The I/O error an EXR encoding failed with, as itself (a full disk stays
+/// a full disk); its other errors as "other".
+fn exr_io_error(error: exr::error::Error) -> std::io::Error {
+    match error {
+        exr::error::Error::Io(io) => io,
+        other => std::io::Error::other(other),
+    }
+}
+
+/// `error` without the partial file's name that some errors carry: the
+/// system's error, named and numbered, where it is one ("No space left on
+/// device (os error 28)"), else its kind.
+fn without_partial_name(error: &std::io::Error) -> std::io::Error {
+    match error.raw_os_error() {
+        Some(code) => std::io::Error::from_raw_os_error(code),
+        None => std::io::Error::new(error.kind(), error.kind().to_string()),
     }
 }
 
@@ -381,8 +400,7 @@ pub fn encode_to_partial(
 ) -> Result<PendingImage, ImageError> {
     let io = |source: std::io::Error| ImageError::Io {
         path: path.to_path_buf(),
-        // Drop the partial file's name that some errors carry.
-        source: std::io::Error::new(source.kind(), source.kind().to_string()),
+        source: without_partial_name(&source),
     };
     let (target, _) = resolve(path)?;
     let mut partial = PartialFile::create_in(folder_of(&target), &IN_FLIGHT).map_err(io)?;
@@ -485,6 +503,17 @@ mod tests {
         assert_eq!(floats.len(), 18);
         // First stored pixel is the bottom-left one: (0, 1).
         assert_eq!(&floats[..3], &[0.0, 1.0, 0.25]);
+    }
+
+    #[test]
+    fn a_full_disk_is_named_whatever_the_format() {
+        let full = std::io::Error::from_raw_os_error(28);
+        let from_exr = exr_io_error(exr::error::Error::Io(full));
+        assert_eq!(from_exr.raw_os_error(), Some(28));
+        let shown = without_partial_name(&from_exr).to_string();
+        assert_eq!(shown, "No space left on device (os error 28)");
+        let other = std::io::Error::new(std::io::ErrorKind::InvalidData, "/x/.whitted-1.partial");
+        assert_eq!(without_partial_name(&other).to_string(), "invalid data");
     }
 
     #[test]
