@@ -419,3 +419,58 @@ fn placements_that_multiply_past_any_count_are_refused_not_wrapped() {
     }
     assert!(!dir.path().join("out.png").exists());
 }
+
+#[test]
+fn every_reader_reads_one_long_line_in_time_linear_in_its_length() {
+    // Each took seconds to minutes when a line's length multiplied the
+    // work of every item on it: an NFF with 200,000 spheres on one line
+    // (18.9 s), an MTL `map_Kd` with 100,000 unknown options (over 60 s),
+    // an OBJ `mtllib` naming 80,000 libraries (12 s). Read one after the
+    // other in well under the time one of them took.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let spheres: Vec<String> = (0..200_000)
+        .map(|i| format!("s {} 0 0 0.1", i % 100))
+        .collect();
+    write(
+        d,
+        "long.nff",
+        format!(
+            "v from 0 0 -50 at 0 0 0 up 0 1 0 angle 30 hither 1 resolution 4 4\n\
+             f 1 0 0 1 0 0 0 0\n{}\n",
+            spheres.join(" ")
+        ),
+    );
+    let options: Vec<String> = (0..100_000).map(|i| format!("-zz{i}")).collect();
+    write(
+        d,
+        "long.mtl",
+        format!("newmtl a\nmap_Kd {} t.png\n", options.join(" ")),
+    );
+    write(
+        d,
+        "options.obj",
+        "mtllib long.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n",
+    );
+    let names: Vec<String> = (0..80_000).map(|i| format!("x{i}.mtl")).collect();
+    write(
+        d,
+        "names.obj",
+        format!(
+            "mtllib {}\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+            names.join(" ")
+        ),
+    );
+    let start = Instant::now();
+    for scene in ["long.nff", "options.obj", "names.obj"] {
+        let p = probe(
+            &[
+                "render", scene, "-o", "out.png", "--width", "4", "--height", "4",
+            ],
+            d,
+        );
+        assert_eq!(p.code(), Some(0), "{scene}: {}", p.stderr);
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    assert!(seconds < 8.0, "{seconds} s");
+}

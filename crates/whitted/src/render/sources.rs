@@ -34,12 +34,18 @@ impl SourceLocation {
 }
 
 /// The lines of a text, to find the line and column of many offsets in
-/// it without reading it again for each (a file of many objects).
+/// it without reading it again for each (a file of many objects): the line
+/// by a binary search, the column counted on from the offset asked before
+/// where that lies earlier on the same line, so that offsets asked in the
+/// order of the file cost time linear in its length, however long its
+/// lines (200,000 spheres on one line of NFF).
 #[derive(Clone, Debug)]
 pub struct LineIndex<'s> {
     source: &'s str,
     /// The byte offset where each line starts.
     starts: Vec<usize>,
+    /// The last offset located, and its column.
+    last: std::cell::Cell<(usize, u32)>,
 }
 
 impl<'s> LineIndex<'s> {
@@ -49,6 +55,7 @@ impl<'s> LineIndex<'s> {
         Self {
             source,
             starts: std::iter::once(0).chain(breaks).collect(),
+            last: std::cell::Cell::new((0, 1)),
         }
     }
 
@@ -59,9 +66,18 @@ impl<'s> LineIndex<'s> {
             offset -= 1;
         }
         let line = self.starts.partition_point(|&start| start <= offset) - 1;
+        let start = self.starts[line];
+        let (before, column) = self.last.get();
+        let (from, counted) = if (start..=offset).contains(&before) {
+            (before, column)
+        } else {
+            (start, 1)
+        };
+        let column = counted + self.source[from..offset].chars().count() as u32;
+        self.last.set((offset, column));
         SourceLocation {
             line: (line + 1) as u32,
-            column: (self.source[self.starts[line]..offset].chars().count() + 1) as u32,
+            column,
         }
     }
 }
@@ -163,6 +179,15 @@ mod tests {
         assert_eq!(SourceLocation::at(text, 999).line, 3);
         let index = LineIndex::new(text);
         for offset in 0..=text.len() + 2 {
+            assert_eq!(
+                index.location(offset),
+                SourceLocation::at(text, offset),
+                "{offset}"
+            );
+        }
+        // Asked backwards and out of order, from the memo of the last.
+        let shuffled = (0..=text.len() + 2).rev().chain([7, 3, 20, 19, 30, 2, 25]);
+        for offset in shuffled {
             assert_eq!(
                 index.location(offset),
                 SourceLocation::at(text, offset),

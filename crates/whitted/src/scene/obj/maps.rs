@@ -153,6 +153,10 @@ impl MapStatement {
     }
 }
 
+/// The longest path a file may have on the systems we run on (Linux's
+/// `PATH_MAX`): a longer rest of a line names no file.
+const MAX_PATH_BYTES: usize = 4096;
+
 /// Reads a map line of an MTL file in folder `folder` (one whose keyword
 /// [`MapSlot::of`] knows); `None` for other lines or a map without a file
 /// name.
@@ -194,8 +198,12 @@ pub(super) fn read_map(line: Line<'_>, folder: &Path) -> Option<MapStatement> {
             let rest = &words[at..];
             let taken = match rest.iter().position(|(word, _)| arguments(word).is_some()) {
                 Some(next_option) => next_option,
+                // Only the tails short enough to be a path are tried, so a
+                // long line costs time in proportion to its length.
                 None => (at..words.len())
-                    .position(|i| folder.join(file_path(tail(i))).is_file())
+                    .position(|i| {
+                        tail(i).len() <= MAX_PATH_BYTES && folder.join(file_path(tail(i))).is_file()
+                    })
                     .unwrap_or(rest.len().saturating_sub(1)),
             };
             let arguments: Vec<&str> = rest[..taken].iter().map(|(word, _)| *word).collect();

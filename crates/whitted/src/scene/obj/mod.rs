@@ -69,15 +69,18 @@ pub fn parse_obj(source: &str, path: &Path) -> Result<LoadedScene, SceneError> {
                 diagnostics.extend(library.diagnostics);
                 materials.extend(library.materials);
             }
-            Err(error) => diagnostics.push(Diagnostic::warning(
-                path,
-                source,
-                span,
-                format!(
-                    "cannot read the material library `{}` ({error}); its materials are grey",
-                    file.display()
-                ),
-            )),
+            Err(error) => push_limited(&mut diagnostics, Severity::Warning, || {
+                Diagnostic::warning(
+                    path,
+                    source,
+                    span,
+                    format!(
+                        "cannot read the material library `{}` ({error}); its materials are \
+                         grey",
+                        file.display()
+                    ),
+                )
+            }),
         }
     }
     if data.faces.is_empty() && diagnostics.iter().all(|d| d.severity != Severity::Error) {
