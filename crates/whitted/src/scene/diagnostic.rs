@@ -268,6 +268,28 @@ impl Diagnostic {
     }
 }
 
+/// `message` with each text between a pair of backticks longer than
+/// [`MAX_QUOTED_CHARS`] cut to that many characters, the last `…`.
+fn quotes_cut(message: &str) -> String {
+    let parts: Vec<&str> = message.split('`').collect();
+    let mut out = String::with_capacity(message.len().min(1 << 16));
+    for (i, part) in parts.iter().enumerate() {
+        if i > 0 {
+            out.push('`');
+        }
+        // Odd parts lie between a pair of backticks (the last one only when
+        // its closing backtick is there).
+        let quoted = i % 2 == 1 && i + 1 < parts.len();
+        if quoted && part.chars().nth(MAX_QUOTED_CHARS).is_some() {
+            out.extend(part.chars().take(MAX_QUOTED_CHARS - 1));
+            out.push('…');
+        } else {
+            out.push_str(part);
+        }
+    }
+    out
+}
+
 /// `c`, or where it is a control character that a terminal would act on
 /// or hide (a NUL, an escape, a carriage return), its picture from
 /// Unicode's Control Pictures block (`␀`, `␛`, `␍`): one character for one,
@@ -281,11 +303,18 @@ fn visible(c: char) -> char {
     }
 }
 
+/// The most characters of a name or word quoted in a message (between
+/// backticks): about a line's width; a longer one is cut, with `…`.
+pub const MAX_QUOTED_CHARS: usize = 72;
+
 /// A message as shown: control characters as [`visible`] makes them
-/// (line breaks kept), and numbers written out in more than 21 characters
+/// (line breaks kept), numbers written out in more than 21 characters
 /// (`-1e300` as 302 digits) in scientific notation, as Rust's shortest
-/// form gives them (`-1e300`).
+/// form gives them (`-1e300`), and what it quotes between backticks cut to
+/// [`MAX_QUOTED_CHARS`].
 fn readable(message: &str) -> String {
+    let cut = quotes_cut(message);
+    let message = cut.as_str();
     let mut out = String::with_capacity(message.len());
     let mut rest = message;
     while let Some(start) = rest.find(|c: char| c.is_ascii_digit()) {
@@ -390,6 +419,18 @@ mod tests {
             "{shown}"
         );
         assert!(!shown.contains('\u{0}') && !shown.contains('\u{1b}'));
+        let long = "m".repeat(200_000);
+        let named = Diagnostic::new(
+            Path::new("s.toml"),
+            source,
+            0..1,
+            format!("unknown material `{long}`; expected one of `a`, `b`"),
+        );
+        let cut = format!("{}…", "m".repeat(MAX_QUOTED_CHARS - 1));
+        assert_eq!(
+            named.message,
+            format!("unknown material `{cut}`; expected one of `a`, `b`")
+        );
     }
 
     #[test]
