@@ -96,14 +96,32 @@ pub fn read_input(path: &Path) -> io::Result<Vec<u8>> {
 }
 
 /// The text of the regular file at `path`, read like [`read_input`]; not
-/// UTF-8 is an [`io::ErrorKind::InvalidData`] error.
+/// UTF-8 is an [`io::ErrorKind::InvalidData`] error naming the line and
+/// column of the first byte that is not ([`not_utf8`]).
 pub fn read_input_text(path: &Path) -> io::Result<String> {
-    String::from_utf8(read_input(path)?).map_err(|_| {
-        io::Error::new(
-            io::ErrorKind::InvalidData,
-            "stream did not contain valid UTF-8",
-        )
+    String::from_utf8(read_input(path)?).map_err(|error| {
+        let message = not_utf8(error.as_bytes(), error.utf8_error().valid_up_to());
+        io::Error::new(io::ErrorKind::InvalidData, message)
     })
+}
+
+/// Why `bytes`, valid UTF-8 up to byte `valid`, are not text we read: a
+/// UTF-16 file when its byte-order mark says so, otherwise where the
+/// first bad byte is (its line, and its column in characters).
+fn not_utf8(bytes: &[u8], valid: usize) -> String {
+    if bytes.starts_with(&[0xff, 0xfe]) || bytes.starts_with(&[0xfe, 0xff]) {
+        return "the file is UTF-16 (its byte-order mark says so); save it as UTF-8".to_string();
+    }
+    // Valid up to there, so these are whole characters.
+    let before = std::str::from_utf8(&bytes[..valid]).unwrap_or_default();
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    format!(
+        "not UTF-8 text: line {}, column {} holds the byte 0x{:02x}, which UTF-8 does not \
+         allow there; save the file as UTF-8",
+        before.matches('\n').count() + 1,
+        before[line_start..].chars().count() + 1,
+        bytes[valid]
+    )
 }
 
 /// [`read_input`] within `budget`.
@@ -159,6 +177,33 @@ fn kind_of(file_type: FileType) -> &'static str {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn text_that_is_not_utf8_is_refused_at_its_first_bad_byte() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.toml");
+        std::fs::write(&path, b"a = 1\nname = \"caf\xe9\"\n").unwrap();
+        let error = read_input_text(&path).unwrap_err();
+        assert_eq!(error.kind(), io::ErrorKind::InvalidData);
+        assert_eq!(
+            error.to_string(),
+            "not UTF-8 text: line 2, column 12 holds the byte 0xe9, which UTF-8 does not allow \
+             there; save the file as UTF-8"
+        );
+        std::fs::write(&path, b"\xff\xfea\x00=\x001\x00").unwrap();
+        assert_eq!(
+            read_input_text(&path).unwrap_err().to_string(),
+            "the file is UTF-16 (its byte-order mark says so); save it as UTF-8"
+        );
+        // A character before the bad byte counts as one column.
+        std::fs::write(&path, "é".bytes().chain([0xc0]).collect::<Vec<u8>>()).unwrap();
+        assert!(
+            read_input_text(&path)
+                .unwrap_err()
+                .to_string()
+                .contains("line 1, column 2")
+        );
+    }
 
     #[test]
     fn every_file_read_is_remembered_once_by_identity() {
