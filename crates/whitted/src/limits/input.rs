@@ -2,8 +2,10 @@
 //! material libraries, textures and ray files goes through here.
 //!
 //! Only regular files are read (after following symbolic links): a device
-//! such as `/dev/zero`, a FIFO or a folder is refused before it is opened,
-//! naming what it is. A file is read no further than the memory budget
+//! such as `/dev/zero`, a FIFO or a folder is refused before anything is
+//! read from it, naming what it is. The file is opened without waiting and
+//! then checked, so one swapped for a FIFO between a check and the open
+//! cannot block the reader. A file is read no further than the memory budget
 //! ([`MemoryBudget::current`]), whatever its size says (files in `/proc`
 //! say 0), and one larger is refused before it is read.
 //!
@@ -12,9 +14,9 @@
 //! a model, a texture, a part).
 
 use std::collections::HashSet;
-use std::fs::{File, FileType};
+use std::fs::FileType;
 use std::io::{self, Read};
-use std::os::unix::fs::{FileTypeExt, MetadataExt};
+use std::os::unix::fs::{FileTypeExt, MetadataExt, OpenOptionsExt};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -67,9 +69,9 @@ pub fn identify_input(path: &Path) -> Option<InputFile> {
     })
 }
 
-/// Notes that the file at `path`, opened as `file`, is read.
-fn remember(path: &Path, file: &File) -> io::Result<()> {
-    let m = file.metadata()?;
+/// Notes that the file at `path`, whose opened file's metadata is `m`, is
+/// read.
+fn remember(path: &Path, m: &std::fs::Metadata) {
     let mut inputs = INPUTS
         .lock()
         .unwrap_or_else(|poisoned| poisoned.into_inner());
@@ -84,7 +86,6 @@ fn remember(path: &Path, file: &File) -> io::Result<()> {
             inode: m.ino(),
         });
     }
-    Ok(())
 }
 
 /// The bytes of the regular file at `path`, read within the memory budget.
@@ -126,7 +127,14 @@ fn not_utf8(bytes: &[u8], valid: usize) -> String {
 
 /// [`read_input`] within `budget`.
 fn read_within(path: &Path, budget: MemoryBudget) -> io::Result<Vec<u8>> {
-    let metadata = std::fs::metadata(path)?;
+    // Opened first, without waiting (a FIFO with no writer would block the
+    // open), then the opened file checked: a file swapped between a check
+    // of the path and the open cannot slip through.
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(rustix::fs::OFlags::NONBLOCK.bits() as i32)
+        .open(path)?;
+    let metadata = file.metadata()?;
     if !metadata.is_file() {
         return Err(io::Error::new(
             io::ErrorKind::InvalidInput,
@@ -145,8 +153,7 @@ fn read_within(path: &Path, budget: MemoryBudget) -> io::Result<Vec<u8>> {
     if let Some(error) = too_large(metadata.len()) {
         return Err(error);
     }
-    let file = File::open(path)?;
-    remember(path, &file)?;
+    remember(path, &metadata);
     let mut bytes = Vec::with_capacity(metadata.len() as usize);
     // One byte past the budget tells a file that grew beyond it.
     file.take(budget.bytes.saturating_add(1))
@@ -265,7 +272,7 @@ mod tests {
     fn a_file_larger_than_the_budget_is_refused_before_it_is_read() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("big.obj");
-        let file = File::create(&path).unwrap();
+        let file = std::fs::File::create(&path).unwrap();
         file.set_len(1 << 40).unwrap();
         let error = read_within(&path, MemoryBudget::given(1 << 20)).unwrap_err();
         assert_eq!(error.kind(), io::ErrorKind::FileTooLarge);
