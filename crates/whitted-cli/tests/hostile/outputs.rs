@@ -550,3 +550,74 @@ fn no_output_is_written_over_a_file_the_run_reads() {
     assert!(before == after, "an input changed");
     assert!(partial_files(d).is_empty());
 }
+
+/// Issue 50, item 15: a part whose data is damaged (its checksum), forged
+/// with values no render gives (a checksum that matches them), or saying
+/// `spp 0` is refused by `merge` with its place; nothing is written.
+#[test]
+fn merge_refuses_damaged_and_forged_parts_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for (i, tile) in ["0/2", "1/2"].iter().enumerate() {
+        let part = format!("p{i}.wpart");
+        let p = tiny_render(&["--tile", tile, "--aov", "depth", "-o", &part], d);
+        assert_eq!(p.code(), Some(0), "{}", p.stderr);
+    }
+    let good = fs::read(d.join("p1.wpart")).unwrap();
+    let data_at = good.windows(5).position(|w| w == b"data\n").unwrap() + 5;
+    let header = String::from_utf8(good[..data_at].to_vec()).unwrap();
+    let hash = header
+        .lines()
+        .find_map(|l| l.strip_prefix("data-sha256 "))
+        .unwrap()
+        .to_string();
+    // The part with `data` in place of its data and the header changed by
+    // `edit`, its checksum made to match the data when `rehash`.
+    let forge = |data: &[u8], edit: (&str, &str), rehash: bool| {
+        let mut header = header.replace(edit.0, edit.1);
+        if rehash {
+            header = header.replace(&hash, &whitted::render::scene_sha256(data));
+        }
+        let mut bytes = header.into_bytes();
+        bytes.extend_from_slice(data);
+        fs::write(d.join("p1.wpart"), bytes).unwrap();
+        probe(&["merge", "p0.wpart", "p1.wpart", "-o", "m.exr"], d)
+    };
+    let mut flipped = good[data_at..].to_vec();
+    flipped[5] ^= 0x01;
+    let mut nan = good[data_at..].to_vec();
+    nan[4..8].copy_from_slice(&f32::NAN.to_le_bytes());
+    let mut negative_depth = good[data_at..].to_vec();
+    negative_depth[12..16].copy_from_slice(&(-2.0f32).to_le_bytes());
+    for (p, says) in [
+        (
+            forge(&flipped, ("", ""), false),
+            "p1.wpart:15: the pixel data's SHA-256 is ",
+        ),
+        (
+            forge(&nan, ("", ""), true),
+            "p1.wpart:15: pixel (0, 1) holds the colour value NaN, which no render gives: the \
+             part is damaged; render it again",
+        ),
+        (
+            forge(&negative_depth, ("", ""), true),
+            "p1.wpart:15: pixel (0, 1) holds the depth value -2, which no render gives",
+        ),
+        (
+            forge(&good[data_at..], ("spp 1\n", "spp 0\n"), false),
+            "p1.wpart:7: `spp 0`: a render takes at least one sample per pixel",
+        ),
+    ] {
+        assert_eq!(p.code(), Some(1), "{}", p.stderr);
+        assert!(
+            p.stderr.starts_with("error: ") && p.stderr.contains(says),
+            "{}",
+            p.stderr
+        );
+        assert!(!d.join("m.exr").exists());
+        assert!(partial_files(d).is_empty());
+    }
+    fs::write(d.join("p1.wpart"), &good).unwrap();
+    let p = probe(&["merge", "p0.wpart", "p1.wpart", "-o", "m.exr"], d);
+    assert_eq!(p.code(), Some(0), "{}", p.stderr);
+}

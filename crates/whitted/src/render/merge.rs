@@ -197,7 +197,8 @@ impl<'a> Merge<'a> {
     }
 
     /// "; missing: tile 2/4, tile 3/4" when every part is a tile of one
-    /// split of one window, else nothing.
+    /// split of one window (or, when every tile is there, that the window
+    /// is not the whole image), else nothing.
     fn missing_tiles(&self) -> String {
         let Some(&(window, Some(Share { count, .. }))) = self.shares.first() else {
             return String::new();
@@ -214,6 +215,13 @@ impl<'a> Merge<'a> {
             .take(10)
             .map(|i| format!("tile {i}/{count}"))
             .collect();
+        if missing.is_empty() {
+            let super::Window { x0, y0, x1, y1 } = window;
+            return format!(
+                "; the parts are every tile of the window {x0},{y0},{x1},{y1}, which is not the \
+                 whole image"
+            );
+        }
         format!(
             "; missing: {} (render them again with --tile and merge all the parts)",
             missing.join(", ")
@@ -330,5 +338,31 @@ mod tests {
             "{error}"
         );
         assert!(matches!(merge_parts(&[]), Err(MergeError::NoParts)));
+    }
+
+    #[test]
+    fn every_tile_of_a_window_smaller_than_the_image_is_named_as_such() {
+        let dir = tempfile::tempdir().unwrap();
+        let scene = scene();
+        let paths: Vec<PathBuf> = [0, 1]
+            .map(|index| {
+                let selection = PixelSelection {
+                    window: Window {
+                        x0: 0,
+                        y0: 0,
+                        x1: 23,
+                        y1: 8,
+                    },
+                    share: Some(Share { index, count: 2 }),
+                };
+                write_part(&scene, dir.path(), &format!("{index}.wpart"), selection)
+            })
+            .to_vec();
+        let error = merge_parts(&paths).unwrap_err().to_string();
+        assert_eq!(
+            error,
+            "207 pixel(s) are in no part, the first at column 0, row 8; the parts are every \
+             tile of the window 0,0,23,8, which is not the whole image"
+        );
     }
 }

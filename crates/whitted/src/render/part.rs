@@ -5,7 +5,7 @@
 //! belong. docs/cluster.md describes the format:
 //!
 //! ```text
-//! whitted-part 1
+//! whitted-part 2
 //! whitted-version 0.1.0
 //! scene "scenes/whitted.toml"
 //! scene-sha256 6f1d...
@@ -18,12 +18,15 @@
 //! settings RenderSettings { ... }
 //! selection crop 0,0,640,480 tile 1/4
 //! pixels 76800
+//! data-sha256 9b0c...
 //! data
 //! ```
 //!
 //! then the selected pixels, row by row from the top, each as its colour
 //! (3 floats) followed by each AOV's channels, as little-endian `f32`:
-//! the exact bits the render computed.
+//! the exact bits the render computed, whose SHA-256 `data-sha256` gives.
+//! A part is read back only if its data has that hash and every value is
+//! one a render gives (a finite colour of 0 or more; see [`Aov::admits`]).
 
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -34,7 +37,11 @@ use super::{Aov, PixelSelection, RenderOutput, Scene, Share, Window};
 use crate::image::{ColorSpace, ImageError, PendingImage, encode_to_partial};
 
 /// The first line of every part.
-const MAGIC: &str = "whitted-part 1";
+const MAGIC: &str = "whitted-part 2";
+
+/// The first line of the parts of whitted 0.1 before their data had a
+/// checksum.
+const OLD_MAGIC: &str = "whitted-part 1";
 
 /// What the scene hash says for the built-in scene, which has no file.
 pub const BUILT_IN_SCENE: &str = "built-in";
@@ -93,10 +100,7 @@ pub enum PartError {
 /// SHA-256 of a scene file's bytes, in lowercase hex (as `sha256sum`
 /// prints it).
 pub fn scene_sha256(bytes: &[u8]) -> String {
-    Sha256::digest(bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
+    hex(&Sha256::digest(bytes))
 }
 
 impl PartHeader {
@@ -175,25 +179,44 @@ pub fn encode_part(
     header: &PartHeader,
     output: &RenderOutput,
 ) -> Result<PendingImage, ImageError> {
+    let mut hash = Sha256::new();
+    for_each_value(header, output, |value| hash.update(value.to_le_bytes()));
+    let data_sha256 = hex(&hash.finalize());
     encode_to_partial(path, |file| {
         let mut out = BufWriter::new(file);
         writeln!(out, "{MAGIC}")?;
         for (key, value) in header.lines() {
             writeln!(out, "{key} {value}")?;
         }
+        writeln!(out, "data-sha256 {data_sha256}")?;
         writeln!(out, "data")?;
-        let window = header.selection.window;
-        for y in header.selection.rows() {
-            for x in window.x0..window.x1 {
-                let films =
-                    std::iter::once(&output.image).chain(output.aovs.iter().map(|(_, f)| f));
-                for value in films.flat_map(|film| film.pixel(x, y)) {
-                    out.write_all(&value.to_le_bytes())?;
-                }
+        let mut written = Ok(());
+        for_each_value(header, output, |value| {
+            if written.is_ok() {
+                written = out.write_all(&value.to_le_bytes());
             }
-        }
+        });
+        written?;
         out.flush()
     })
+}
+
+/// Calls `f` with each value a part of `output` holds, in file order.
+fn for_each_value(header: &PartHeader, output: &RenderOutput, mut f: impl FnMut(f32)) {
+    let window = header.selection.window;
+    for y in header.selection.rows() {
+        for x in window.x0..window.x1 {
+            let films = std::iter::once(&output.image).chain(output.aovs.iter().map(|(_, f)| f));
+            for &value in films.flat_map(|film| film.pixel(x, y)) {
+                f(value);
+            }
+        }
+    }
+}
+
+/// Bytes in lowercase hex, as `sha256sum` prints a hash.
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 /// A part read back: its header and its pixels' floats, in file order.
@@ -224,6 +247,13 @@ pub fn parse_part(bytes: &[u8], path: &Path) -> Result<Part, PartError> {
         path,
     };
     let magic = reader.line()?;
+    if magic == OLD_MAGIC {
+        return Err(reader.error(
+            "a part written by an older whitted, without a checksum of its data: render it \
+             again with this one"
+                .to_string(),
+        ));
+    }
     if magic != MAGIC {
         return Err(reader.error(format!(
             "not a whitted part: expected the first line `{MAGIC}` (a file written by \
@@ -237,6 +267,12 @@ pub fn parse_part(bytes: &[u8], path: &Path) -> Result<Part, PartError> {
     let height = reader.number("height")?;
     crate::render::check_image_size(width, height).map_err(|e| reader.error(e.to_string()))?;
     let spp = reader.number("spp")?;
+    if spp == 0 {
+        return Err(reader.error(
+            "`spp 0`: a render takes at least one sample per pixel; the part is damaged"
+                .to_string(),
+        ));
+    }
     let aovs = reader.value("aovs")?;
     let aovs = match aovs {
         "-" => Vec::new(),
@@ -269,6 +305,7 @@ pub fn parse_part(bytes: &[u8], path: &Path) -> Result<Part, PartError> {
             selection.pixel_count()
         )));
     }
+    let data_sha256 = reader.value("data-sha256")?;
     if reader.line()? != "data" {
         return Err(reader.error("expected the line `data` after the header".to_string()));
     }
@@ -295,11 +332,52 @@ pub fn parse_part(bytes: &[u8], path: &Path) -> Result<Part, PartError> {
             header.floats_per_pixel()
         )));
     }
-    let values = data
+    let found = hex(&Sha256::digest(data));
+    if found != data_sha256 {
+        return Err(reader.error(format!(
+            "the pixel data's SHA-256 is {found}, but the header says {data_sha256}: the \
+             data is damaged; render this part again"
+        )));
+    }
+    let values: Vec<f32> = data
         .chunks_exact(4)
         .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
         .collect();
+    check_values(&header, &values).map_err(|why| reader.error(why))?;
     Ok(Part { header, values })
+}
+
+/// Refuses a value no render gives (see the module's doc), naming its
+/// pixel, what it is and the value.
+fn check_values(header: &PartHeader, values: &[f32]) -> Result<(), String> {
+    // Each value's AOV in a pixel's order; `None` for the colour.
+    let channels: Vec<Option<Aov>> = [None; 3]
+        .into_iter()
+        .chain(
+            header
+                .aovs
+                .iter()
+                .flat_map(|&aov| std::iter::repeat_n(Some(aov), aov.channels())),
+        )
+        .collect();
+    let admits = |i: usize, v: f32| match channels[i % channels.len()] {
+        None => v >= 0.0 && v.is_finite(),
+        Some(aov) => aov.admits(v),
+    };
+    let Some(at) = (0..values.len()).find(|&i| !admits(i, values[i])) else {
+        return Ok(());
+    };
+    let what = channels[at % channels.len()].map_or("colour", |aov| aov.name());
+    let window = header.selection.window;
+    let pixel = at / channels.len();
+    let columns = (window.x1 - window.x0) as usize;
+    let x = window.x0 as usize + pixel % columns;
+    let y = header.selection.rows().nth(pixel / columns).unwrap_or(0);
+    Err(format!(
+        "pixel ({x}, {y}) holds the {what} value {}, which no render gives: the part is \
+         damaged; render it again",
+        values[at]
+    ))
 }
 
 /// `crop X0,Y0,X1,Y1` with an optional ` tile I/N`.
@@ -436,15 +514,25 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            error.starts_with("p.wpart:14: the pixel data is"),
+            error.starts_with("p.wpart:15: the pixel data is"),
             "{error}"
         );
         let header = String::from_utf8(bytes[..text_end].to_vec()).unwrap();
         for (from, to, says) in [
             (
-                "whitted-part 1",
                 "whitted-part 2",
+                "whitted-part 3",
                 "p.wpart:1: not a whitted part",
+            ),
+            (
+                "whitted-part 2",
+                "whitted-part 1",
+                "p.wpart:1: a part written by an older whitted, without a checksum",
+            ),
+            (
+                "spp 1",
+                "spp 0",
+                "p.wpart:7: `spp 0`: a render takes at least one sample",
             ),
             (
                 "width 20",
@@ -471,6 +559,105 @@ mod tests {
                 .unwrap_err()
                 .to_string();
             assert!(error.contains(says), "{from} -> {to}: {error}");
+        }
+    }
+
+    #[test]
+    fn damaged_data_is_refused_by_its_checksum_and_values_no_render_gives_by_their_pixel() {
+        let (_, bytes) = part_bytes(PixelSelection {
+            window: Window {
+                x0: 2,
+                y0: 0,
+                x1: 20,
+                y1: 9,
+            },
+            share: Some(Share { index: 1, count: 2 }),
+        });
+        let data_at = bytes.windows(5).position(|w| w == b"data\n").unwrap() + 5;
+        let mut flipped = bytes.clone();
+        flipped[data_at + 9] ^= 0x10;
+        let error = parse_part(&flipped, Path::new("p.wpart"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.starts_with("p.wpart:15: the pixel data's SHA-256 is")
+                && error.ends_with("the data is damaged; render this part again"),
+            "{error}"
+        );
+        // The same values with a hash that matches them: only the values'
+        // rule is left to refuse them. A pixel is colour, depth, normal.
+        let with_value = |index: usize, value: f32| {
+            let mut data = bytes[data_at..].to_vec();
+            data[index * 4..index * 4 + 4].copy_from_slice(&value.to_le_bytes());
+            let header = String::from_utf8(bytes[..data_at].to_vec()).unwrap();
+            let old_hash = header
+                .lines()
+                .find_map(|l| l.strip_prefix("data-sha256 "))
+                .unwrap();
+            let mut changed = header
+                .replace(old_hash, &hex(&Sha256::digest(&data)))
+                .into_bytes();
+            changed.extend_from_slice(&data);
+            parse_part(&changed, Path::new("p.wpart")).map(|_| ())
+        };
+        let stride = 7;
+        for (index, value, says) in [
+            (0, f32::NAN, "pixel (2, 1) holds the colour value NaN"),
+            (1, -0.5, "pixel (2, 1) holds the colour value -0.5"),
+            (
+                stride + 2,
+                f32::INFINITY,
+                "pixel (3, 1) holds the colour value inf",
+            ),
+            (
+                18 * stride + 3,
+                -1.0,
+                "pixel (2, 3) holds the depth value -1",
+            ),
+            (3, f32::NAN, "pixel (2, 1) holds the depth value NaN"),
+            (
+                5,
+                f32::NEG_INFINITY,
+                "pixel (2, 1) holds the normal value -inf",
+            ),
+        ] {
+            let error = with_value(index, value).unwrap_err().to_string();
+            assert!(
+                error.starts_with("p.wpart:15: ")
+                    && error.contains(says)
+                    && error
+                        .ends_with("which no render gives: the part is damaged; render it again"),
+                "{index} {value}: {error}"
+            );
+        }
+        // What a render does give is read: a miss's depth, a bright colour.
+        with_value(3, f32::INFINITY).unwrap();
+        with_value(0, 3e38).unwrap();
+        with_value(4, -1.0).unwrap();
+    }
+
+    #[test]
+    fn every_aov_admits_what_a_render_gives_and_nothing_else() {
+        let gives = [
+            (Aov::Depth, vec![0.0, 2.5, f32::INFINITY]),
+            (Aov::Normal, vec![-1.0, 0.0, 0.6]),
+            (Aov::Id, vec![-1.0, 0.0, 16_777_216.0]),
+            (Aov::Cost, vec![0.0, 17.0]),
+            (Aov::Instance, vec![-1.0, 3.0]),
+        ];
+        let never = [
+            (Aov::Depth, vec![-0.1, f32::NAN, f32::NEG_INFINITY]),
+            (Aov::Normal, vec![f32::NAN, f32::INFINITY]),
+            (Aov::Id, vec![-2.0, 0.5, f32::NAN, f32::INFINITY]),
+            (Aov::Cost, vec![-1.0, 1.5, f32::NAN, f32::INFINITY]),
+            (Aov::Instance, vec![-2.0, 0.25, f32::NAN]),
+        ];
+        assert_eq!(gives.len(), Aov::ALL.len());
+        for (aov, values) in gives {
+            assert!(values.iter().all(|&v| aov.admits(v)), "{aov:?}");
+        }
+        for (aov, values) in never {
+            assert!(values.iter().all(|&v| !aov.admits(v)), "{aov:?}");
         }
     }
 

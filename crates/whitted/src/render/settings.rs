@@ -88,6 +88,19 @@ impl Aov {
             Aov::Depth | Aov::Id | Aov::Cost | Aov::Instance => 1,
         }
     }
+
+    /// Whether a render can give `value` as one of this AOV's channels:
+    /// a depth of 0 or more (+∞ for a miss), a finite normal component,
+    /// a whole index from -1 on, a whole cost from 0 on. What reads stored
+    /// AOVs back (merged parts) refuses any other value.
+    pub fn admits(&self, value: f32) -> bool {
+        match self {
+            Aov::Depth => value >= 0.0,
+            Aov::Normal => value.is_finite(),
+            Aov::Id | Aov::Instance => value >= -1.0 && value.fract() == 0.0,
+            Aov::Cost => value >= 0.0 && value.fract() == 0.0,
+        }
+    }
 }
 
 /// How to render: image size, sampling, recursion limits, the acceleration
