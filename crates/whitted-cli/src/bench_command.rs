@@ -160,6 +160,7 @@ struct AccelReport {
 /// Runs the command.
 pub fn run(args: &BenchArgs) -> Result<(), String> {
     let kinds = kinds(&args.accel)?;
+    report::check_results_stream()?;
     if let Some(bytes) = args.max_memory {
         MemoryBudget::given(bytes).set_current();
     }

@@ -82,6 +82,7 @@ fn sample_index(text: &str) -> Result<u32, String> {
 
 /// Runs the command.
 pub fn run(args: &ExplainArgs) -> Result<(), String> {
+    crate::report::check_results_stream()?;
     args.scene.check()?;
     let mut outputs = Vec::new();
     if let Some(path) = &args.svg {

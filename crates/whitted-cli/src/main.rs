@@ -6,6 +6,8 @@
 mod anti_aliasing;
 mod arguments;
 mod bench_command;
+#[cfg(unix)]
+mod closed_streams;
 mod explain_command;
 mod explain_json;
 mod explain_svg;

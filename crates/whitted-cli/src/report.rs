@@ -66,7 +66,23 @@ pub fn note_line(line: fmt::Arguments<'_>) {
 /// Writes the command's results on standard output and flushes them; the
 /// error says why they could not be written.
 pub fn results(text: &str) -> Result<(), String> {
+    check_results_stream()?;
     write_results(&mut std::io::stdout().lock(), text)
+}
+
+/// Refuses a standard output that was closed when the command started
+/// (`>&-`): the runtime put `/dev/null` there, which would take the results
+/// and lose them. A command that writes results checks this before its work.
+pub fn check_results_stream() -> Result<(), String> {
+    #[cfg(unix)]
+    if crate::closed_streams::stdout_was_closed() {
+        return Err(
+            "standard output is closed (as with `>&-`), and this command writes its \
+             results there; redirect it to a file, or to /dev/null to drop them"
+                .to_string(),
+        );
+    }
+    Ok(())
 }
 
 fn write_results(out: &mut impl Write, text: &str) -> Result<(), String> {

@@ -326,12 +326,12 @@ fn send(child: &std::process::Child, signal: libc::c_int) {
     assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, signal) }, 0);
 }
 
-#[test]
-fn sigint_while_encoding_removes_the_partial_files_and_exits_130() {
+/// Sends `signal` to a big render once it is encoding an image (a
+/// partial file with bytes in it; the empty one made when the folder is
+/// checked does not count) and returns how it ended.
+fn signal_while_encoding(signal: libc::c_int) -> std::process::ExitStatus {
     let dir = tempfile::tempdir().unwrap();
     let mut child = start_big_render(dir.path(), "1500");
-    // Wait until an image is being encoded: a partial file with bytes in
-    // it (the empty one made when the folder is checked does not count).
     let deadline = Instant::now() + Duration::from_secs(60);
     let encoding = loop {
         let found = fs::read_dir(dir.path()).unwrap().any(|e| {
@@ -348,11 +348,73 @@ fn sigint_while_encoding_removes_the_partial_files_and_exits_130() {
         std::thread::sleep(Duration::from_millis(1));
     };
     assert!(encoding, "the render never wrote a partial file");
-    send(&child, libc::SIGINT);
+    send(&child, signal);
     let status = child.wait().unwrap();
-    assert_eq!(status.code(), Some(130), "{status:?}");
-    assert_eq!(partial_files(dir.path()), Vec::<String>::new());
+    assert_eq!(partial_files(dir.path()), Vec::<String>::new(), "{signal}");
     assert!(!dir.path().join("big.exr").exists());
+    status
+}
+
+#[test]
+fn sigint_while_encoding_removes_the_partial_files_and_exits_130() {
+    let status = signal_while_encoding(libc::SIGINT);
+    assert_eq!(status.code(), Some(130), "{status:?}");
+}
+
+/// Issue 50, item 12: every signal that ends a process and can be caught
+/// leaves no partial file, and the exit code names it.
+#[test]
+fn every_catchable_ending_signal_while_encoding_removes_the_partial_files() {
+    for signal in [libc::SIGQUIT, libc::SIGUSR1, libc::SIGXCPU, libc::SIGALRM] {
+        let status = signal_while_encoding(signal);
+        assert_eq!(status.code(), Some(128 + signal), "{signal}: {status:?}");
+    }
+}
+
+/// Issue 50, item 12: an output past `ulimit -f` is an error said on
+/// standard error, not a silent death by SIGXFSZ, and leaves no partial
+/// file, for an image and for a part.
+#[test]
+fn a_file_size_limit_is_an_error_with_its_cause_and_leaves_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    fs::write(dir.path().join("empty.toml"), EMPTY_SCENE).unwrap();
+    for output in ["x.exr", "x.wpart"] {
+        let mut command = whitted(
+            &[
+                "render",
+                "empty.toml",
+                "--width",
+                "400",
+                "--height",
+                "400",
+                "-o",
+                output,
+            ],
+            dir.path(),
+        );
+        // SAFETY: setrlimit is async-signal-safe, as pre_exec requires.
+        unsafe {
+            command.pre_exec(|| {
+                let limit = libc::rlimit {
+                    rlim_cur: 200 * 1024,
+                    rlim_max: 200 * 1024,
+                };
+                if libc::setrlimit(libc::RLIMIT_FSIZE, &limit) != 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                Ok(())
+            });
+        }
+        let p = run(command);
+        assert_eq!(p.code(), Some(1), "{output}: {:?} {}", p.status, p.stderr);
+        assert!(
+            p.stderr.contains(output) && p.stderr.contains("File too large (os error 27)"),
+            "{output}: {}",
+            p.stderr
+        );
+        assert!(!dir.path().join(output).exists());
+        assert_eq!(partial_files(dir.path()), Vec::<String>::new(), "{output}");
+    }
 }
 
 #[test]
@@ -620,4 +682,57 @@ fn merge_refuses_damaged_and_forged_parts_and_writes_nothing() {
     fs::write(d.join("p1.wpart"), &good).unwrap();
     let p = probe(&["merge", "p0.wpart", "p1.wpart", "-o", "m.exr"], d);
     assert_eq!(p.code(), Some(0), "{}", p.stderr);
+}
+
+/// Issue 50, item 14: results asked of a command whose standard output is
+/// closed (`>&-`) are refused before any work, as a full one is after it;
+/// `render`, which writes none there, runs.
+#[test]
+fn a_closed_stdout_is_an_error_for_the_commands_that_write_results_there() {
+    let dir = tempfile::tempdir().unwrap();
+    fs::write(dir.path().join("empty.toml"), EMPTY_SCENE).unwrap();
+    let closed_stdout = |args: &[&str]| {
+        let mut command = whitted(args, dir.path());
+        // SAFETY: close() is async-signal-safe, as pre_exec requires.
+        unsafe {
+            command.pre_exec(|| {
+                libc::close(libc::STDOUT_FILENO);
+                Ok(())
+            });
+        }
+        run(command)
+    };
+    let says = "error: standard output is closed (as with `>&-`), and this command writes its \
+                results there; redirect it to a file, or to /dev/null to drop them\n";
+    for args in [
+        &["explain", "empty.toml", "--pixel", "1,1", "--svg", "x.svg"][..],
+        &["explain", "empty.toml", "--pixel", "1,1", "--json"],
+        &[
+            "bench",
+            "-q",
+            "--accel",
+            "bvh",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "empty.toml",
+        ],
+    ] {
+        let p = closed_stdout(args);
+        assert_eq!(p.code(), Some(1), "{args:?}: {}", p.stderr);
+        assert_eq!(p.stderr, says, "{args:?}");
+    }
+    assert!(!dir.path().join("x.svg").exists());
+    let p = closed_stdout(&[
+        "render",
+        "empty.toml",
+        "--width",
+        "8",
+        "--height",
+        "6",
+        "-q",
+    ]);
+    assert_eq!(p.code(), Some(0), "{}", p.stderr);
+    assert!(dir.path().join("whitted.png").is_file());
 }

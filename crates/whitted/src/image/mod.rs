@@ -79,13 +79,24 @@ pub enum ImageError {
         why: String,
     },
     /// The file system refused.
-    #[error("{path}: {source}")]
+    #[error("{path}: {source}{}", io_hint(source))]
     Io {
         /// The destination.
         path: PathBuf,
         /// The cause.
         source: std::io::Error,
     },
+}
+
+/// What a user can do about a write error, when its cause says more
+/// than its OS text: the file size limit a shell sets (`ulimit -f`).
+fn io_hint(error: &std::io::Error) -> &'static str {
+    if error.kind() == std::io::ErrorKind::FileTooLarge {
+        ": the image is larger than this process may write (`ulimit -f`); raise the limit or \
+         make the image smaller"
+    } else {
+        ""
+    }
 }
 
 impl ImageFormat {
