@@ -58,6 +58,7 @@ struct Explanation<'a> {
     accel: &'static str,
     anti_aliasing: AntiAliasingJson,
     image: Image,
+    left_out: u64,
     limits: Limits,
     pixel: Pixel,
     sample: Sample,
@@ -76,6 +77,7 @@ struct Image {
 #[derive(Serialize)]
 struct Limits {
     max_depth: u32,
+    max_tree_rays: u64,
     min_weight: f64,
     ray_budget: u32,
 }
@@ -127,8 +129,10 @@ fn explanation<'a>(context: Context<'a>, e: &'a PixelExplanation) -> Explanation
             height: settings.height,
             width: settings.width,
         },
+        left_out: e.left_out,
         limits: Limits {
             max_depth: e.limits.max_depth,
+            max_tree_rays: e.max_tree_rays,
             min_weight: e.limits.min_weight,
             ray_budget: e.limits.ray_budget,
         },
@@ -397,6 +401,11 @@ enum StopJson {
         ray: &'static str,
         reason: &'static str,
     },
+    TreeLimit {
+        left_out: u64,
+        max_rays: u64,
+        reason: &'static str,
+    },
 }
 
 fn stop(stop: &Stop) -> StopJson {
@@ -423,6 +432,11 @@ fn stop(stop: &Stop) -> StopJson {
             budget,
             ray: kind_name(kind),
             reason: "ray_budget",
+        },
+        Stop::TreeLimit { left_out, max_rays } => StopJson::TreeLimit {
+            left_out,
+            max_rays,
+            reason: "tree_limit",
         },
     }
 }
@@ -518,8 +532,10 @@ mod tests {
                 "sample_colors": e.sample_colors.iter().map(|&c| rgb(c)).collect::<Vec<_>>(),
                 "anti_aliasing": anti_aliasing(e.aa),
                 "accel": e.accel.name(),
+                "left_out": e.left_out,
                 "limits": {
                     "max_depth": e.limits.max_depth,
+                    "max_tree_rays": e.max_tree_rays,
                     "min_weight": e.limits.min_weight,
                     "ray_budget": e.limits.ray_budget,
                 },
@@ -624,6 +640,11 @@ mod tests {
                     "ray": kind_name(kind),
                     "budget": budget,
                 }),
+                Stop::TreeLimit { left_out, max_rays } => json!({
+                    "reason": "tree_limit",
+                    "left_out": left_out,
+                    "max_rays": max_rays,
+                }),
             }
         }
     }
@@ -686,10 +707,22 @@ mod tests {
                 kind: kinds[1],
                 budget: 4096,
             },
+            Stop::TreeLimit {
+                left_out: 12,
+                max_rays: 30,
+            },
         ] {
             let written = serde_json::to_string(&super::stop(&stop)).unwrap();
             assert_eq!(written, reference::stop_json(&stop).to_string());
         }
+        // A tree cut short.
+        let cut = Explainer::new(&scene)
+            .unwrap()
+            .with_max_tree_rays(3)
+            .explain(&scene.camera, (20, 15), 0)
+            .unwrap();
+        assert!(cut.left_out > 0);
+        same_bytes(&path, &scene, &cut);
         scene.settings.aa = AntiAliasing::Adaptive(Adaptive::default());
         same_bytes(&path, &scene, &explain_pixel(&scene, (20, 15), 1).unwrap());
     }

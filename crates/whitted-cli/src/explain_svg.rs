@@ -62,7 +62,13 @@ pub fn svg_drawing(
         line: (f64::from(width.max(height)) / 400.0).max(1.0),
     };
     drawing.node(&explanation.tree);
-    drawing.legend();
+    let cut = (explanation.left_out > 0).then(|| {
+        format!(
+            "tree cut at {} rays: {} more not drawn",
+            explanation.max_tree_rays, explanation.left_out
+        )
+    });
+    drawing.legend(cut.as_deref());
     drawing.svg.push_str("</svg>\n");
     drawing.svg
 }
@@ -186,7 +192,8 @@ impl Drawing<'_> {
         self.mark(hit.point, stroke(node.kind), &title);
     }
 
-    fn legend(&mut self) {
+    /// The colours' key, and `note` (in white) under it when given.
+    fn legend(&mut self, note: Option<&str>) {
         let size = 10.0 * self.line;
         let entries = [
             ("camera", stroke(RayKind::Primary)),
@@ -195,7 +202,8 @@ impl Drawing<'_> {
             ("shadow, lit", stroke(RayKind::Shadow)),
             ("shadow, blocked", BLOCKED),
         ];
-        for (i, (name, color)) in entries.into_iter().enumerate() {
+        let note = note.map(|text| (text, "#ffffff"));
+        for (i, (name, color)) in entries.into_iter().chain(note).enumerate() {
             let y = size * (1.5 + 1.2 * i as f64);
             let _ = writeln!(
                 self.svg,

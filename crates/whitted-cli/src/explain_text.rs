@@ -77,6 +77,15 @@ pub fn explanation_text(scene: &Scene, file: Option<&Path>, e: &PixelExplanation
         e.limits.min_weight,
         e.limits.ray_budget
     );
+    if e.left_out > 0 {
+        let _ = writeln!(
+            out,
+            "the tree is cut: it holds the first {} rays and light verdicts traced \
+             (--max-tree-rays); {} more are in the colours but not shown, each hit says how many \
+             it lost",
+            e.max_tree_rays, e.left_out
+        );
+    }
     let [r, g, b] = e.pixel;
     let _ = writeln!(out, "pixel as rendered: ({r:.4}, {g:.4}, {b:.4})");
     match e.aa {
@@ -254,6 +263,10 @@ fn hit_text(out: &mut String, scene: &Scene, file: Option<&Path>, hit: &HitNode,
             Stop::RayBudget { kind, budget } => format!(
                 "no {} ray: the sample has traced its {budget} secondary rays",
                 kind_name(kind)
+            ),
+            Stop::TreeLimit { left_out, max_rays } => format!(
+                "{left_out} more rays and light verdicts traced from here are left out of the \
+                 tree (it holds {max_rays}; --max-tree-rays)"
             ),
         };
         let _ = writeln!(out, "{at}stop: {why}");

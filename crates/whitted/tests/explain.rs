@@ -9,7 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use whitted::accel::AccelKind;
-use whitted::integrator::RayNode;
+use whitted::integrator::{RayNode, Stop};
 use whitted::math::random::hash64;
 use whitted::render::{Adaptive, AntiAliasing, Explainer, Scene, explain_pixel, render};
 use whitted::scene::load_any;
@@ -288,4 +288,72 @@ fn the_caustic_term_is_listed_and_the_terms_add_up_to_each_rays_colour() {
         }
     }
     assert!(caustic > 0, "some pixels see the caustic");
+}
+
+/// Rays and light verdicts a tree holds, and the sum of what its hits say
+/// they left out.
+fn records_and_left_out(node: &RayNode) -> (u64, u64) {
+    let Some(hit) = &node.hit else {
+        return (1, 0);
+    };
+    let lights: u64 = hit
+        .lights
+        .iter()
+        .map(|l| 1 + l.shadow_rays.len() as u64)
+        .sum();
+    let left: u64 = hit
+        .stops
+        .iter()
+        .map(|stop| match stop {
+            Stop::TreeLimit { left_out, .. } => *left_out,
+            _ => 0,
+        })
+        .sum();
+    hit.children
+        .iter()
+        .map(records_and_left_out)
+        .fold((1 + lights, left), |(a, b), (c, d)| (a + c, b + d))
+}
+
+/// Issue 50, item 2: a tree records at most its limit of rays and light
+/// verdicts, the first ones traced; what it leaves out is counted at the
+/// hits it came from, the two add up to the whole tree, and the colours
+/// are the same bits.
+#[test]
+fn a_tree_holds_at_most_its_limit_and_counts_what_it_leaves_out() {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/hostile_scenes/glass_in_mirrors.toml");
+    let mut scene = load_any(&path).unwrap();
+    scene.settings.max_depth = 9;
+    let whole = Explainer::new(&scene)
+        .unwrap()
+        .with_max_tree_rays(u64::MAX)
+        .explain(&scene.camera, (4, 4), 0)
+        .unwrap();
+    assert_eq!(whole.left_out, 0);
+    let (all, none) = records_and_left_out(&whole.tree);
+    assert_eq!(none, 0);
+    assert!(all > 500, "{all}");
+    for limit in [1, 2, 7, 50, 499, all - 1, all] {
+        let cut = Explainer::new(&scene)
+            .unwrap()
+            .with_max_tree_rays(limit)
+            .explain(&scene.camera, (4, 4), 0)
+            .unwrap();
+        let (held, left_out) = records_and_left_out(&cut.tree);
+        assert_eq!(held, limit, "{limit}");
+        assert_eq!(left_out, cut.left_out, "{limit}");
+        assert_eq!(held + left_out, all, "{limit}");
+        assert_eq!(cut.max_tree_rays, limit);
+        assert_eq!(cut.tree.color, whole.tree.color, "{limit}");
+        assert_eq!(cut.pixel, whole.pixel);
+        assert_eq!(cut.tree.hit.is_some(), whole.tree.hit.is_some());
+    }
+    // The limit's least is the camera ray.
+    let cut = Explainer::new(&scene)
+        .unwrap()
+        .with_max_tree_rays(0)
+        .explain(&scene.camera, (4, 4), 0)
+        .unwrap();
+    assert_eq!(records_and_left_out(&cut.tree), (1, all - 1));
 }

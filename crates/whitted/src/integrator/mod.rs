@@ -20,7 +20,8 @@ pub use observer::{FirstHit, RayObserver, ShadowStep, Unobserved};
 pub use photon_map::{CausticMap, PhotonSettings};
 pub use ray_counts::{RayCounts, RayKind};
 pub use ray_tree::{
-    HitNode, LightTerm, LightVerdict, RayNode, RayTreeRecorder, ShadingTerms, ShadowSegment, Stop,
+    DEFAULT_MAX_TREE_RAYS, HitNode, LightTerm, LightVerdict, RayNode, RayTreeRecorder,
+    ShadingTerms, ShadowSegment, Stop,
 };
 pub use whitted::Whitted;
 

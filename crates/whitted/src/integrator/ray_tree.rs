@@ -6,6 +6,12 @@
 //! colour of the root is the colour the integrator returned, the very
 //! same bits.
 //!
+//! A tree is bounded: it records at most a given number of rays and light
+//! verdicts ([`DEFAULT_MAX_TREE_RAYS`] unless told otherwise), the first
+//! ones traced, depth first. What is traced past that still counts in
+//! the colours, but is left out of the tree: the hit where it would have
+//! gone says so with [`Stop::TreeLimit`] and how many were left out.
+//!
 //! The shading terms are recomputed from the observed values with the
 //! shading layer's own functions ([`phong`], the material's textures), so
 //! they are what the integrator added up; they are shown one by one, and
@@ -178,7 +184,20 @@ pub enum Stop {
         /// The budget.
         budget: u32,
     },
+    /// The tree had recorded as many rays and light verdicts as it may:
+    /// these, traced from this hit (with their own rays, shadow rays and
+    /// verdicts), are in the colours but not in the tree.
+    TreeLimit {
+        /// How many were left out here.
+        left_out: u64,
+        /// The tree's limit.
+        max_rays: u64,
+    },
 }
+
+/// How many rays and light verdicts a tree records unless told otherwise:
+/// a tree of this size takes a few MB, its JSON some more.
+pub const DEFAULT_MAX_TREE_RAYS: u64 = 20_000;
 
 /// Builds the [`RayNode`] tree of one camera sample while the integrator
 /// traces it; [`RayTreeRecorder::finish`] returns it.
@@ -193,12 +212,31 @@ pub struct RayTreeRecorder<'a> {
     shadow: Vec<ShadowSegment>,
     /// The camera ray once it has ended.
     root: Option<RayNode>,
+    /// How many rays and light verdicts the tree may hold (at least 1).
+    max_rays: u64,
+    /// How many it holds.
+    recorded: u64,
+    /// How many it left out.
+    left_out: u64,
+    /// The rays started and not yet ended that are left out, within the
+    /// innermost recorded one.
+    skipping: u32,
+    /// Whether the verdict of the light being considered has its place
+    /// counted already (taken with its first shadow ray, so that no
+    /// shadow ray is held without its verdict).
+    verdict_taken: bool,
 }
 
 impl<'a> RayTreeRecorder<'a> {
     /// A recorder for a sample traced in `world` with `shading` and
-    /// `limits` (those the integrator was given).
-    pub fn new(world: &'a World<'a>, shading: Shading<'a>, limits: RecursionLimits) -> Self {
+    /// `limits` (those the integrator was given), that records at most
+    /// `max_rays` rays and light verdicts (the camera ray always).
+    pub fn new(
+        world: &'a World<'a>,
+        shading: Shading<'a>,
+        limits: RecursionLimits,
+        max_rays: u64,
+    ) -> Self {
         Self {
             world,
             shading,
@@ -206,12 +244,45 @@ impl<'a> RayTreeRecorder<'a> {
             open: Vec::new(),
             shadow: Vec::new(),
             root: None,
+            max_rays: max_rays.max(1),
+            recorded: 0,
+            left_out: 0,
+            skipping: 0,
+            verdict_taken: false,
         }
     }
 
-    /// The tree, once the camera ray has ended.
-    pub fn finish(self) -> Option<RayNode> {
-        self.root
+    /// The tree, once the camera ray has ended, and how many rays and light
+    /// verdicts were left out of it.
+    pub fn finish(self) -> Option<(RayNode, u64)> {
+        Some((self.root?, self.left_out))
+    }
+
+    /// Takes `count` more places in the tree if it has room for them and
+    /// is not within a ray left out; else counts one ray or verdict as
+    /// left out.
+    fn take(&mut self, count: u64) -> bool {
+        if self.skipping == 0 && self.max_rays - self.recorded >= count {
+            self.recorded += count;
+            return true;
+        }
+        self.left_out += 1;
+        let max_rays = self.max_rays;
+        // The innermost recorded ray is the one it comes from, whether it
+        // is its own or that of a ray left out below it.
+        if let Some(hit) = self.hit() {
+            match hit.stops.iter_mut().find_map(|stop| match stop {
+                Stop::TreeLimit { left_out, .. } => Some(left_out),
+                _ => None,
+            }) {
+                Some(left_out) => *left_out += 1,
+                None => hit.stops.push(Stop::TreeLimit {
+                    left_out: 1,
+                    max_rays,
+                }),
+            }
+        }
+        false
     }
 
     fn node(&mut self) -> Option<&mut RayNode> {
@@ -229,6 +300,10 @@ impl<'a> RayTreeRecorder<'a> {
 
 impl RayObserver for RayTreeRecorder<'_> {
     fn ray_start(&mut self, kind: RayKind, ray: &Ray, coefficient: Color, weight: f64) {
+        if !self.take(1) {
+            self.skipping += 1;
+            return;
+        }
         let depth = self.open.len() as u32;
         let mut ctx = QueryContext::default();
         self.world.intersect_with(ray, &mut ctx);
@@ -249,6 +324,9 @@ impl RayObserver for RayTreeRecorder<'_> {
         let Some((hit, surface)) = hit else {
             return;
         };
+        if self.skipping > 0 {
+            return;
+        }
         let terms = match self.material(surface.material) {
             Some(m) => ShadingTerms {
                 emission: m.emission.at(surface.uv),
@@ -283,13 +361,20 @@ impl RayObserver for RayTreeRecorder<'_> {
     }
 
     fn shading(&mut self, normal: Vec3, entering: bool) {
-        if let Some(hit) = self.hit() {
+        if self.skipping == 0
+            && let Some(hit) = self.hit()
+        {
             hit.shading_normal = normal;
             hit.entering = entering;
         }
     }
 
     fn shadow_ray(&mut self, ray: &Ray, step: ShadowStep<'_>) {
+        // The first shadow ray of a light takes its verdict's place too.
+        if !self.take(if self.verdict_taken { 1 } else { 2 }) {
+            return;
+        }
+        self.verdict_taken = true;
         let mut ctx = QueryContext::default();
         let blocker = match step {
             ShadowStep::AnyHit { blocked } => {
@@ -315,13 +400,18 @@ impl RayObserver for RayTreeRecorder<'_> {
     }
 
     fn caustic(&mut self, term: Color) {
-        if let Some(hit) = self.hit() {
+        if self.skipping == 0
+            && let Some(hit) = self.hit()
+        {
             hit.terms.caustic = term;
         }
     }
 
     fn light(&mut self, index: usize, sample: Option<&LightSample>, transmittance: Option<Color>) {
         let shadow_rays = std::mem::take(&mut self.shadow);
+        if !(std::mem::take(&mut self.verdict_taken) || self.take(1)) {
+            return;
+        }
         let view = self.node().map_or(Vec3::ZERO, |node| -node.direction);
         let Some(hit) = self.hit() else {
             return;
@@ -369,6 +459,9 @@ impl RayObserver for RayTreeRecorder<'_> {
     }
 
     fn depth_limit(&mut self) {
+        if self.skipping > 0 {
+            return;
+        }
         let max_depth = self.limits.max_depth;
         let Some(hit) = self.hit() else {
             return;
@@ -385,6 +478,9 @@ impl RayObserver for RayTreeRecorder<'_> {
     }
 
     fn lobes(&mut self, _mirror: Color, refraction: Color, refracted: bool, indices: [f64; 2]) {
+        if self.skipping > 0 {
+            return;
+        }
         let Some(hit) = self.hit() else {
             return;
         };
@@ -403,6 +499,9 @@ impl RayObserver for RayTreeRecorder<'_> {
     }
 
     fn branch_skipped(&mut self, kind: RayKind, _coefficient: Color, weight: f64) {
+        if self.skipping > 0 {
+            return;
+        }
         let limits = self.limits;
         let stop = if weight < limits.min_weight {
             Stop::WeightCutOff {
@@ -422,6 +521,10 @@ impl RayObserver for RayTreeRecorder<'_> {
     }
 
     fn ray_end(&mut self, color: Color) {
+        if self.skipping > 0 {
+            self.skipping -= 1;
+            return;
+        }
         let Some(mut node) = self.open.pop() else {
             return;
         };

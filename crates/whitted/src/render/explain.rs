@@ -10,13 +10,17 @@
 //! With adaptive anti-aliasing the samples are the corners the pixel's
 //! subdivision traces ([`super::adaptive`], the renderer's own pass run
 //! on that pixel alone) and the pixel is their area average.
+//!
+//! The tree holds at most [`Explainer::with_max_tree_rays`] rays and light
+//! verdicts (see [`RayTreeRecorder`]); the colours are exact whatever it
+//! leaves out, and [`PixelExplanation::left_out`] says how much that is.
 
 use std::collections::HashMap;
 
 use crate::accel::AccelKind;
 use crate::integrator::{
-    CausticMap, Integrator, RayCounts, RayNode, RayTreeRecorder, RecursionLimits,
-    SECONDARY_RAY_BUDGET, Unobserved,
+    CausticMap, DEFAULT_MAX_TREE_RAYS, Integrator, RayCounts, RayNode, RayTreeRecorder,
+    RecursionLimits, SECONDARY_RAY_BUDGET, Unobserved,
 };
 use crate::math::DVec2;
 use crate::render::adaptive::{AdaptivePixels, Cost};
@@ -54,6 +58,12 @@ pub struct PixelExplanation {
     pub limits: RecursionLimits,
     /// The ray tree; its root's colour is the sample's colour.
     pub tree: RayNode,
+    /// How many rays and light verdicts the tree could hold.
+    pub max_tree_rays: u64,
+    /// How many the sample traced that the tree left out (0: the tree is
+    /// whole); each hit where some were says so with a
+    /// [`crate::integrator::Stop::TreeLimit`].
+    pub left_out: u64,
     /// Every sample's colour, in order.
     pub sample_colors: Vec<Color>,
     /// The pixel as the renderer stores it, in 32-bit floats: the mean of
@@ -113,6 +123,7 @@ pub struct Explainer<'s> {
     scene: &'s Scene,
     world: World<'s>,
     caustics: Option<CausticMap>,
+    max_tree_rays: u64,
 }
 
 impl<'s> Explainer<'s> {
@@ -131,7 +142,15 @@ impl<'s> Explainer<'s> {
             scene,
             world,
             caustics: caustics.map(|(map, _)| map),
+            max_tree_rays: DEFAULT_MAX_TREE_RAYS,
         })
+    }
+
+    /// Records at most `max_rays` rays and light verdicts in each tree
+    /// (at least the camera ray; [`DEFAULT_MAX_TREE_RAYS`] unless told).
+    pub fn with_max_tree_rays(mut self, max_rays: u64) -> Self {
+        self.max_tree_rays = max_rays;
+        self
     }
 
     /// Explains sample `sample` of pixel (`x`, `y`) seen through `camera`
@@ -209,9 +228,9 @@ impl<'s> Explainer<'s> {
             }
             AntiAliasing::Adaptive(_) => position_differential(camera, settings, position, 1.0),
         };
-        let mut recorder = RayTreeRecorder::new(world, shading, limits);
+        let mut recorder = RayTreeRecorder::new(world, shading, limits, self.max_tree_rays);
         integrator.trace_primary_observed(&ray, differential, &mut counts, &mut recorder);
-        let tree = recorder.finish().ok_or(ExplainError::SampleOutside {
+        let (tree, left_out) = recorder.finish().ok_or(ExplainError::SampleOutside {
             sample,
             samples: count,
         })?;
@@ -225,6 +244,8 @@ impl<'s> Explainer<'s> {
             accel: settings.accel,
             limits,
             tree,
+            max_tree_rays: self.max_tree_rays.max(1),
+            left_out,
             sample_colors: samples.into_iter().map(|(_, color)| color).collect(),
             pixel: pixel.to_f32(),
         })

@@ -212,7 +212,15 @@ function explain(x, y, sample = 0) {
       const title = document.createElement("p");
       title.textContent = `pixel ${x},${y}: ${rgbText(tree.pixel.value)}; `;
       title.append(sampleChooser(x, y, tree.sample, tree.anti_aliasing.method));
-      $("tree").replaceChildren(title, root);
+      const shown = [title];
+      if (tree.left_out > 0) {
+        const cut = document.createElement("p");
+        cut.className = "stop";
+        cut.textContent = `The tree is cut: it holds the first ${tree.limits.max_tree_rays} ` +
+          `rays and light verdicts traced; ${tree.left_out} more are in the colours but not shown.`;
+        shown.push(cut);
+      }
+      $("tree").replaceChildren(...shown, root);
       const rays = $("rays");
       rays.onload = () => { rays.hidden = false; };
       rays.src = `/api/explain.svg?${query}&request=${request}`;
@@ -288,7 +296,9 @@ function treeNode(n) {
   for (const stop of h.stops) {
     const item = document.createElement("li");
     item.className = "stop";
-    item.textContent = "stopped: " + stop.reason.replaceAll("_", " ");
+    item.textContent = stop.reason === "tree_limit"
+      ? `${stop.left_out} more rays and light verdicts traced from here are left out of the tree (it holds ${stop.max_rays})`
+      : "stopped: " + stop.reason.replaceAll("_", " ");
     list.appendChild(item);
   }
   li.appendChild(list);
