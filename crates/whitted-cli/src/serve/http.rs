@@ -4,6 +4,7 @@
 //! a 4xx, never a panic.
 
 use std::io::{self, BufRead, Read, Write};
+use std::time::Duration;
 
 /// The most bytes of a request's line and headers.
 const MAX_HEAD: usize = 16 << 10;
@@ -63,6 +64,26 @@ impl Refusal {
     }
 }
 
+/// How long a client has to send a whole request, head and body: a client
+/// sending a byte now and then cannot hold a request's place for longer.
+/// The reader given to [`read_request`] keeps it.
+pub const REQUEST_DEADLINE: Duration = Duration::from_secs(10);
+
+/// The refusal of a request whose `what` could not be read: 408 when it
+/// did not come before [`REQUEST_DEADLINE`], else 400.
+fn unreadable(what: &str, e: &io::Error) -> Refusal {
+    match e.kind() {
+        io::ErrorKind::TimedOut | io::ErrorKind::WouldBlock => Refusal::new(
+            408,
+            format!(
+                "{what} did not arrive in time: a request's head and body must come within {} s",
+                REQUEST_DEADLINE.as_secs()
+            ),
+        ),
+        _ => Refusal::new(400, format!("{what} could not be read: {e}")),
+    }
+}
+
 /// Reads one request. `Ok(None)`: the peer closed before sending one.
 pub fn read_request(input: &mut impl BufRead) -> Result<Option<Request>, Refusal> {
     let mut head = Read::take(&mut *input, MAX_HEAD as u64);
@@ -71,7 +92,7 @@ pub fn read_request(input: &mut impl BufRead) -> Result<Option<Request>, Refusal
         line.clear();
         let n = head
             .read_line(line)
-            .map_err(|e| Refusal::new(400, format!("the request could not be read: {e}")))?;
+            .map_err(|e| unreadable("the request", &e))?;
         if n > 0 && !line.ends_with('\n') {
             return Err(Refusal::new(431, "the request's head is too long"));
         }
@@ -143,7 +164,7 @@ pub fn read_request(input: &mut impl BufRead) -> Result<Option<Request>, Refusal
     request.body = vec![0; length];
     input
         .read_exact(&mut request.body)
-        .map_err(|e| Refusal::new(400, format!("the request's body could not be read: {e}")))?;
+        .map_err(|e| unreadable("the request's body", &e))?;
     Ok(Some(request))
 }
 

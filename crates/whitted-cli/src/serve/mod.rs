@@ -10,22 +10,25 @@ mod picture;
 mod routes;
 mod session;
 
-use std::io::{BufReader, Write};
+use std::io::{self, BufReader, Read, Write};
 use std::net::{IpAddr, Ipv4Addr, SocketAddr, TcpListener, TcpStream};
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use clap::Args;
 
 use crate::report::{note, results};
 use crate::scene_arguments::SceneArgs;
-use http::{Refusal, Request, Response, read_request};
+use http::{REQUEST_DEADLINE, Refusal, Request, Response, read_request};
 use session::Session;
 
-/// The most connections served at once (each event stream holds one).
-const MAX_CONNECTIONS: usize = 64;
+/// The most requests read or answered at once (event streams aside).
+const MAX_REQUESTS: usize = 256;
 
-/// How long a connection may wait to read or write.
+/// The most event streams (open pages) at once, besides the requests.
+const MAX_EVENT_STREAMS: usize = 16;
+
+/// How long a connection may wait to write.
 const IO_TIMEOUT: Duration = Duration::from_secs(20);
 
 /// How often an idle event stream sends a comment, to find closed pages.
@@ -73,7 +76,7 @@ pub fn run(args: ServeArgs) -> Result<(), String> {
         "whitted serve: http://{address}/ ({who}; Ctrl-C stops)\n"
     ))?;
     let session = Session::new(args.scene);
-    let connections = AtomicUsize::new(0);
+    let slots = Slots::default();
     std::thread::scope(|scope| {
         scope.spawn(|| session.render_loop());
         scope.spawn(|| session.explaining.run());
@@ -84,27 +87,84 @@ pub fn run(args: ServeArgs) -> Result<(), String> {
         }
         for stream in listener.incoming() {
             let Ok(stream) = stream else { continue };
-            let (session, connections) = (&session, &connections);
-            if connections.fetch_add(1, Ordering::SeqCst) >= MAX_CONNECTIONS {
-                let refusal = Refusal::new(503, "too many connections");
+            let (session, slots) = (&session, &slots);
+            let Some(request_slot) = Slot::take(&slots.requests, MAX_REQUESTS) else {
+                let refusal = Refusal::new(503, "too many requests at once; try again");
                 let _ = Response::refused(&refusal).write(&mut &stream);
-                connections.fetch_sub(1, Ordering::SeqCst);
                 continue;
-            }
-            scope.spawn(move || {
-                serve_connection(session, stream, address);
-                connections.fetch_sub(1, Ordering::SeqCst);
-            });
+            };
+            scope.spawn(move || serve_connection(session, slots, request_slot, stream, address));
         }
     });
     Ok(())
 }
 
-/// Reads one request from `stream` and answers it.
-fn serve_connection(session: &Session, stream: TcpStream, address: SocketAddr) {
-    let _ = stream.set_read_timeout(Some(IO_TIMEOUT));
+/// The places of the connections served at once: requests being read or
+/// answered, and event streams, each bounded on its own, so that open
+/// pages cannot keep requests out nor requests pages.
+#[derive(Default)]
+struct Slots {
+    requests: AtomicUsize,
+    streams: AtomicUsize,
+}
+
+/// One place of a [`Slots`] count, given back when dropped.
+struct Slot<'a>(&'a AtomicUsize);
+
+impl<'a> Slot<'a> {
+    /// A place in `count` if fewer than `most` are taken.
+    fn take(count: &'a AtomicUsize, most: usize) -> Option<Self> {
+        count
+            .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |n| {
+                (n < most).then_some(n + 1)
+            })
+            .ok()
+            .map(|_| Self(count))
+    }
+}
+
+impl Drop for Slot<'_> {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// A connection read until a deadline: each read waits at most until it,
+/// and a read after it fails with [`io::ErrorKind::TimedOut`].
+struct ReadBefore<'a> {
+    stream: &'a TcpStream,
+    deadline: Instant,
+}
+
+impl Read for ReadBefore<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let left = self.deadline.saturating_duration_since(Instant::now());
+        if left.is_zero() {
+            return Err(io::Error::new(
+                io::ErrorKind::TimedOut,
+                "the deadline has passed",
+            ));
+        }
+        self.stream.set_read_timeout(Some(left))?;
+        self.stream.read(buf)
+    }
+}
+
+/// Reads one request from `stream` (within [`REQUEST_DEADLINE`]) and
+/// answers it, holding `request_slot` meanwhile; an event stream trades
+/// it for a place among the streams.
+fn serve_connection(
+    session: &Session,
+    slots: &Slots,
+    request_slot: Slot<'_>,
+    stream: TcpStream,
+    address: SocketAddr,
+) {
     let _ = stream.set_write_timeout(Some(IO_TIMEOUT));
-    let mut reader = BufReader::new(&stream);
+    let mut reader = BufReader::new(ReadBefore {
+        stream: &stream,
+        deadline: Instant::now() + REQUEST_DEADLINE,
+    });
     let request = match read_request(&mut reader) {
         Ok(Some(request)) => request,
         Ok(None) => return,
@@ -120,6 +180,19 @@ fn serve_connection(session: &Session, stream: TcpStream, address: SocketAddr) {
         return;
     }
     if request.path == "/events" && request.method == "GET" {
+        let Some(_stream_slot) = Slot::take(&slots.streams, MAX_EVENT_STREAMS) else {
+            let refusal = Refusal::new(
+                503,
+                format!(
+                    "too many pages are open ({MAX_EVENT_STREAMS}, the most this server \
+                     follows at once): close one"
+                ),
+            );
+            let _ = Response::refused(&refusal).write(&mut &stream);
+            return;
+        };
+        drop(request_slot);
+        let _ = stream.set_read_timeout(None);
         stream_events(session, &stream);
         return;
     }
@@ -139,9 +212,9 @@ fn serve_connection(session: &Session, stream: TcpStream, address: SocketAddr) {
 /// still sends is read and dropped, within bounds, so that closing with
 /// unread data does not reset the connection before the client reads the
 /// answer.
-fn linger(stream: &TcpStream, unread: &mut impl std::io::Read) {
+fn linger(stream: &TcpStream, unread: &mut BufReader<ReadBefore<'_>>) {
     let _ = stream.shutdown(std::net::Shutdown::Write);
-    let _ = stream.set_read_timeout(Some(LINGER));
+    unread.get_mut().deadline = Instant::now() + LINGER;
     let mut sink = [0u8; 4096];
     let mut left = MAX_LINGER_BYTES;
     while left > 0 {

@@ -4,6 +4,8 @@
 //! flags, the views, and bad requests.
 
 use crate::pfm::read_pfm;
+use std::time::{Duration, Instant};
+
 use crate::support::{Server, scene_text, whitted};
 
 const SIZE: [&str; 4] = ["--width", "64", "--height", "48"];
@@ -293,5 +295,85 @@ fn bad_and_foreign_requests_are_refused_and_the_server_stays_up() {
     );
     assert_eq!(server.raw(&long, b"").0, 431);
     assert!(server.alive());
+    assert_eq!(server.get("/").0, 200);
+}
+
+/// Issue 50, item 4: a newer scene cancels the pass under way within a
+/// pixel's work. The glass ball in mirrors at 64 samples costs some 0.15 s
+/// a pixel in a debug build, so a tile of its full pass takes some 40 s:
+/// a render cancelled only between tiles kept the next scene waiting
+/// that long.
+#[test]
+fn a_newer_scene_cancels_the_pass_under_way_within_a_pixel() {
+    let slow = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../whitted/tests/hostile_scenes/glass_in_mirrors.toml"),
+    )
+    .unwrap()
+    .replace("height = 8\n", "height = 8\nsamples = 64\n");
+    assert!(slow.contains("samples = 64"));
+    let server = Server::start(&slow, &SIZE);
+    let mut events = server.events();
+    events.until(|name, data| name == "frame" && data["pass"] == "refining");
+    // Into the full pass.
+    std::thread::sleep(Duration::from_millis(500));
+    let start = Instant::now();
+    std::fs::write(server.scene(), scene_text()).unwrap();
+    let (name, frame) = events.next();
+    let waited = start.elapsed();
+    eprintln!("the new scene's first frame came {waited:?} after it was saved");
+    assert_eq!(name, "frame", "{frame}");
+    assert_eq!(
+        frame["pass"], "coarse",
+        "the new scene's first frame: {frame}"
+    );
+    assert!(waited < Duration::from_secs(5), "{waited:?}");
+}
+
+/// Issue 50, item 20: 70 clients sending a request a byte at a time, and
+/// 16 open pages, neither keep out the page's requests; a request must
+/// come whole within 10 s (408 after), and a 17th page is refused by name.
+#[test]
+fn slow_clients_and_open_pages_do_not_lock_out_requests() {
+    use std::io::{Read, Write};
+    let server = Server::start(&scene_text(), &SIZE);
+    let port = server.port;
+    let started = Instant::now();
+    let mut slow: Vec<std::net::TcpStream> = (0..70)
+        .map(|_| {
+            let mut stream = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
+            stream.write_all(b"GET / HT").unwrap();
+            stream
+        })
+        .collect();
+    let pages: Vec<_> = (0..16).map(|_| server.events()).collect();
+    assert_eq!(server.get("/").0, 200, "a request beside them");
+    let (status, refused) = server.get("/events");
+    assert_eq!(status, 503);
+    assert_eq!(
+        String::from_utf8_lossy(&refused),
+        "too many pages are open (16, the most this server follows at once): close one\n"
+    );
+    // Each slow client is answered 408 once its 10 s are up.
+    let first = &mut slow[0];
+    first
+        .set_read_timeout(Some(Duration::from_secs(30)))
+        .unwrap();
+    let mut answer = String::new();
+    first.read_to_string(&mut answer).unwrap();
+    let waited = started.elapsed();
+    assert!(
+        answer.starts_with("HTTP/1.1 408 ")
+            && answer.contains(
+                "the request did not arrive in time: a request's head and body must come \
+                 within 10 s"
+            ),
+        "{answer}"
+    );
+    assert!(
+        waited >= Duration::from_secs(9) && waited < Duration::from_secs(25),
+        "{waited:?}"
+    );
+    drop(pages);
     assert_eq!(server.get("/").0, 200);
 }

@@ -401,7 +401,7 @@ fn trace_pixels(
     progress: &(dyn Fn(Progress) + Sync),
     build_seconds: f64,
 ) -> Result<RenderOutput, RenderError> {
-    let cancelled = || cancel.is_some_and(|c| c.load(Ordering::Relaxed));
+    let cancelled = || is_cancelled(cancel);
     let scene = prepared.scene;
     let (width, height) = (settings.width, settings.height);
     settings.check()?;
@@ -464,16 +464,18 @@ fn trace_pixels(
             if cancelled() {
                 return;
             }
-            let tile = clock.tile(|| {
+            let Some(tile) = clock.tile(|| {
                 render_tile(
                     &integrator,
                     (camera, on_image.as_ref()),
                     scene.color_space,
-                    settings,
-                    selection,
+                    (settings, selection),
                     (index % tiles_x, index / tiles_x),
+                    cancel,
                 )
-            });
+            }) else {
+                return;
+            };
             let pixels = tile.selected;
             let non_finite = tile.non_finite();
             films
@@ -542,17 +544,24 @@ fn tile_is_selected(selection: &PixelSelection, tile_x: u32, tile_y: u32) -> boo
     x0 < w.x1 && x0 + TILE_SIZE > w.x0 && (y0..y0 + TILE_SIZE).any(|y| selection.has_row(y))
 }
 
+/// Whether `cancel` is given and set.
+fn is_cancelled(cancel: Option<&AtomicBool>) -> bool {
+    cancel.is_some_and(|c| c.load(Ordering::Relaxed))
+}
+
 /// Renders the selected pixels of tile (`tile_x`, `tile_y`) of the image
 /// (the others are left black), seen by `camera`; `on_image`, where known,
-/// is where the world can appear.
+/// is where the world can appear. `None` once `cancel` is set: it is
+/// checked before each pixel is shaded, so a cancelled render stops within
+/// a pixel's work per thread.
 fn render_tile(
     integrator: &Integrator,
     (camera, on_image): (&Camera, Option<&WorldOnImage>),
     color_space: ColorSpace,
-    settings: &RenderSettings,
-    selection: &PixelSelection,
+    (settings, selection): (&RenderSettings, &PixelSelection),
     (tile_x, tile_y): (u32, u32),
-) -> Tile {
+    cancel: Option<&AtomicBool>,
+) -> Option<Tile> {
     let x0 = tile_x * TILE_SIZE;
     let y0 = tile_y * TILE_SIZE;
     let width = TILE_SIZE.min(settings.width - x0);
@@ -586,43 +595,50 @@ fn render_tile(
     let row = x0..x0 + width;
     let mut samples = RowSamples::new(settings, width, on_image);
     for y in y0..y0 + height {
-        match &mut adaptive {
+        let finished = match &mut adaptive {
             Some(adaptive) => adaptive_row(
                 integrator,
                 camera,
-                settings,
-                selection,
+                (settings, selection),
                 adaptive,
                 (row.clone(), y),
                 &mut tile,
+                cancel,
             ),
             None => samples.trace(
                 integrator,
                 camera,
-                settings,
-                selection,
+                (settings, selection),
                 (row.clone(), y),
                 &mut tile,
+                cancel,
             ),
+        };
+        if !finished {
+            return None;
         }
     }
-    tile
+    Some(tile)
 }
 
-/// The pixels `row` of row `y` sampled adaptively, appended to `tile`.
+/// The pixels `row` of row `y` sampled adaptively, appended to `tile`;
+/// false, with the row unfinished, once `cancel` is set.
 fn adaptive_row(
     integrator: &Integrator,
     camera: &Camera,
-    settings: &RenderSettings,
-    selection: &PixelSelection,
+    (settings, selection): (&RenderSettings, &PixelSelection),
     adaptive: &mut AdaptivePixels,
     (row, y): (Range<u32>, u32),
     tile: &mut Tile,
-) {
+    cancel: Option<&AtomicBool>,
+) -> bool {
     for x in row {
         if !selection.contains(x, y) {
             push_unselected(settings, tile);
             continue;
+        }
+        if is_cancelled(cancel) {
+            return false;
         }
         tile.selected += 1;
         let mut cost = Cost {
@@ -633,6 +649,7 @@ fn adaptive_row(
         tile.color.extend_from_slice(&color.to_f32());
         push_aovs(integrator, camera, settings, x, y, None, &mut tile.aovs);
     }
+    true
 }
 
 /// The ray through a pixel's centre and its first hit, if any.
@@ -677,16 +694,17 @@ impl<'w> RowSamples<'w> {
     }
 
     /// The pixels `row` of row `y`, each the mean of its samples, appended
-    /// to `tile` (the unselected ones black).
+    /// to `tile` (the unselected ones black); false, with the row
+    /// unfinished, once `cancel` is set.
     fn trace(
         &mut self,
         integrator: &Integrator,
         camera: &Camera,
-        settings: &RenderSettings,
-        selection: &PixelSelection,
+        (settings, selection): (&RenderSettings, &PixelSelection),
         (row, y): (Range<u32>, u32),
         tile: &mut Tile,
-    ) {
+        cancel: Option<&AtomicBool>,
+    ) -> bool {
         let spp = settings.samples_per_pixel;
         let world = integrator.world();
         let packets = settings.packets && settings.fast_paths && world.walks_packets();
@@ -733,6 +751,9 @@ impl<'w> RowSamples<'w> {
                 if !selected(x) {
                     continue;
                 }
+                if is_cancelled(cancel) {
+                    return false;
+                }
                 let ray = &self.rays[i];
                 if prefetch && let Some(Some(ahead)) = self.hits[..count].get(i + SURFACES_AHEAD) {
                     world.prefetch_surface(ahead);
@@ -777,6 +798,7 @@ impl<'w> RowSamples<'w> {
                 push_aovs(integrator, camera, settings, x, y, centre, &mut tile.aovs);
             }
         }
+        true
     }
 
     /// The closest hits of the selected pixels' rays of `row` (of row `y`),
@@ -1087,7 +1109,8 @@ mod tests {
                         let tile = |on_image| {
                             let view = (&scene.camera, on_image);
                             let (at, space) = ((tile_x, tile_y), scene.color_space);
-                            render_tile(&integrator, view, space, settings, &selection, at)
+                            render_tile(&integrator, view, space, (settings, &selection), at, None)
+                                .unwrap()
                         };
                         let (walked, kept) = (tile(None), tile(Some(&grid)));
                         assert_eq!(walked.color, kept.color, "tile {tile_x}, {tile_y}");
@@ -1133,6 +1156,47 @@ mod tests {
         assert_eq!(clamp.tiles, 4);
         assert!(clamp.used <= clamp.tiles, "{clamp:?}");
         assert_eq!(clamped.image, output.image);
+    }
+
+    #[test]
+    fn a_tile_stops_before_its_next_pixel_once_cancelled_stratified_or_adaptive() {
+        for aa in [
+            AntiAliasing::Stratified,
+            AntiAliasing::Adaptive(Adaptive::default()),
+        ] {
+            let mut scene = crate::scene::default_scene();
+            scene.settings.width = 16;
+            scene.settings.height = 16;
+            scene.settings.aa = aa;
+            let prepared = Prepared::new(&scene).unwrap();
+            let settings = &scene.settings;
+            let limits = RecursionLimits {
+                max_depth: settings.max_depth,
+                min_weight: settings.min_weight,
+                ray_budget: SECONDARY_RAY_BUDGET,
+            };
+            let integrator = Integrator::new(
+                settings.integrator,
+                &prepared.world,
+                shading_of(&scene),
+                limits,
+            );
+            let whole = PixelSelection::whole(16, 16);
+            let tile = |cancel: &AtomicBool| {
+                render_tile(
+                    &integrator,
+                    (&scene.camera, None),
+                    scene.color_space,
+                    (settings, &whole),
+                    (0, 0),
+                    Some(cancel),
+                )
+            };
+            let kept = tile(&AtomicBool::new(false)).unwrap();
+            let plain = render(&scene, &|_| {}).unwrap();
+            assert_eq!(kept.color, plain.image.data(), "{aa:?}");
+            assert!(tile(&AtomicBool::new(true)).is_none(), "{aa:?}");
+        }
     }
 
     #[test]
