@@ -53,7 +53,17 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // Help and the version go to standard output as clap prints them.
+        Err(e) if !e.use_stderr() => e.exit(),
+        // Usage errors quote the arguments, which may be long: they are
+        // printed as every report is (see report::bounded).
+        Err(e) => {
+            note!("{}", e.render().to_string().trim_end());
+            return ExitCode::from(e.exit_code().clamp(0, 255) as u8);
+        }
+    };
     #[cfg(unix)]
     if let Err(message) = signals::remove_partial_files_on_signals() {
         note!("warning: {message}; an interrupted render may leave .partial files behind");

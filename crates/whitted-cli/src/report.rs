@@ -11,9 +11,12 @@
 //!   says so on standard error if it can and exits with 1, as for any
 //!   other failure.
 
+use std::borrow::Cow;
 use std::fmt;
 use std::io::Write;
 use std::sync::atomic::{AtomicBool, Ordering};
+
+use whitted::scene::quotes_cut;
 
 /// Writes a line (`format!` arguments) on standard error, if reports can
 /// still be written there.
@@ -58,9 +61,51 @@ impl ReportStream {
 /// Standard error, as a report stream.
 static STDERR: ReportStream = ReportStream::new();
 
-/// Writes a line on standard error (see [`note!`]).
+/// Writes a line on standard error (see [`note!`]), [`bounded`].
 pub fn note_line(line: fmt::Arguments<'_>) {
-    STDERR.line(&mut std::io::stderr().lock(), line);
+    let text = line.to_string();
+    STDERR.line(
+        &mut std::io::stderr().lock(),
+        format_args!("{}", bounded(&text)),
+    );
+}
+
+/// The most characters of a line shown as it is: messages are shorter,
+/// and a diagnostic's excerpt of a line is cut well before this.
+const MAX_LINE_CHARS: usize = 400;
+
+/// `text` with every line longer than [`MAX_LINE_CHARS`] shown with what
+/// it quotes (between backticks, then between single quotes, as the
+/// argument parser quotes) cut to about a line's width
+/// ([`whitted::scene::quotes_cut`]): such a line quotes its input at
+/// length, a name or value of megabytes. A line still too long keeps its
+/// start and its end around a `…`. Shorter lines are left alone.
+pub fn bounded(text: &str) -> Cow<'_, str> {
+    if !text
+        .lines()
+        .any(|line| line.chars().nth(MAX_LINE_CHARS).is_some())
+    {
+        return Cow::Borrowed(text);
+    }
+    let lines: Vec<String> = text
+        .split('\n')
+        .map(|line| {
+            if line.chars().nth(MAX_LINE_CHARS).is_none() {
+                return line.to_string();
+            }
+            let cut = quotes_cut(&quotes_cut(line, '`'), '\'');
+            let length = cut.chars().count();
+            if length <= MAX_LINE_CHARS {
+                return cut;
+            }
+            // Still too long (its input not quoted): its start and end,
+            // which say what is wrong and why.
+            let head: String = cut.chars().take(MAX_LINE_CHARS - 100).collect();
+            let tail: String = cut.chars().skip(length - 99).collect();
+            format!("{head}…{tail}")
+        })
+        .collect();
+    Cow::Owned(lines.join("\n"))
 }
 
 /// Writes the command's results on standard output and flushes them; the
@@ -153,5 +198,24 @@ mod tests {
         let mut fine = Vec::new();
         write_results(&mut fine, "a table\n").unwrap();
         assert_eq!(fine, b"a table\n");
+    }
+
+    #[test]
+    fn long_lines_quote_at_most_a_lines_width_and_short_ones_are_left_alone() {
+        let short = "error: `x` is not a number\n  | `a a`\n";
+        assert!(matches!(bounded(short), Cow::Borrowed(_)));
+        let long = "b".repeat(100_000);
+        let said = format!("error: invalid value '{long}' for '--x': `{long}` is wrong\nnext");
+        let cut = format!("{}…", "b".repeat(71));
+        assert_eq!(
+            bounded(&said),
+            format!("error: invalid value '{cut}' for '--x': `{cut}` is wrong\nnext")
+        );
+        // Not quoted: its start and end, 400 characters in all.
+        let bare = format!("error: {long} is too large");
+        let shown = bounded(&bare);
+        assert_eq!(shown.chars().count(), 400);
+        assert!(shown.starts_with("error: bbb") && shown.ends_with("bbb is too large"));
+        assert!(shown.contains('…'));
     }
 }

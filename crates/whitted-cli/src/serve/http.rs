@@ -55,11 +55,14 @@ pub struct Refusal {
 }
 
 impl Refusal {
-    /// A refusal with `status`.
+    /// A refusal with `status`; `message` is shown as every report is
+    /// ([`crate::report::bounded`]: what it quotes of a request at length
+    /// is cut).
     pub fn new(status: u16, message: impl Into<String>) -> Self {
+        let message = message.into();
         Self {
             status,
-            message: message.into(),
+            message: crate::report::bounded(&message).into_owned(),
         }
     }
 }

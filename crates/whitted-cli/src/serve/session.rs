@@ -354,6 +354,7 @@ impl Session {
         inner.scene = None;
         inner.world = None;
         drop(inner);
+        let message = crate::report::bounded(message);
         self.publish("error", json!({ "request": request, "message": message }));
     }
 

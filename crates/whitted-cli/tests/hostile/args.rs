@@ -258,3 +258,30 @@ fn scene_files_bound_their_sizes_and_counts_with_the_true_cause() {
         assert_refused_early(&["render", scene, "-o", "out.png"], dir.path(), 1, says);
     }
 }
+
+/// Issue 50, item 16: an argument of 100,000 characters is quoted at
+/// about a line's width in the refusal, by clap and by our own parsers.
+#[test]
+fn a_huge_argument_is_quoted_at_a_lines_width() {
+    let dir = tempfile::tempdir().unwrap();
+    let huge_number = "7".repeat(100_000);
+    let huge_words = "a ".repeat(50_000);
+    for args in [
+        vec!["render", "--width", &huge_number],
+        vec!["explain", "--pixel", &huge_words],
+        vec!["render", "--max-memory", &huge_words],
+        vec!["render", "--aov", &huge_number],
+        vec!["render", &huge_number],
+    ] {
+        let p = probe(&args, dir.path());
+        assert!(matches!(p.code(), Some(1 | 2)), "{}", p.stderr);
+        assert!(p.stderr.starts_with("error: "), "{}", p.stderr);
+        assert!(
+            p.stderr.len() < 1_500,
+            "{} bytes: {}",
+            p.stderr.len(),
+            p.stderr
+        );
+        assert!(p.stderr.contains("…"), "{}", p.stderr);
+    }
+}

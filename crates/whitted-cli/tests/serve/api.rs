@@ -377,3 +377,23 @@ fn slow_clients_and_open_pages_do_not_lock_out_requests() {
     drop(pages);
     assert_eq!(server.get("/").0, 200);
 }
+
+/// Issue 50, item 16: a refusal quotes what it refuses at about a line's
+/// width, however long the request's header or value.
+#[test]
+fn refusals_quote_long_requests_at_a_lines_width() {
+    let server = Server::start(&scene_text(), &SIZE);
+    let long = "h".repeat(15_000);
+    let (status, body) = server.raw(&format!("GET / HTTP/1.1\r\nHost: {long}"), b"");
+    assert_eq!(status, 403);
+    let text = String::from_utf8_lossy(&body);
+    assert!(body.len() < 500, "{text}");
+    assert!(
+        text.starts_with(&format!("requests for host `{}…` are refused", &long[..71])),
+        "{text}"
+    );
+    let (status, text) = server.view(&format!("aov={}", "x".repeat(50_000)));
+    assert_eq!(status, 400);
+    assert!(text.len() < 500, "{text}");
+    assert!(text.contains("…"), "{text}");
+}

@@ -268,14 +268,17 @@ impl Diagnostic {
     }
 }
 
-/// `message` with each text between a pair of backticks longer than
-/// [`MAX_QUOTED_CHARS`] cut to that many characters, the last `…`.
-fn quotes_cut(message: &str) -> String {
-    let parts: Vec<&str> = message.split('`').collect();
+/// `message` with each text between a pair of `quote` characters longer
+/// than [`MAX_QUOTED_CHARS`] cut to that many characters, the last `…`:
+/// what a message quotes of its input is shown at about a line's width,
+/// whatever the input. Diagnostics apply it with backticks; messages made
+/// elsewhere (a command's own, a server's) may apply it too.
+pub fn quotes_cut(message: &str, quote: char) -> String {
+    let parts: Vec<&str> = message.split(quote).collect();
     let mut out = String::with_capacity(message.len().min(1 << 16));
     for (i, part) in parts.iter().enumerate() {
         if i > 0 {
-            out.push('`');
+            out.push(quote);
         }
         // Odd parts lie between a pair of backticks (the last one only when
         // its closing backtick is there).
@@ -313,7 +316,7 @@ pub const MAX_QUOTED_CHARS: usize = 72;
 /// form gives them (`-1e300`), and what it quotes between backticks cut to
 /// [`MAX_QUOTED_CHARS`].
 fn readable(message: &str) -> String {
-    let cut = quotes_cut(message);
+    let cut = quotes_cut(message, '`');
     let message = cut.as_str();
     let mut out = String::with_capacity(message.len());
     let mut rest = message;

@@ -16,8 +16,8 @@ pub use bom::{BYTE_ORDER_MARK, without_bom};
 pub use bpt::{load_bpt, load_bpt_patches, parse_bpt, parse_bpt_patches};
 pub use camera_override::CameraOverride;
 pub use diagnostic::{
-    Diagnostic, MAX_DIAGNOSTICS, MAX_SHOWN_CHARS, SceneError, Severity, limit_warnings,
-    push_limited,
+    Diagnostic, MAX_DIAGNOSTICS, MAX_QUOTED_CHARS, MAX_SHOWN_CHARS, SceneError, Severity,
+    limit_warnings, push_limited, quotes_cut,
 };
 pub use nff::{load_nff, parse_nff};
 pub use obj::{load_obj, parse_obj};
