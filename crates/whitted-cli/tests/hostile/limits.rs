@@ -547,3 +547,57 @@ fn every_reader_reads_one_long_line_in_time_linear_in_its_length() {
     let seconds = start.elapsed().as_secs_f64();
     assert!(seconds < 8.0, "{seconds} s");
 }
+
+/// Issue 50, item 6: under `ulimit -v 4G` a 16384² render passed the
+/// default budget (3/4 of the machine), then aborted while writing (exit
+/// 134) and left a partial file. The default budget honours the process's
+/// own limits.
+#[test]
+fn the_default_budget_honours_the_address_space_limit() {
+    use std::os::unix::process::CommandExt;
+    let dir = tempfile::tempdir().unwrap();
+    let limited = |args: &[&str]| {
+        let mut command = super::support::whitted(args, dir.path());
+        // SAFETY: setrlimit is async-signal-safe, as pre_exec requires.
+        unsafe {
+            command.pre_exec(|| {
+                let limit = libc::rlimit {
+                    rlim_cur: 4 << 30,
+                    rlim_max: 4 << 30,
+                };
+                if libc::setrlimit(libc::RLIMIT_AS, &limit) != 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                Ok(())
+            });
+        }
+        super::support::run(command)
+    };
+    let p = limited(&[
+        "render", "--width", "16384", "--height", "16384", "-o", "big.png",
+    ]);
+    assert_eq!(p.code(), Some(1), "{}", p.stderr);
+    assert!(
+        p.stderr.contains(
+            "the memory budget is 3.0 GiB (3/4 of the 4.0 GiB of address space the process may \
+             use (ulimit -v))"
+        ),
+        "{}",
+        p.stderr
+    );
+    let p = limited(&[
+        "render",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "-o",
+        "small.png",
+    ]);
+    assert_eq!(p.code(), Some(0), "{}", p.stderr);
+    let names: Vec<_> = fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    assert_eq!(names, ["small.png"]);
+}

@@ -1,10 +1,11 @@
 //! The memory budget: the most bytes one request sized by input may take.
 //!
 //! The budget is one per process. By default it is 3/4 of the memory this
-//! process may use: the smaller of the machine's `MemTotal`
-//! (`/proc/meminfo`) and the control group's limit (`memory.max`, or
-//! `memory.limit_in_bytes` under cgroup v1); where neither can be read it
-//! is 4 GiB. The command replaces it with `--max-memory`
+//! process may use: the smallest of the machine's `MemTotal`
+//! (`/proc/meminfo`), the control group's limit (`memory.max`, or
+//! `memory.limit_in_bytes` under cgroup v1) and the process's own limits
+//! on its address space and its data (`ulimit -v`, `ulimit -d`); where
+//! none can be read it is 4 GiB. The command replaces it with `--max-memory`
 //! ([`MemoryBudget::set_current`]). A request ([`MemoryBudget::check`]) is
 //! measured before anything is allocated for it, so what input declares
 //! (an image size, a texture header) is refused with a message instead of
@@ -21,6 +22,17 @@ const FALLBACK_BYTES: u64 = 4 << 30;
 /// fraction numerator / denominator.
 const SHARE: (u64, u64) = (3, 4);
 
+/// What bounds the memory a process may use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MemoryLimit {
+    /// The machine's memory, or its control group's limit.
+    Machine,
+    /// The process's address space (`RLIMIT_AS`, `ulimit -v`).
+    AddressSpace,
+    /// The process's data segment (`RLIMIT_DATA`, `ulimit -d`).
+    Data,
+}
+
 /// Where a budget comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BudgetOrigin {
@@ -28,6 +40,8 @@ pub enum BudgetOrigin {
     Machine {
         /// The memory this process may use.
         total: u64,
+        /// What bounds it.
+        by: MemoryLimit,
     },
     /// The machine's memory could not be read.
     Fallback,
@@ -80,13 +94,13 @@ impl MemoryBudget {
         *MACHINE.get_or_init(|| Self::from_total(usable_memory()))
     }
 
-    /// The default budget for a process that may use `total` bytes
-    /// (`None`: unknown).
-    fn from_total(total: Option<u64>) -> Self {
+    /// The default budget for a process that may use `total` bytes, bound
+    /// by what the limit says (`None`: unknown).
+    fn from_total(total: Option<(u64, MemoryLimit)>) -> Self {
         match total {
-            Some(total) => Self {
+            Some((total, by)) => Self {
                 bytes: total / SHARE.1 * SHARE.0,
-                origin: BudgetOrigin::Machine { total },
+                origin: BudgetOrigin::Machine { total, by },
             },
             None => Self {
                 bytes: FALLBACK_BYTES,
@@ -130,12 +144,19 @@ impl fmt::Display for MemoryBudget {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let bytes = format_bytes(self.bytes);
         match self.origin {
-            BudgetOrigin::Machine { total } => write!(
+            BudgetOrigin::Machine { total, by } => write!(
                 f,
-                "{bytes} ({}/{} of the {} this machine gives the process)",
+                "{bytes} ({}/{} of the {} {})",
                 SHARE.0,
                 SHARE.1,
-                format_bytes(total)
+                format_bytes(total),
+                match by {
+                    MemoryLimit::Machine => "this machine gives the process",
+                    MemoryLimit::AddressSpace => {
+                        "of address space the process may use (ulimit -v)"
+                    }
+                    MemoryLimit::Data => "of data the process may use (ulimit -d)",
+                }
             ),
             BudgetOrigin::Fallback => {
                 write!(f, "{bytes} (the machine's memory could not be read)")
@@ -145,9 +166,10 @@ impl fmt::Display for MemoryBudget {
     }
 }
 
-/// The memory this process may use: the smaller of the machine's total and
-/// its control group's limit, where they can be read.
-fn usable_memory() -> Option<u64> {
+/// The memory this process may use and what bounds it: the smallest of
+/// the machine's total, its control group's limit and the process's
+/// limits on its address space and data, where they can be read.
+fn usable_memory() -> Option<(u64, MemoryLimit)> {
     let read = |path: &str| std::fs::read_to_string(path).ok();
     let total = read("/proc/meminfo").and_then(|text| mem_total(&text));
     let group = [
@@ -155,12 +177,33 @@ fn usable_memory() -> Option<u64> {
         "/sys/fs/cgroup/memory/memory.limit_in_bytes",
     ]
     .into_iter()
-    .filter_map(|path| read(path)?.trim().parse::<u64>().ok())
-    .min();
-    match (total, group) {
-        (Some(t), Some(g)) => Some(t.min(g)),
-        (t, g) => t.or(g),
-    }
+    .filter_map(|path| read(path)?.trim().parse::<u64>().ok());
+    let machine = total
+        .into_iter()
+        .chain(group)
+        .map(|bytes| (bytes, MemoryLimit::Machine));
+    machine
+        .chain(process_limits())
+        .min_by_key(|&(bytes, _)| bytes)
+}
+
+/// The process's own limits on its memory, where set.
+#[cfg(unix)]
+fn process_limits() -> Vec<(u64, MemoryLimit)> {
+    use rustix::process::{Resource, getrlimit};
+    [
+        (Resource::As, MemoryLimit::AddressSpace),
+        (Resource::Data, MemoryLimit::Data),
+    ]
+    .into_iter()
+    .filter_map(|(resource, by)| Some((getrlimit(resource).current?, by)))
+    .collect()
+}
+
+/// The process's own limits on its memory: none known here.
+#[cfg(not(unix))]
+fn process_limits() -> Vec<(u64, MemoryLimit)> {
+    Vec::new()
 }
 
 /// `MemTotal` in bytes from the text of `/proc/meminfo`.
@@ -227,7 +270,7 @@ mod tests {
 
     #[test]
     fn a_request_above_the_budget_says_what_it_needs_and_how_to_proceed() {
-        let budget = MemoryBudget::from_total(Some(16 << 30));
+        let budget = MemoryBudget::from_total(Some((16 << 30, MemoryLimit::Machine)));
         assert_eq!(budget.bytes, 12 << 30);
         assert!(
             budget
@@ -253,6 +296,20 @@ mod tests {
     }
 
     #[test]
+    fn a_process_limit_says_which_it_is() {
+        let budget = MemoryBudget::from_total(Some((4 << 30, MemoryLimit::AddressSpace)));
+        assert_eq!(
+            budget.to_string(),
+            "3.0 GiB (3/4 of the 4.0 GiB of address space the process may use (ulimit -v))"
+        );
+        let budget = MemoryBudget::from_total(Some((2 << 30, MemoryLimit::Data)));
+        assert_eq!(
+            budget.to_string(),
+            "1.5 GiB (3/4 of the 2.0 GiB of data the process may use (ulimit -d))"
+        );
+    }
+
+    #[test]
     fn an_unreadable_machine_falls_back_to_four_gibibytes() {
         let budget = MemoryBudget::from_total(None);
         assert_eq!(budget.bytes, 4 << 30);
@@ -266,7 +323,7 @@ mod tests {
     fn the_machine_budget_is_a_share_of_a_positive_total() {
         let budget = MemoryBudget::of_machine();
         assert!(budget.bytes > 0);
-        if let BudgetOrigin::Machine { total } = budget.origin {
+        if let BudgetOrigin::Machine { total, .. } = budget.origin {
             assert_eq!(budget.bytes, total / 4 * 3);
         }
     }
