@@ -211,7 +211,9 @@ fn check_texel_memory(width: u32, height: u32, decoded: u64) -> Result<(), Strin
 const FREE_PIXELS: u64 = 1 << 20;
 
 /// Beyond [`FREE_PIXELS`], the most pixels a JPEG may claim per byte of
-/// file. zune-jpeg fills what a truncated file lacks, so without this a
+/// its entropy-coded data ([`entropy_coded_bytes`]: the compressed
+/// pixels, not the comments, thumbnails or other segments that can pad a
+/// file). zune-jpeg fills what a truncated file lacks, so without this a
 /// file of a few hundred bytes is decoded into as many texels as its
 /// header claims, taking the time and memory of a real image that size
 /// (figures in docs/performance-log.md, figures moved out of doc
@@ -229,8 +231,12 @@ fn decode_jpeg(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
     decoder.decode_headers().map_err(|e| e.to_string())?;
     let (width, height) = decoder.dimensions().ok_or("no image size")?;
     let claimed = width as u64 * height as u64;
-    if claimed > FREE_PIXELS + MAX_PIXELS_PER_BYTE * bytes.len() as u64 {
-        return Err(claims_too_much(width as u32, height as u32, bytes.len()));
+    let coded = entropy_coded_bytes(bytes);
+    if claimed > FREE_PIXELS + MAX_PIXELS_PER_BYTE * coded {
+        return Err(format!(
+            "{} ({coded} of its bytes are compressed pixels)",
+            claims_too_much(width as u32, height as u32, bytes.len())
+        ));
     }
     check_texel_memory(width as u32, height as u32, claimed * 3)?;
     let pixels = decoder.decode().map_err(|e| e.to_string())?;
@@ -241,6 +247,54 @@ fn decode_jpeg(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
         .map(|p| [0, 1, 2].map(|c| table[usize::from(p[c])]))
         .collect();
     ImageData::new(width, height, texels).ok_or_else(|| "the image data is truncated".to_string())
+}
+
+/// The bytes of a JPEG's entropy-coded data: what follows each start of
+/// scan (`FFDA`) up to the next marker other than a restart (`FFD0` to
+/// `FFD7`) or a stuffed byte (`FF00`), summed over the scans. Segments are
+/// walked by their lengths; where the file is damaged the count stops
+/// there (the decoder then says what is wrong).
+fn entropy_coded_bytes(bytes: &[u8]) -> u64 {
+    let mut coded = 0;
+    let mut at = 2; // after SOI
+    while at + 1 < bytes.len() {
+        if bytes[at] != 0xff {
+            break;
+        }
+        let marker = bytes[at + 1];
+        match marker {
+            // Fill bytes before a marker.
+            0xff => {
+                at += 1;
+                continue;
+            }
+            // Markers without a length.
+            0x01 | 0xd0..=0xd8 => {
+                at += 2;
+                continue;
+            }
+            0xd9 => break,
+            _ => {}
+        }
+        let Some(length) = bytes.get(at + 2..at + 4) else {
+            break;
+        };
+        let end = at + 2 + usize::from(u16::from_be_bytes([length[0], length[1]]));
+        if marker != 0xda {
+            at = end;
+            continue;
+        }
+        // The scan's data, to the next marker that is not a restart.
+        let mut i = end;
+        while i + 1 < bytes.len()
+            && (bytes[i] != 0xff || matches!(bytes[i + 1], 0x00 | 0xd0..=0xd7))
+        {
+            i += 1;
+        }
+        coded += i.saturating_sub(end) as u64;
+        at = i;
+    }
+    coded
 }
 
 /// The sRGB transfer curve, from an encoded value in [0, 1] to linear light.
@@ -367,8 +421,9 @@ pub(crate) mod tests {
             error,
             format!(
                 "the header claims 16000x16000 pixels, far more than {} bytes can hold: \
-                 the file is truncated or corrupt",
-                bytes.len()
+                 the file is truncated or corrupt ({} of its bytes are compressed pixels)",
+                bytes.len(),
+                entropy_coded_bytes(&bytes)
             )
         );
         // A size within the allowance still decodes (the missing data filled).
@@ -377,6 +432,42 @@ pub(crate) mod tests {
         }
         let data = decode_image(&bytes, Decoding::Color).unwrap();
         assert_eq!((data.width(), data.height()), (1000, 1000));
+    }
+
+    /// Issue 50, item 8: a comment segment padding a small JPEG does not
+    /// buy it pixels: only its compressed data counts.
+    #[test]
+    fn a_jpeg_padded_with_a_comment_is_refused_as_its_compressed_data_says() {
+        let plain = include_bytes!("../../../tests/textures/two_blocks.jpg").to_vec();
+        let coded = entropy_coded_bytes(&plain);
+        assert!(coded > 0 && coded < plain.len() as u64 / 2, "{coded}");
+        // 60 kB of comments after SOI, in segments of at most 65533 bytes.
+        let mut padded = plain[..2].to_vec();
+        for _ in 0..3 {
+            padded.extend_from_slice(&[0xff, 0xfe]);
+            padded.extend_from_slice(&20_002u16.to_be_bytes());
+            padded.extend(std::iter::repeat_n(b'x', 20_000));
+        }
+        padded.extend_from_slice(&plain[2..]);
+        assert_eq!(entropy_coded_bytes(&padded), coded);
+        assert_eq!(
+            decode_image(&padded, Decoding::Color).unwrap(),
+            decode_image(&plain, Decoding::Color).unwrap()
+        );
+        let sof = padded
+            .windows(2)
+            .position(|w| w == [0xff, 0xc0] || w == [0xff, 0xc2])
+            .unwrap();
+        // 9000² pixels: within 4096 per byte of the padded file, not of
+        // its compressed pixels.
+        for at in [sof + 5, sof + 7] {
+            padded[at..at + 2].copy_from_slice(&9000u16.to_be_bytes());
+        }
+        let error = decode_image(&padded, Decoding::Color).unwrap_err();
+        assert!(
+            error.starts_with("the header claims 9000x9000 pixels"),
+            "{error}"
+        );
     }
 
     #[test]
