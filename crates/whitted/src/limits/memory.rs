@@ -10,10 +10,17 @@
 //! measured before anything is allocated for it, so what input declares
 //! (an image size, a texture header) is refused with a message instead of
 //! ending in the allocator's abort.
+//!
+//! The budget is for the whole run, not for each request: what stays in
+//! memory once made (decoded textures with their mipmaps, Bézier patches
+//! and their pieces, a render's films) is charged to one ledger while it
+//! is held ([`MemoryBudget::charge`], a [`Charge`] given back when
+//! dropped), and every request is weighed together with what the ledger
+//! holds.
 
 use std::fmt;
-use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, OnceLock};
 
 /// Budget used where the machine's memory cannot be read.
 const FALLBACK_BYTES: u64 = 4 << 30;
@@ -58,21 +65,124 @@ pub struct MemoryBudget {
     pub origin: BudgetOrigin,
 }
 
-/// A request larger than the budget.
+/// A request larger than what the budget has left.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error(
-    "{what} needs {}; the memory budget is {budget}: {remedy}, or raise the budget with --max-memory",
-    format_bytes(*needed)
-)]
 pub struct MemoryError {
     /// What was asked for, such as "a 16384x16384 image with 2 AOVs".
     pub what: String,
     /// The bytes it needs.
     pub needed: u64,
+    /// The bytes the run held already (textures, patches, films).
+    pub held: u64,
     /// The budget it exceeds.
     pub budget: MemoryBudget,
     /// How to ask for less, such as "render a smaller image".
     pub remedy: String,
+}
+
+impl fmt::Display for MemoryError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} needs {}", self.what, format_bytes(self.needed))?;
+        if self.held > 0 {
+            write!(
+                f,
+                " beside the {} the run holds already (textures, patches, images)",
+                format_bytes(self.held)
+            )?;
+        }
+        write!(
+            f,
+            "; the memory budget is {}: {}, or raise the budget with --max-memory",
+            self.budget, self.remedy
+        )
+    }
+}
+
+/// The bytes held by charges.
+#[derive(Debug)]
+struct Ledger {
+    held: AtomicU64,
+}
+
+/// The process's ledger.
+static LEDGER: Ledger = Ledger {
+    held: AtomicU64::new(0),
+};
+
+/// Memory charged to the process's ledger ([`MemoryBudget::charge`]),
+/// given back when dropped: keep it with what it pays for.
+#[derive(Debug)]
+#[must_use = "the memory is given back when the charge is dropped"]
+pub struct Charge {
+    bytes: u64,
+    ledger: &'static Ledger,
+}
+
+impl Default for Charge {
+    fn default() -> Self {
+        Self {
+            bytes: 0,
+            ledger: &LEDGER,
+        }
+    }
+}
+
+impl Charge {
+    /// A charge of nothing, to [`Charge::grow`].
+    pub fn none() -> Self {
+        Self::default()
+    }
+
+    /// The bytes it holds.
+    pub fn bytes(&self) -> u64 {
+        self.bytes
+    }
+
+    /// Adds `more` bytes for `what` (see [`MemoryBudget::charge`]); on a
+    /// refusal it holds what it held.
+    pub fn grow(
+        &mut self,
+        budget: &MemoryBudget,
+        what: &str,
+        more: u64,
+        remedy: &str,
+    ) -> Result<(), MemoryError> {
+        let added = budget.charge_in(self.ledger, what, more, remedy)?;
+        self.bytes += added.bytes;
+        std::mem::forget(added);
+        Ok(())
+    }
+}
+
+impl Drop for Charge {
+    fn drop(&mut self) {
+        self.ledger.held.fetch_sub(self.bytes, Ordering::Relaxed);
+    }
+}
+
+/// Charges kept with the value they pay for. It compares equal whatever
+/// it holds, so that values that carry it compare by their content.
+#[derive(Clone, Debug, Default)]
+pub struct Held(Vec<Arc<Charge>>);
+
+impl Held {
+    /// Keeps `charge` (a charge of nothing is dropped).
+    pub fn keep(&mut self, charge: Charge) {
+        if charge.bytes > 0 {
+            self.0.push(Arc::new(charge));
+        }
+    }
+
+    /// The bytes it holds.
+    pub fn bytes(&self) -> u64 {
+        self.0.iter().map(|c| c.bytes).sum()
+    }
+}
+
+impl PartialEq for Held {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 /// The budget given for this process in bytes; 0 when none was given.
@@ -124,19 +234,67 @@ impl MemoryBudget {
         GIVEN.store(self.bytes, Ordering::Relaxed);
     }
 
-    /// Refuses a request for `needed` bytes above the budget: `what` names
-    /// the request ("a 16384x16384 image with 2 AOVs"), `remedy` how to ask
-    /// for less ("render a smaller image").
+    /// Refuses a request for `needed` bytes that, with what the ledger
+    /// holds, exceeds the budget: `what` names the request ("a 16384x16384
+    /// image with 2 AOVs"), `remedy` how to ask for less ("render a
+    /// smaller image").
     pub fn check(&self, what: &str, needed: u64, remedy: &str) -> Result<(), MemoryError> {
-        if needed <= self.bytes {
+        self.check_beside(LEDGER.held.load(Ordering::Relaxed), what, needed, remedy)
+    }
+
+    /// [`MemoryBudget::check`] beside `held` bytes.
+    fn check_beside(
+        &self,
+        held: u64,
+        what: &str,
+        needed: u64,
+        remedy: &str,
+    ) -> Result<(), MemoryError> {
+        if held.saturating_add(needed) <= self.bytes {
             return Ok(());
         }
         Err(MemoryError {
             what: what.to_string(),
             needed,
+            held,
             budget: *self,
             remedy: remedy.to_string(),
         })
+    }
+
+    /// Charges `needed` bytes to the process's ledger, refused as
+    /// [`MemoryBudget::check`] refuses; the bytes count against every later
+    /// request until the charge is dropped.
+    pub fn charge(&self, what: &str, needed: u64, remedy: &str) -> Result<Charge, MemoryError> {
+        self.charge_in(&LEDGER, what, needed, remedy)
+    }
+
+    /// [`MemoryBudget::charge`] to `ledger`.
+    fn charge_in(
+        &self,
+        ledger: &'static Ledger,
+        what: &str,
+        needed: u64,
+        remedy: &str,
+    ) -> Result<Charge, MemoryError> {
+        let mut held = ledger.held.load(Ordering::Relaxed);
+        loop {
+            self.check_beside(held, what, needed, remedy)?;
+            match ledger.held.compare_exchange_weak(
+                held,
+                held + needed,
+                Ordering::Relaxed,
+                Ordering::Relaxed,
+            ) {
+                Ok(_) => {
+                    return Ok(Charge {
+                        bytes: needed,
+                        ledger,
+                    });
+                }
+                Err(now) => held = now,
+            }
+        }
     }
 }
 
@@ -274,11 +432,11 @@ mod tests {
         assert_eq!(budget.bytes, 12 << 30);
         assert!(
             budget
-                .check("a small image", 12 << 30, "render smaller")
+                .check_beside(0, "a small image", 12 << 30, "render smaller")
                 .is_ok()
         );
         let error = budget
-            .check("a 16384x16384 image", 13 << 30, "render a smaller image")
+            .check_beside(0, "a 16384x16384 image", 13 << 30, "render a smaller image")
             .unwrap_err();
         assert_eq!(
             error.to_string(),
@@ -293,6 +451,48 @@ mod tests {
                 .to_string()
                 .contains("1.0 MiB (as given)")
         );
+    }
+
+    #[test]
+    fn charges_add_up_against_the_budget_until_dropped_and_say_what_is_held() {
+        // A ledger of its own: the process's is charged by other tests.
+        static OWN: Ledger = Ledger {
+            held: AtomicU64::new(0),
+        };
+        let budget = MemoryBudget::given(1 << 40);
+        let charge = |bytes: u64| budget.charge_in(&OWN, "a texture", bytes, "use a smaller one");
+        let first = charge(600 << 30).unwrap();
+        let mut second = Charge {
+            bytes: 0,
+            ledger: &OWN,
+        };
+        second.grow(&budget, "b", 300 << 30, "less").unwrap();
+        let error = charge(200 << 30).unwrap_err();
+        assert_eq!(error.held, 900 << 30);
+        assert_eq!(
+            error.to_string(),
+            "a texture needs 200.0 GiB beside the 900.0 GiB the run holds already (textures, \
+             patches, images); the memory budget is 1.0 TiB (as given): use a smaller one, or \
+             raise the budget with --max-memory"
+        );
+        assert!(second.grow(&budget, "c", 200 << 30, "less").is_err());
+        assert_eq!(
+            second.bytes(),
+            300 << 30,
+            "a refused growth holds what it held"
+        );
+        let mut held = Held::default();
+        held.keep(second);
+        let copy = held.clone();
+        drop(held);
+        assert_eq!(copy.bytes(), 300 << 30, "shared until the last copy goes");
+        drop(first);
+        let third = charge(200 << 30).unwrap();
+        assert!(charge(600 << 30).is_err());
+        drop(copy);
+        drop(third);
+        assert_eq!(OWN.held.load(Ordering::Relaxed), 0);
+        assert!(charge(1 << 40).is_ok());
     }
 
     #[test]

@@ -11,4 +11,6 @@ mod input;
 mod memory;
 
 pub use input::{InputFile, identify_input, inputs_read, read_input, read_input_text};
-pub use memory::{BudgetOrigin, MemoryBudget, MemoryError, MemoryLimit, format_bytes, parse_size};
+pub use memory::{
+    BudgetOrigin, Charge, Held, MemoryBudget, MemoryError, MemoryLimit, format_bytes, parse_size,
+};

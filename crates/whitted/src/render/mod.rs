@@ -406,7 +406,9 @@ fn trace_pixels(
     let (width, height) = (settings.width, settings.height);
     settings.check()?;
     selection.check(width, height)?;
-    resources::check_memory(settings, MemoryBudget::current())?;
+    // Held until the films are returned: a render beside it is weighed
+    // with them.
+    let _films = resources::charge_memory(settings, MemoryBudget::current())?;
     let tiles_x = width.div_ceil(TILE_SIZE);
     let tiles_y = height.div_ceil(TILE_SIZE);
     let tiles: Vec<u32> = (0..tiles_x * tiles_y)

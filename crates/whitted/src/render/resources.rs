@@ -5,7 +5,7 @@
 use std::fmt;
 
 use crate::integrator::SECONDARY_RAY_BUDGET;
-use crate::limits::{MemoryBudget, MemoryError};
+use crate::limits::{Charge, MemoryBudget, MemoryError};
 use crate::render::{Aov, RenderSettings};
 use crate::world::MaterialId;
 
@@ -33,22 +33,43 @@ pub fn memory_needed(settings: &RenderSettings) -> u64 {
     (u64::from(settings.width) * u64::from(settings.height)).saturating_mul(per_pixel)
 }
 
-/// Refuses a render whose films ([`memory_needed`]) exceed `budget`.
+/// Refuses a render whose films ([`memory_needed`]) do not fit in
+/// `budget` beside what the run holds.
 pub(super) fn check_memory(
     settings: &RenderSettings,
     budget: MemoryBudget,
 ) -> Result<(), MemoryError> {
+    budget.check(
+        &films_named(settings),
+        memory_needed(settings),
+        FILMS_REMEDY,
+    )
+}
+
+/// [`check_memory`], charging the films to the ledger while the render
+/// holds them.
+pub(super) fn charge_memory(
+    settings: &RenderSettings,
+    budget: MemoryBudget,
+) -> Result<Charge, MemoryError> {
+    budget.charge(
+        &films_named(settings),
+        memory_needed(settings),
+        FILMS_REMEDY,
+    )
+}
+
+/// How to ask for smaller films.
+const FILMS_REMEDY: &str = "render a smaller image or fewer AOVs";
+
+/// "a 640x480 image with 2 AOVs".
+fn films_named(settings: &RenderSettings) -> String {
     let (width, height) = (settings.width, settings.height);
-    let what = match settings.aovs.len() {
+    match settings.aovs.len() {
         0 => format!("a {width}x{height} image"),
         1 => format!("a {width}x{height} image with 1 AOV"),
         n => format!("a {width}x{height} image with {n} AOVs"),
-    };
-    budget.check(
-        &what,
-        memory_needed(settings),
-        "render a smaller image or fewer AOVs",
-    )
+    }
 }
 
 /// A thread count asked for that was lowered to what helps.

@@ -3,6 +3,7 @@
 //! renderer only ever sees this.
 
 use crate::image::ColorSpace;
+use crate::limits::Held;
 use crate::math::Transform;
 use crate::mesh::TriangleMesh;
 use crate::render::{Camera, ObjectSources, RenderSettings};
@@ -35,6 +36,10 @@ pub struct Scene {
     pub objects: Objects,
     /// Where the scene file defines each of them (for `whitted explain`).
     pub sources: ObjectSources,
+    /// What a reader charged the memory ledger for what it put in the
+    /// scene, beyond what its shapes and textures hold themselves (such
+    /// as the pieces of Bézier patches); given back when the scene goes.
+    pub held: Held,
 }
 
 impl Scene {
@@ -52,6 +57,7 @@ impl Scene {
             lights: Vec::new(),
             objects: Objects::default(),
             sources: ObjectSources::default(),
+            held: Held::default(),
         }
     }
 

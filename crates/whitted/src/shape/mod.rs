@@ -121,6 +121,10 @@ pub struct LocalSurface {
 /// Why a shape could not be built.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ShapeError {
+    /// What the shape keeps (a Bézier patch's hierarchy) does not fit in
+    /// the memory budget beside what the run holds.
+    #[error(transparent)]
+    Memory(#[from] crate::limits::MemoryError),
     /// A length that must be positive was not.
     #[error("{what} must be a positive number, got {value}")]
     NotPositive {

@@ -194,7 +194,9 @@ fn refused(r: &mut Reader<'_>, f: &Fields<'_, '_>, fallback: Span, error: ShapeE
         | ShapeError::Negative { what, .. }
         | ShapeError::NotFinite { what }
         | ShapeError::OutOfRange { what, .. } => f.get(what),
-        ShapeError::Degenerate { .. } | ShapeError::NotPlanar { .. } => None,
+        ShapeError::Degenerate { .. } | ShapeError::NotPlanar { .. } | ShapeError::Memory(_) => {
+            None
+        }
     };
     let span = named.map_or(fallback, |value| r.span_of(value));
     r.error(span, error.to_string())

@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use super::image::ImageData;
-use crate::limits::MemoryBudget;
+use crate::limits::{Charge, MemoryBudget, MemoryError};
 
 /// Why an image file gave no texture.
 #[derive(Debug, thiserror::Error)]
@@ -140,7 +140,7 @@ fn decode_png(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
     let size = reader
         .output_buffer_size()
         .ok_or("the image is too large")?;
-    check_texel_memory(width, height, size as u64)?;
+    let (charge, decoding_charge) = charge_texel_memory(width, height, size as u64)?;
     let mut buffer = vec![0; size];
     let info = reader.next_frame(&mut buffer).map_err(|e| e.to_string())?;
     let channels = match info.color_type {
@@ -176,7 +176,10 @@ fn decode_png(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
             });
         }
     }
-    ImageData::new(width, height, texels).ok_or_else(|| "the image data is truncated".to_string())
+    drop((buffer, decoding_charge));
+    ImageData::new(width, height, texels)
+        .map(|data| data.holding(charge))
+        .ok_or_else(|| "the image data is truncated".to_string())
 }
 
 /// The most bytes deflate (PNG's compression) can expand one byte into
@@ -191,20 +194,30 @@ fn claims_too_much(width: u32, height: u32, file_bytes: usize) -> String {
     )
 }
 
-/// Refuses an image of `width` × `height` whose texels, with the
-/// `decoded` bytes the decoder fills first, exceed the memory budget.
-fn check_texel_memory(width: u32, height: u32, decoded: u64) -> Result<(), String> {
+/// Bytes an image keeps per texel: its linear RGB texel (12) and its share
+/// of the mipmap's levels below it (at most a third of that).
+const KEPT_BYTES_PER_TEXEL: u64 = 16;
+
+/// Charges the memory ledger for an image of `width` × `height`: what it
+/// keeps ([`KEPT_BYTES_PER_TEXEL`]), and apart, the `decoded` bytes the
+/// decoder fills first, given back once the texels are made. Refused when
+/// they do not fit beside what the run holds.
+fn charge_texel_memory(width: u32, height: u32, decoded: u64) -> Result<(Charge, Charge), String> {
     let texels = u64::from(width) * u64::from(height);
-    let needed = texels
-        .saturating_mul(std::mem::size_of::<[f32; 3]>() as u64)
-        .saturating_add(decoded);
-    MemoryBudget::current()
-        .check(
-            &format!("decoding its {width}x{height} texels"),
-            needed,
-            "use a smaller image",
-        )
-        .map_err(|e| e.to_string())
+    let budget = MemoryBudget::current();
+    let what = format!("decoding its {width}x{height} texels");
+    let kept = texels.saturating_mul(KEPT_BYTES_PER_TEXEL);
+    let refused = |e: MemoryError| e.to_string();
+    budget
+        .check(&what, kept.saturating_add(decoded), "use a smaller image")
+        .map_err(refused)?;
+    let kept = budget
+        .charge(&what, kept, "use a smaller image")
+        .map_err(refused)?;
+    let decoding = budget
+        .charge(&what, decoded, "use a smaller image")
+        .map_err(refused)?;
+    Ok((kept, decoding))
 }
 
 /// Pixels any JPEG may claim, whatever its length.
@@ -238,7 +251,7 @@ fn decode_jpeg(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
             claims_too_much(width as u32, height as u32, bytes.len())
         ));
     }
-    check_texel_memory(width as u32, height as u32, claimed * 3)?;
+    let (charge, decoding_charge) = charge_texel_memory(width as u32, height as u32, claimed * 3)?;
     let pixels = decoder.decode().map_err(|e| e.to_string())?;
     let (width, height) = decoder.dimensions().ok_or("no image size")?;
     let table = eight_bit_table(decoding);
@@ -246,7 +259,10 @@ fn decode_jpeg(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
         .chunks_exact(3)
         .map(|p| [0, 1, 2].map(|c| table[usize::from(p[c])]))
         .collect();
-    ImageData::new(width, height, texels).ok_or_else(|| "the image data is truncated".to_string())
+    drop((pixels, decoding_charge));
+    ImageData::new(width, height, texels)
+        .map(|data| data.holding(charge))
+        .ok_or_else(|| "the image data is truncated".to_string())
 }
 
 /// The bytes of a JPEG's entropy-coded data: what follows each start of

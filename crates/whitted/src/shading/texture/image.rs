@@ -11,6 +11,8 @@ use std::sync::{Arc, OnceLock};
 
 use super::mipmap::Mipmap;
 
+use crate::limits::{Charge, Held};
+
 use crate::shading::Color;
 
 use crate::math::DVec2;
@@ -25,6 +27,8 @@ pub struct ImageData {
     mean: Color,
     /// Its mipmap, built by the first filtered lookup.
     mipmap: OnceLock<Mipmap>,
+    /// What it is charged in the memory ledger, texels and mipmap.
+    held: Held,
 }
 
 impl PartialEq for ImageData {
@@ -62,7 +66,15 @@ impl ImageData {
             max_component,
             mean,
             mipmap: OnceLock::new(),
+            held: Held::default(),
         })
+    }
+
+    /// The image, keeping `charge` (what its texels and mipmap are
+    /// charged in the memory ledger) until it is dropped.
+    pub fn holding(mut self, charge: Charge) -> Self {
+        self.held.keep(charge);
+        self
     }
 
     /// Its mipmap pyramid, built once on first use.

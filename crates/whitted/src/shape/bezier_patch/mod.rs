@@ -67,6 +67,7 @@ use self::bernstein::{ControlNet, evaluate};
 use self::hierarchy::{Hierarchy, MAX_DEPTH};
 use self::newton::RayFrame;
 use super::{LocalSurface, ShapeError, ShapeHit, finite, not_tiny};
+use crate::limits::{Held, MemoryBudget};
 use crate::math::{Aabb, DVec2, Ray, Vec3, gamma, magnitude, unit};
 use std::sync::Arc;
 
@@ -107,12 +108,16 @@ struct PatchData {
     /// The normal used where no limit of the derivatives gives one.
     fallback_normal: Vec3,
     hierarchy: Hierarchy,
+    /// What it is charged in the memory ledger.
+    held: Held,
 }
 
 impl BezierPatch {
     /// The patch with control points `points[i][j]`, i along u; refused
-    /// when a point is not finite or out of range, or when the points are
-    /// all equal or all on one line.
+    /// when a point is not finite or out of range, when the points are
+    /// all equal or all on one line, or when its hierarchy does not fit in
+    /// the memory budget (it is charged to the ledger while the patch and
+    /// its pieces live).
     pub fn new(points: [[Vec3; 4]; 4]) -> Result<Self, ShapeError> {
         for &p in points.iter().flatten() {
             finite("points", p)?;
@@ -152,6 +157,17 @@ impl BezierPatch {
         let diagonals = (points[3][3] - points[0][0]).cross(points[0][3] - points[3][0]);
         let fallback_normal = unit(diagonals).unwrap_or(Vec3::Z);
         let margin = 1e-9 * size + gamma(16) * magnitude.max_element();
+        let hierarchy = Hierarchy::build(&points, margin);
+        let bytes = size_of::<PatchData>()
+            + hierarchy.nodes.capacity() * size_of::<hierarchy::Node>()
+            + hierarchy.nets.capacity() * size_of::<ControlNet>();
+        let charge = MemoryBudget::current().charge(
+            "a Bézier patch's hierarchy",
+            bytes as u64,
+            "use fewer or flatter patches",
+        )?;
+        let mut held = Held::default();
+        held.keep(charge);
         Ok(Self {
             root: 0,
             data: Arc::new(PatchData {
@@ -160,7 +176,8 @@ impl BezierPatch {
                 size,
                 magnitude,
                 fallback_normal,
-                hierarchy: Hierarchy::build(&points, margin),
+                hierarchy,
+                held,
             }),
         })
     }
