@@ -6,7 +6,7 @@ use std::time::Instant;
 use clap::Args;
 use whitted::image::{Destination, ImageError, ImageFormat, check_destination};
 use whitted::limits::{InputFile, identify_input, inputs_read};
-use whitted::render::{Aov, Share, Window, render, render_selected};
+use whitted::render::{Aov, Share, Window, render, render_selected, slow_implicit_surfaces};
 
 use crate::arguments;
 use crate::progress::ProgressReport;
@@ -186,6 +186,11 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         u64::from(scene.settings.width) * u64::from(scene.settings.height),
         |s| s.pixel_count(),
     );
+    if !args.quiet {
+        for slow in slow_implicit_surfaces(&scene) {
+            note!("warning: {slow}");
+        }
+    }
     let bar = ProgressReport::new(total, args.quiet);
     let start = Instant::now();
     let output = match &selection {

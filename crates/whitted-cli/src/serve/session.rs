@@ -316,6 +316,9 @@ impl Session {
                 base = None;
                 match self.args.load(true) {
                     Ok(scene) => {
+                        for slow in whitted::render::slow_implicit_surfaces(&scene) {
+                            crate::report::note!("warning: {slow}");
+                        }
                         self.lock().scene_camera = Some(CameraView::of(&scene.camera));
                         base = Some(scene);
                     }

@@ -702,3 +702,38 @@ fn bezier_patches_past_the_budget_are_refused_while_read() {
     );
     assert_eq!(p.code(), Some(0), "{}", p.stderr);
 }
+
+/// Issue 50, item 10: an implicit surface whose march will be slow (here a
+/// bound 1e30, a million steps a ray) is warned of before the render,
+/// with the estimate and what to change; one whose bound fits is not.
+#[test]
+fn a_slow_implicit_surface_is_warned_of_before_the_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = |max_gradient: &str| {
+        format!(
+            "[render]\nwidth = 2\nheight = 2\n[camera]\neye = [0, 0, -5]\nlook_at = [0, 0, 0]\n\
+             fov = 10\n[materials.m]\ndiffuse = 0.8\n[[objects]]\nshape = \"implicit\"\n\
+             function = \"x^2 + y^2 + z^2 - 1\"\nbounds = [[-2, -2, -2], [2, 2, 2]]\n\
+             max_gradient = {max_gradient}\nmaterial = \"m\"\n"
+        )
+    };
+    write(dir.path(), "slow.toml", scene("1e30"));
+    write(dir.path(), "fine.toml", scene("8"));
+    let p = probe(&["render", "slow.toml", "-o", "slow.png"], dir.path());
+    assert_eq!(p.code(), Some(0), "{}", p.stderr);
+    let warning = p
+        .stderr
+        .lines()
+        .find(|l| l.starts_with("warning: the implicit surface objects[0]"))
+        .unwrap_or_else(|| panic!("{}", p.stderr));
+    assert!(
+        warning.contains("with max_gradient = 1e30 against values of about")
+            && warning.contains(
+                "its march takes about 1000000 steps, each an evaluation of 13 operations"
+            ),
+        "{warning}"
+    );
+    let p = probe(&["render", "fine.toml", "-o", "fine.png"], dir.path());
+    assert_eq!(p.code(), Some(0), "{}", p.stderr);
+    assert!(!p.stderr.contains("warning"), "{}", p.stderr);
+}

@@ -6,6 +6,7 @@ mod adaptive;
 mod camera;
 mod explain;
 mod gradient_note;
+mod implicit_cost;
 mod merge;
 mod non_finite;
 mod part;
@@ -26,6 +27,7 @@ pub use adaptive::{
 pub use camera::{Camera, CameraError};
 pub use explain::{ExplainError, Explainer, PixelExplanation, explain_pixel};
 pub use gradient_note::GradientExceeded;
+pub use implicit_cost::{SLOW_RAY_SECONDS, SlowImplicit, slow_implicit_surfaces};
 pub use merge::{MergeError, Merged, merge_parts};
 pub use part::{
     BUILT_IN_SCENE, Part, PartError, PartHeader, encode_part, parse_part, read_part, scene_sha256,

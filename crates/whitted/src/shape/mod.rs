@@ -51,7 +51,7 @@ pub use cone::Cone;
 pub use csg::{COINCIDENT, Csg, CsgChild, CsgError, CsgOperation, MAX_LEAVES};
 pub use cylinder::Cylinder;
 pub use disk::Disk;
-pub use implicit::{Expression, ExpressionError, Implicit};
+pub use implicit::{Expression, ExpressionError, Implicit, MIN_STEP, NAN_STEP};
 pub use parallelogram::Parallelogram;
 pub use plane::Plane;
 #[cfg(target_arch = "x86_64")]

@@ -528,6 +528,11 @@ impl Expression {
         &self.text
     }
 
+    /// How many operations one evaluation runs (after constant folding).
+    pub fn operations(&self) -> usize {
+        self.ops.len()
+    }
+
     /// True when the expression folded to a constant (it names no
     /// variable).
     pub fn is_constant(&self) -> bool {
