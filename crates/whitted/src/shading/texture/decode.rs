@@ -18,7 +18,7 @@ use std::io::Cursor;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use super::image::ImageData;
+use super::image::{ImageData, Texels};
 use crate::limits::{Charge, MemoryBudget, MemoryError};
 
 /// Why an image file gave no texture.
@@ -140,7 +140,13 @@ fn decode_png(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
     let size = reader
         .output_buffer_size()
         .ok_or("the image is too large")?;
-    let (charge, decoding_charge) = charge_texel_memory(width, height, size as u64)?;
+    let sample_bytes = if info.bit_depth == png::BitDepth::Sixteen {
+        2
+    } else {
+        1
+    };
+    let (charge, decoding_charge) =
+        charge_texel_memory(width, height, size as u64, 3 * sample_bytes)?;
     let mut buffer = vec![0; size];
     let info = reader.next_frame(&mut buffer).map_err(|e| e.to_string())?;
     let channels = match info.color_type {
@@ -153,31 +159,39 @@ fn decode_png(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
     let (width, height) = (width as usize, height as usize);
     let wide = info.bit_depth == png::BitDepth::Sixteen;
     let sample_bytes = if wide { 2 } else { 1 };
-    let table = eight_bit_table(decoding);
-    let sample = |at: &[u8]| -> f32 {
-        if wide {
-            texel_value(
-                f32::from(u16::from_be_bytes([at[0], at[1]])) / 65535.0,
-                decoding,
-            )
-        } else {
-            table[usize::from(at[0])]
+    let alpha = (decoding == Decoding::Opacity && channels % 2 == 0).then_some(channels - 1);
+    // Each texel's three samples: the alpha channel's three times, grey's
+    // three times, or red, green and blue.
+    let samples = |pixel: &[u8], read: &dyn Fn(&[u8]) -> u16| -> [u16; 3] {
+        let value = |channel: usize| read(&pixel[channel * sample_bytes..]);
+        match alpha {
+            Some(channel) => [value(channel); 3],
+            None if channels < 3 => [value(0); 3],
+            None => [value(0), value(1), value(2)],
         }
     };
-    let alpha = (decoding == Decoding::Opacity && channels % 2 == 0).then_some(channels - 1);
-    let mut texels = Vec::with_capacity(width * height);
-    for row in buffer.chunks(info.line_size).take(height) {
-        for pixel in row.chunks_exact(channels * sample_bytes).take(width) {
-            let value = |channel: usize| sample(&pixel[channel * sample_bytes..]);
-            texels.push(match alpha {
-                Some(channel) => [value(channel); 3],
-                None if channels < 3 => [value(0); 3],
-                None => [value(0), value(1), value(2)],
-            });
-        }
-    }
+    let pixels = || {
+        buffer
+            .chunks(info.line_size)
+            .take(height)
+            .flat_map(|row| row.chunks_exact(channels * sample_bytes).take(width))
+    };
+    let texels = if wide {
+        let words = pixels()
+            .map(|p| samples(p, &|at| u16::from_be_bytes([at[0], at[1]])))
+            .collect();
+        let table: Arc<[f32]> = (0..=u16::MAX)
+            .map(|v| texel_value(f32::from(v) / 65535.0, decoding))
+            .collect();
+        Texels::Words(words, table)
+    } else {
+        let bytes = pixels()
+            .map(|p| samples(p, &|at| u16::from(at[0])).map(|v| v as u8))
+            .collect();
+        Texels::Bytes(bytes, Arc::new(eight_bit_table(decoding)))
+    };
     drop((buffer, decoding_charge));
-    ImageData::new(width, height, texels)
+    ImageData::stored(width, height, texels)
         .map(|data| data.holding(charge))
         .ok_or_else(|| "the image data is truncated".to_string())
 }
@@ -194,19 +208,25 @@ fn claims_too_much(width: u32, height: u32, file_bytes: usize) -> String {
     )
 }
 
-/// Bytes an image keeps per texel: its linear RGB texel (12) and its share
-/// of the mipmap's levels below it (at most a third of that).
-const KEPT_BYTES_PER_TEXEL: u64 = 16;
+/// Bytes of the mipmap's levels per texel of the image: a third of a
+/// linear RGB texel (12 bytes), at most.
+const MIPMAP_BYTES_PER_TEXEL: u64 = 4;
 
-/// Charges the memory ledger for an image of `width` × `height`: what it
-/// keeps ([`KEPT_BYTES_PER_TEXEL`]), and apart, the `decoded` bytes the
-/// decoder fills first, given back once the texels are made. Refused when
-/// they do not fit beside what the run holds.
-fn charge_texel_memory(width: u32, height: u32, decoded: u64) -> Result<(Charge, Charge), String> {
+/// Charges the memory ledger for an image of `width` × `height` kept at
+/// `texel_bytes` a texel (3 for 8-bit samples, 6 for 16-bit): what it keeps
+/// with its mipmap ([`MIPMAP_BYTES_PER_TEXEL`] more), and apart, the
+/// `decoded` bytes the decoder fills first, given back once the texels are
+/// made. Refused when they do not fit beside what the run holds.
+fn charge_texel_memory(
+    width: u32,
+    height: u32,
+    decoded: u64,
+    texel_bytes: u64,
+) -> Result<(Charge, Charge), String> {
     let texels = u64::from(width) * u64::from(height);
     let budget = MemoryBudget::current();
     let what = format!("decoding its {width}x{height} texels");
-    let kept = texels.saturating_mul(KEPT_BYTES_PER_TEXEL);
+    let kept = texels.saturating_mul(texel_bytes + MIPMAP_BYTES_PER_TEXEL);
     let refused = |e: MemoryError| e.to_string();
     budget
         .check(&what, kept.saturating_add(decoded), "use a smaller image")
@@ -251,16 +271,14 @@ fn decode_jpeg(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
             claims_too_much(width as u32, height as u32, bytes.len())
         ));
     }
-    let (charge, decoding_charge) = charge_texel_memory(width as u32, height as u32, claimed * 3)?;
+    let (charge, decoding_charge) =
+        charge_texel_memory(width as u32, height as u32, claimed * 3, 3)?;
     let pixels = decoder.decode().map_err(|e| e.to_string())?;
     let (width, height) = decoder.dimensions().ok_or("no image size")?;
-    let table = eight_bit_table(decoding);
-    let texels = pixels
-        .chunks_exact(3)
-        .map(|p| [0, 1, 2].map(|c| table[usize::from(p[c])]))
-        .collect();
+    let texels = pixels.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
     drop((pixels, decoding_charge));
-    ImageData::new(width, height, texels)
+    let texels = Texels::Bytes(texels, Arc::new(eight_bit_table(decoding)));
+    ImageData::stored(width, height, texels)
         .map(|data| data.holding(charge))
         .ok_or_else(|| "the image data is truncated".to_string())
 }
@@ -484,6 +502,37 @@ pub(crate) mod tests {
             error.starts_with("the header claims 9000x9000 pixels"),
             "{error}"
         );
+    }
+
+    /// Issue 50, item 5: 8-bit and 16-bit samples are kept as such, each
+    /// read through the table of its value: the values the decoder made
+    /// before, when it stored them as 32-bit floats, in a quarter or half
+    /// of the memory.
+    #[test]
+    fn samples_are_kept_at_their_precision_and_read_as_the_same_values() {
+        let rgb: Vec<u8> = (0..=255u8).flat_map(|v| [v, 255 - v, v / 2]).collect();
+        let eight = decode_image(&png_bytes(16, 16, &rgb), Decoding::Color).unwrap();
+        let table = eight_bit_table(Decoding::Color);
+        let mut words = Vec::new();
+        let mut encoder = png::Encoder::new(&mut words, 256, 1);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Sixteen);
+        let samples: Vec<u16> = (0..256u16).map(|i| i * 257 - i % 7).collect();
+        let data: Vec<u8> = samples.iter().flat_map(|v| v.to_be_bytes()).collect();
+        let mut writer = encoder.write_header().unwrap();
+        writer.write_image_data(&data).unwrap();
+        writer.finish().unwrap();
+        let sixteen = decode_image(&words, Decoding::Color).unwrap();
+        for i in 0..256 {
+            let (x, y) = (i % 16, i / 16);
+            let expected =
+                [rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]].map(|v| table[usize::from(v)]);
+            assert_eq!(eight.texel_values(x, y), expected, "8-bit texel {i}");
+            let value = texel_value(f32::from(samples[i]) / 65535.0, Decoding::Color);
+            assert_eq!(sixteen.texel_values(i, 0), [value; 3], "16-bit texel {i}");
+        }
+        assert_eq!(eight.bytes_per_texel(), 3);
+        assert_eq!(sixteen.bytes_per_texel(), 6);
     }
 
     #[test]

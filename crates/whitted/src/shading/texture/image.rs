@@ -17,12 +17,72 @@ use crate::shading::Color;
 
 use crate::math::DVec2;
 
+/// Texels as stored: linear RGB values, or the image's own 8-bit or
+/// 16-bit samples with the table of the values they stand for (each value
+/// then read from the table: the same numbers, in a quarter or half of the
+/// memory).
+#[derive(Clone, PartialEq)]
+pub enum Texels {
+    /// Linear RGB values.
+    Values(Vec<[f32; 3]>),
+    /// 8-bit samples and the value of each.
+    Bytes(Vec<[u8; 3]>, Arc<[f32; 256]>),
+    /// 16-bit samples and the value of each.
+    Words(Vec<[u16; 3]>, Arc<[f32]>),
+}
+
+impl Texels {
+    /// How many texels.
+    pub fn len(&self) -> usize {
+        match self {
+            Texels::Values(v) => v.len(),
+            Texels::Bytes(v, _) => v.len(),
+            Texels::Words(v, _) => v.len(),
+        }
+    }
+
+    /// True when there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Texel `i`'s values.
+    #[inline]
+    pub fn get(&self, i: usize) -> [f32; 3] {
+        match self {
+            Texels::Values(v) => v[i],
+            Texels::Bytes(v, table) => v[i].map(|s| table[usize::from(s)]),
+            Texels::Words(v, table) => v[i].map(|s| table[usize::from(s)]),
+        }
+    }
+
+    /// The values of texels `at`, the storage looked at once for the four
+    /// (a bilinear lookup's).
+    #[inline]
+    fn four(&self, at: [usize; 4]) -> [[f32; 3]; 4] {
+        match self {
+            Texels::Values(v) => at.map(|i| v[i]),
+            Texels::Bytes(v, table) => at.map(|i| v[i].map(|s| table[usize::from(s)])),
+            Texels::Words(v, table) => at.map(|i| v[i].map(|s| table[usize::from(s)])),
+        }
+    }
+
+    /// Bytes a texel takes.
+    pub fn bytes_per_texel(&self) -> usize {
+        match self {
+            Texels::Values(_) => 12,
+            Texels::Bytes(..) => 3,
+            Texels::Words(..) => 6,
+        }
+    }
+}
+
 /// Decoded texels in linear RGB, row 0 at the top of the image.
 #[derive(Clone)]
 pub struct ImageData {
     width: usize,
     height: usize,
-    texels: Vec<[f32; 3]>,
+    texels: Texels,
     max_component: f64,
     mean: Color,
     /// Its mipmap, built by the first filtered lookup.
@@ -48,14 +108,20 @@ impl ImageData {
     /// An image of `width × height` linear RGB texels, row by row from the
     /// top; `None` when a side is zero or the count does not match.
     pub fn new(width: usize, height: usize, texels: Vec<[f32; 3]>) -> Option<Self> {
+        Self::stored(width, height, Texels::Values(texels))
+    }
+
+    /// An image of `width × height` texels stored as `texels` are.
+    pub fn stored(width: usize, height: usize, texels: Texels) -> Option<Self> {
         if width == 0 || height == 0 || width.checked_mul(height) != Some(texels.len()) {
             return None;
         }
-        let max_component = texels
-            .iter()
+        let values = (0..texels.len()).map(|i| texels.get(i));
+        let max_component = values
+            .clone()
             .flatten()
-            .fold(0.0f64, |m, &c| m.max(f64::from(c)));
-        let sum = texels.iter().fold(Color::ZERO, |sum, &[r, g, b]| {
+            .fold(0.0f64, |m, c| m.max(f64::from(c)));
+        let sum = values.fold(Color::ZERO, |sum, [r, g, b]| {
             sum + Color::new(f64::from(r), f64::from(g), f64::from(b))
         });
         let mean = sum / texels.len() as f64;
@@ -80,7 +146,7 @@ impl ImageData {
     /// Its mipmap pyramid, built once on first use.
     pub fn mipmap(&self) -> &Mipmap {
         self.mipmap
-            .get_or_init(|| Mipmap::build(self.width, self.height, &self.texels))
+            .get_or_init(|| Mipmap::build(self.width, self.height, |i| self.texels.get(i)))
     }
 
     /// The mean of all texels.
@@ -98,10 +164,16 @@ impl ImageData {
         self.height
     }
 
-    /// The texel in column `x`, row `y` from the top (both in range).
-    fn texel(&self, x: usize, y: usize) -> Color {
-        let [r, g, b] = self.texels[y * self.width + x];
-        Color::new(f64::from(r), f64::from(g), f64::from(b))
+    /// The values of the texel in column `x`, row `y` from the top (both
+    /// in range).
+    pub fn texel_values(&self, x: usize, y: usize) -> [f32; 3] {
+        self.texels.get(y * self.width + x)
+    }
+
+    /// Bytes each texel takes as stored (3 for 8-bit samples, 6 for
+    /// 16-bit, 12 for linear values).
+    pub fn bytes_per_texel(&self) -> usize {
+        self.texels.bytes_per_texel()
     }
 }
 
@@ -184,8 +256,18 @@ impl ImageTexture {
         let (x0, y0) = (x0 as i64, y0 as i64);
         let xs = [x0, x0.saturating_add(1)].map(|i| self.wrap.index(i, data.width));
         let ys = [y0, y0.saturating_add(1)].map(|i| self.wrap.index(i, data.height));
-        let top = data.texel(xs[0], ys[0]) * (1.0 - fx) + data.texel(xs[1], ys[0]) * fx;
-        let bottom = data.texel(xs[0], ys[1]) * (1.0 - fx) + data.texel(xs[1], ys[1]) * fx;
+        let w = data.width;
+        let [a, b, c, d] = data
+            .texels
+            .four([
+                ys[0] * w + xs[0],
+                ys[0] * w + xs[1],
+                ys[1] * w + xs[0],
+                ys[1] * w + xs[1],
+            ])
+            .map(|[r, g, b]| Color::new(f64::from(r), f64::from(g), f64::from(b)));
+        let top = a * (1.0 - fx) + b * fx;
+        let bottom = c * (1.0 - fx) + d * fx;
         top * (1.0 - fy) + bottom * fy
     }
 

@@ -41,54 +41,72 @@ pub struct Mipmap {
 }
 
 impl Mipmap {
-    /// The pyramid of a `width × height` image of `texels`.
-    pub fn build(width: usize, height: usize, texels: &[[f32; 3]]) -> Self {
+    /// The pyramid of a `width × height` image whose texel `i` (row by
+    /// row from the top) is `texel(i)`. The image is read where it is,
+    /// not copied, and each level is made a row at a time, so building
+    /// takes the levels' memory and a few rows' more.
+    pub fn build(width: usize, height: usize, texel: impl Fn(usize) -> [f32; 3]) -> Self {
         let mut levels: Vec<MipLevel> = Vec::new();
-        let mut current = MipLevel {
-            width,
-            height,
-            texels: texels.to_vec(),
-        };
-        while current.width > 1 || current.height > 1 {
-            let next = halve(&current);
-            levels.push(next.clone());
-            current = next;
+        if width > 1 || height > 1 {
+            levels.push(halve(width, height, texel));
+        }
+        while let Some(last) = levels.last().filter(|l| l.width > 1 || l.height > 1) {
+            let next = halve(last.width, last.height, |i| last.texels[i]);
+            levels.push(next);
         }
         Self { levels }
     }
 }
 
-/// The level of half the size (rounded up), by area-weighted box
-/// filtering: rows first, then columns.
-fn halve(level: &MipLevel) -> MipLevel {
-    let (w, h) = (level.width, level.height);
+/// The level of half the size (rounded up) of a `w × h` level whose texel
+/// `i` is `texel(i)`, by area-weighted box filtering: rows first, then
+/// columns. Each output row sums, in f64, the rows it covers, each summed
+/// along the row first.
+fn halve(w: usize, h: usize, texel: impl Fn(usize) -> [f32; 3]) -> MipLevel {
     let (nw, nh) = (w.div_ceil(2), h.div_ceil(2));
     let wx = box_weights(w, nw);
     let wy = box_weights(h, nh);
-    // Horizontal pass: h rows of nw texels.
-    let mut rows = vec![[0.0f64; 3]; h * nw];
-    for y in 0..h {
-        for (x, weights) in wx.iter().enumerate() {
-            let out = &mut rows[y * nw + x];
+    // The horizontal pass of input row `y`: nw texels.
+    let horizontal = |y: usize, row: &mut Vec<[f64; 3]>| {
+        row.clear();
+        row.extend(wx.iter().map(|weights| {
+            let mut out = [0.0f64; 3];
             for &(i, weight) in weights {
-                let t = level.texels[y * w + i];
+                let t = texel(y * w + i);
                 for c in 0..3 {
                     out[c] += weight * f64::from(t[c]);
                 }
             }
+            out
+        }));
+    };
+    let mut texels = Vec::with_capacity(nw * nh);
+    // The input rows the last output row covered, by number: the next one
+    // may share its first row with them.
+    let mut rows: Vec<(usize, Vec<[f64; 3]>)> = Vec::new();
+    for weights in &wy {
+        let mut next = Vec::with_capacity(weights.len());
+        for &(j, _) in weights {
+            let row = match rows.iter().position(|(k, _)| *k == j) {
+                Some(at) => rows.swap_remove(at).1,
+                None => {
+                    let mut row = Vec::with_capacity(nw);
+                    horizontal(j, &mut row);
+                    row
+                }
+            };
+            next.push((j, row));
         }
-    }
-    let mut texels = vec![[0.0f32; 3]; nw * nh];
-    for (y, weights) in wy.iter().enumerate() {
+        rows = next;
         for x in 0..nw {
             let mut sum = [0.0f64; 3];
-            for &(j, weight) in weights {
-                let t = rows[j * nw + x];
+            for ((_, row), &(_, weight)) in rows.iter().zip(weights) {
+                let t = row[x];
                 for c in 0..3 {
                     sum[c] += weight * t[c];
                 }
             }
-            texels[y * nw + x] = sum.map(|c| c as f32);
+            texels.push(sum.map(|c| c as f32));
         }
     }
     MipLevel {
@@ -206,7 +224,7 @@ mod tests {
     #[test]
     fn level_sizes_halve_rounding_up_down_to_one_texel() {
         let sizes = |w, h| {
-            Mipmap::build(w, h, &vec![[0.0; 3]; w * h])
+            Mipmap::build(w, h, |_| [0.0; 3])
                 .levels
                 .iter()
                 .map(|l| (l.width, l.height))
@@ -221,7 +239,7 @@ mod tests {
     #[test]
     fn a_constant_image_stays_constant_on_every_level() {
         let c = [0.25f32, 0.5, 0.75];
-        let m = Mipmap::build(13, 6, &vec![c; 13 * 6]);
+        let m = Mipmap::build(13, 6, |_| c);
         for level in &m.levels {
             for t in &level.texels {
                 for k in 0..3 {
@@ -240,7 +258,7 @@ mod tests {
                 height: h,
                 texels: texels.clone(),
             });
-            for level in Mipmap::build(w, h, &texels).levels {
+            for level in Mipmap::build(w, h, |i| texels[i]).levels {
                 let m = mean(&level);
                 for c in 0..3 {
                     assert!((m[c] - full[c]).abs() < 1e-6, "{w}x{h}: {m:?} {full:?}");
