@@ -918,6 +918,23 @@ fn push_aovs(
 mod tests {
     use super::*;
 
+    /// The integrator of `scene`'s settings over `prepared`'s world, as the
+    /// tests here need it (no caustic map).
+    fn plain_integrator<'a>(scene: &'a Scene, prepared: &'a Prepared<'a>) -> Integrator<'a> {
+        let settings = &scene.settings;
+        let limits = RecursionLimits {
+            max_depth: settings.max_depth,
+            min_weight: settings.min_weight,
+            ray_budget: SECONDARY_RAY_BUDGET,
+        };
+        Integrator::new(
+            settings.integrator,
+            &prepared.world,
+            shading_of(scene),
+            limits,
+        )
+    }
+
     /// A glass ball that reflects and transmits everything, in a mirror
     /// box: its ray tree grows at every bounce and no weight decays.
     const GLASS_IN_MIRRORS: &str = include_str!("../../tests/hostile_scenes/glass_in_mirrors.toml");
@@ -1085,17 +1102,7 @@ mod tests {
             scene.settings.aovs = aovs;
             let prepared = Prepared::new(&scene).unwrap();
             let settings = &scene.settings;
-            let limits = RecursionLimits {
-                max_depth: settings.max_depth,
-                min_weight: settings.min_weight,
-                ray_budget: SECONDARY_RAY_BUDGET,
-            };
-            let integrator = Integrator::new(
-                settings.integrator,
-                &prepared.world,
-                shading_of(&scene),
-                limits,
-            );
+            let integrator = plain_integrator(&scene, &prepared);
             let (width, height) = (settings.width, settings.height);
             let grid = WorldOnImage::new(&scene.camera, width, height, &prepared.world).unwrap();
             let window = PixelSelection {
@@ -1174,17 +1181,7 @@ mod tests {
             scene.settings.aa = aa;
             let prepared = Prepared::new(&scene).unwrap();
             let settings = &scene.settings;
-            let limits = RecursionLimits {
-                max_depth: settings.max_depth,
-                min_weight: settings.min_weight,
-                ray_budget: SECONDARY_RAY_BUDGET,
-            };
-            let integrator = Integrator::new(
-                settings.integrator,
-                &prepared.world,
-                shading_of(&scene),
-                limits,
-            );
+            let integrator = plain_integrator(&scene, &prepared);
             let whole = PixelSelection::whole(16, 16);
             let tile = |cancel: &AtomicBool| {
                 render_tile(
