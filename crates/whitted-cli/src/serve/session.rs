@@ -316,9 +316,16 @@ impl Session {
                 base = None;
                 match self.args.load(true) {
                     Ok(scene) => {
-                        for slow in whitted::render::slow_implicit_surfaces(&scene) {
-                            crate::report::note!("warning: {slow}");
+                        let warnings: Vec<String> = whitted::render::slow_implicit_surfaces(&scene)
+                            .iter()
+                            .map(|slow| format!("warning: {slow}"))
+                            .collect();
+                        for warning in &warnings {
+                            crate::report::note!("{warning}");
                         }
+                        // Sent even when empty: the page then clears the
+                        // last scene's.
+                        self.publish("warnings", json!({ "request": done, "messages": warnings }));
                         self.lock().scene_camera = Some(CameraView::of(&scene.camera));
                         base = Some(scene);
                     }

@@ -319,7 +319,7 @@ fn a_newer_scene_cancels_the_pass_under_way_within_a_pixel() {
     std::thread::sleep(Duration::from_millis(500));
     let start = Instant::now();
     std::fs::write(server.scene(), scene_text()).unwrap();
-    let (name, frame) = events.next();
+    let (name, frame) = events.until(|name, _| name == "frame").pop().unwrap();
     let waited = start.elapsed();
     eprintln!("the new scene's first frame came {waited:?} after it was saved");
     assert_eq!(name, "frame", "{frame}");
@@ -396,4 +396,33 @@ fn refusals_quote_long_requests_at_a_lines_width() {
     assert_eq!(status, 400);
     assert!(text.len() < 500, "{text}");
     assert!(text.contains("…"), "{text}");
+}
+
+/// Issue 50, item 10: an implicit surface estimated slow is warned of on
+/// the page, and the warning goes when the scene is fixed.
+#[test]
+fn a_slow_implicit_surface_is_warned_of_on_the_page() {
+    let scene = |max_gradient: &str| {
+        format!(
+            "[render]\nwidth = 2\nheight = 2\n[camera]\neye = [0, 0, -5]\nlook_at = [0, 0, 0]\n\
+             fov = 10\n[materials.m]\ndiffuse = 0.8\n[[objects]]\nshape = \"implicit\"\n\
+             function = \"x^2 + y^2 + z^2 - 1\"\nbounds = [[-2, -2, -2], [2, 2, 2]]\n\
+             max_gradient = {max_gradient}\nmaterial = \"m\"\n"
+        )
+    };
+    let server = Server::start(&scene("1e30"), &["--width", "4", "--height", "4"]);
+    let mut events = server.events();
+    let (_, warnings) = events.until(|name, _| name == "warnings").pop().unwrap();
+    let messages = warnings["messages"].as_array().unwrap();
+    assert_eq!(messages.len(), 1, "{warnings}");
+    assert!(
+        messages[0]
+            .as_str()
+            .unwrap()
+            .starts_with("warning: the implicit surface objects[0]"),
+        "{warnings}"
+    );
+    std::fs::write(server.scene(), scene("8")).unwrap();
+    let (_, warnings) = events.until(|name, _| name == "warnings").pop().unwrap();
+    assert_eq!(warnings["messages"], serde_json::json!([]), "{warnings}");
 }

@@ -63,6 +63,11 @@ events.addEventListener("frame", (e) => {
     `${frame.rays} rays in ${(frame.render_seconds * 1000).toFixed(0)} ms, ` +
     `${(frame.rays_per_second / 1e6).toFixed(2)} M rays/s`;
 });
+events.addEventListener("warnings", (e) => {
+  const warnings = JSON.parse(e.data);
+  $("warnings").textContent = warnings.messages.join("\n");
+  $("warnings").hidden = warnings.messages.length === 0;
+});
 events.addEventListener("error", (e) => {
   if (!e.data) return; // the connection dropped; EventSource reconnects
   const error = JSON.parse(e.data);
