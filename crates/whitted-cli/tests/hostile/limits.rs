@@ -724,12 +724,15 @@ fn bezier_patches_past_the_budget_are_refused_while_read() {
 #[test]
 fn a_slow_implicit_surface_is_warned_of_before_the_render() {
     let dir = tempfile::tempdir().unwrap();
+    let slow = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../whitted/tests/hostile_scenes/slow_implicit.toml"),
+    )
+    .unwrap();
     let scene = |max_gradient: &str| {
-        format!(
-            "[render]\nwidth = 2\nheight = 2\n[camera]\neye = [0, 0, -5]\nlook_at = [0, 0, 0]\n\
-             fov = 10\n[materials.m]\ndiffuse = 0.8\n[[objects]]\nshape = \"implicit\"\n\
-             function = \"x^2 + y^2 + z^2 - 1\"\nbounds = [[-2, -2, -2], [2, 2, 2]]\n\
-             max_gradient = {max_gradient}\nmaterial = \"m\"\n"
+        slow.replace(
+            "max_gradient = 1e30",
+            &format!("max_gradient = {max_gradient}"),
         )
     };
     write(dir.path(), "slow.toml", scene("1e30"));
