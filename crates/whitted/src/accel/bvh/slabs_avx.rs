@@ -200,9 +200,21 @@ impl SlabTest for Avx {
 mod tests {
     use super::*;
     use crate::accel::bvh::node::round_up;
-    use crate::accel::bvh::slabs::tests::random_cases;
+    use crate::accel::bvh::slabs::tests::{assert_conservative, face_cases, random_cases};
     use crate::accel::bvh::slabs::{Halves, Planes};
     use crate::math::random::Rng;
+
+    #[test]
+    fn rays_from_faces_far_origins_and_grazing_rays_keep_their_boxes() {
+        if !crate::math::test_support::has_avx_or_skip_allowed() {
+            return;
+        }
+        let kept: u32 = face_cases(48)
+            .iter()
+            .map(|(node, ray, t_max)| assert_conservative::<Avx>(node, ray, *t_max).count_ones())
+            .sum();
+        assert!(kept > 5_000, "{kept}");
+    }
 
     #[test]
     fn agrees_with_the_two_halves_bit_for_bit() {
