@@ -215,6 +215,10 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
             continue;
         }
         status.set(format!("building {}", kind.name()));
+        // Held while the structure is measured.
+        let _world_charge =
+            whitted::render::charge_world(&scene.objects, (kind, kind), MemoryBudget::current())
+                .map_err(|e| e.to_string())?;
         let (world, build_seconds) = time_build(&scene, kind, args.runs);
         let stats = world.accelerator().stats();
         let mut kind_reports = Vec::new();

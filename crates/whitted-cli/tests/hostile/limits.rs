@@ -755,3 +755,64 @@ fn a_slow_implicit_surface_is_warned_of_before_the_render() {
     assert_eq!(p.code(), Some(0), "{}", p.stderr);
     assert!(!p.stderr.contains("warning"), "{}", p.stderr);
 }
+
+/// An OBJ grid of `n` x `n` vertices: 2(n - 1)² triangles.
+fn grid_obj(n: usize) -> String {
+    let mut text = String::new();
+    for i in 0..n {
+        for j in 0..n {
+            text.push_str(&format!("v {i} {j} {}\n", (i * j) % 3));
+        }
+    }
+    for i in 0..n - 1 {
+        for j in 0..n - 1 {
+            let a = i * n + j + 1;
+            text.push_str(&format!("f {a} {} {}\n", a + 1, a + n));
+            text.push_str(&format!("f {} {} {}\n", a + 1, a + n + 1, a + n));
+        }
+    }
+    text
+}
+
+/// Item 5's rule for geometry: the world (its meshes, entries and
+/// structures, as estimated) is charged before it is built, so a model
+/// whose kd-tree would not fit is refused with what it needs before the
+/// tree is built; a structure that fits passes.
+#[test]
+fn geometry_and_structures_beyond_the_budget_are_refused_before_they_are_built() {
+    let dir = tempfile::tempdir().unwrap();
+    // 64,082 triangles.
+    write(dir.path(), "grid.obj", grid_obj(180));
+    let small = ["--width", "8", "--height", "8", "--max-memory", "32M"];
+    let render = |accel: &str| {
+        let mut args = vec!["render", "grid.obj", "-o", "out.png", "--accel", accel];
+        args.extend(small);
+        probe(&args, dir.path())
+    };
+    let p = render("kdtree");
+    assert_eq!(p.code(), Some(1), "{}", p.stderr);
+    assert!(
+        p.stderr.contains(
+            "error: the scene's geometry with its kdtree structures needs 41.3 MiB; the memory \
+             budget is 32.0 MiB (as given): use a smaller model, or a structure that takes less \
+             (the kd-tree takes the most, then the BVH), or raise the budget with --max-memory"
+        ),
+        "{}",
+        p.stderr
+    );
+    assert!(!dir.path().join("out.png").exists());
+    assert!(p.peak_bytes < 100 * MIB, "{}", p.peak_bytes);
+    let p = render("bvh");
+    assert_eq!(p.code(), Some(0), "{}", p.stderr);
+    // The bench reads positions only (no vertex normals): a little less.
+    let mut args = vec!["bench", "grid.obj", "--accel", "bvh,kdtree", "--runs", "1"];
+    args.extend(small);
+    let p = probe(&args, dir.path());
+    assert_eq!(p.code(), Some(1), "{}", p.stderr);
+    assert!(
+        p.stderr
+            .contains("the scene's geometry with its kdtree structures needs 40.6 MiB"),
+        "{}",
+        p.stderr
+    );
+}

@@ -106,6 +106,20 @@ impl AccelKind {
     pub fn from_name(name: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|k| k.name() == name)
     }
+
+    /// An estimate of the most bytes a structure of this kind takes per
+    /// primitive while it is built and used: its boxes, scratch and nodes
+    /// (the kd-tree's references clipped to its cells included). Measured
+    /// on the bunny and the dragon (docs/performance-log.md, "Large
+    /// models"), rounded up; an estimate, not a bound.
+    pub fn bytes_per_primitive(self) -> u64 {
+        match self {
+            AccelKind::Linear => 48,
+            AccelKind::Grid => 96,
+            AccelKind::Bvh => 160,
+            AccelKind::KdTree => 512,
+        }
+    }
 }
 
 /// What every acceleration structure offers, checked by the compiler;

@@ -142,6 +142,14 @@ impl TriangleMesh {
         self.triangles.len()
     }
 
+    /// The bytes its vertices and triangles take.
+    pub fn heap_bytes(&self) -> u64 {
+        (self.positions.len() * size_of::<Vec3>()
+            + self.normals.len() * size_of::<Vec3>()
+            + self.uvs.len() * size_of::<DVec2>()
+            + self.triangles.len() * size_of::<[u32; 3]>()) as u64
+    }
+
     /// True when it has no triangles.
     pub fn is_empty(&self) -> bool {
         self.triangles.is_empty()

@@ -22,6 +22,7 @@ use crate::integrator::{
     CausticMap, DEFAULT_MAX_TREE_RAYS, Integrator, RayCounts, RayNode, RayTreeRecorder,
     RecursionLimits, SECONDARY_RAY_BUDGET, Unobserved,
 };
+use crate::limits::Charge;
 use crate::math::DVec2;
 use crate::render::adaptive::{AdaptivePixels, Cost};
 use crate::render::sample_ray::{
@@ -124,6 +125,8 @@ pub struct Explainer<'s> {
     world: World<'s>,
     caustics: Option<CausticMap>,
     max_tree_rays: u64,
+    /// The world's estimated memory, charged while it lives.
+    _world_charge: Charge,
 }
 
 impl<'s> Explainer<'s> {
@@ -132,6 +135,7 @@ impl<'s> Explainer<'s> {
         let settings = &scene.settings;
         settings.check()?;
         super::check_objects(&scene.objects)?;
+        let world_charge = super::charge_world_of(scene).map_err(RenderError::from)?;
         // As `render` builds them.
         let world = super::build_world(scene);
         let caustics = on_deep_stack(settings.max_depth, || {
@@ -143,6 +147,7 @@ impl<'s> Explainer<'s> {
             world,
             caustics: caustics.map(|(map, _)| map),
             max_tree_rays: DEFAULT_MAX_TREE_RAYS,
+            _world_charge: world_charge,
         })
     }
 

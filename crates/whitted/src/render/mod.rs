@@ -34,7 +34,7 @@ pub use part::{
 };
 pub use photon_pass::PhotonReport;
 pub use prepared::{Pass, Prepared};
-pub use resources::{RayBudgetCut, ThreadClamp, memory_needed};
+pub use resources::{RayBudgetCut, ThreadClamp, charge_world, memory_needed};
 pub use scene::Scene;
 pub use selection::{PixelSelection, SelectionError, Share, Window};
 pub use settings::{
@@ -48,13 +48,13 @@ use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Mutex, PoisonError};
 
-use crate::accel::QueryContext;
+use crate::accel::{AccelKind, QueryContext};
 use crate::image::{ColorSpace, Film};
 use crate::integrator::{
     FirstHit, Integrator, RayCounts, RayKind, RecursionLimits, SECONDARY_RAY_BUDGET, Shading,
     Unobserved,
 };
-use crate::limits::{MemoryBudget, MemoryError};
+use crate::limits::{Charge, MemoryBudget, MemoryError};
 use crate::math::{DVec2, Ray, Vec3};
 use crate::shading::Color;
 use crate::world::{Hit, MAX_PRIMITIVES, MaterialId, PACKET_SIZE, Surface, World};
@@ -101,11 +101,26 @@ pub fn check_objects(objects: &crate::world::Objects) -> Result<(), RenderError>
 /// The world of `scene`, its structures of the kinds its settings ask for
 /// (shared by [`render`] and [`explain_pixel`], which must trace the same).
 fn build_world(scene: &Scene) -> World<'_> {
-    let settings = &scene.settings;
-    World::build_levels(
-        &scene.objects,
+    let (top, bottom) = world_kinds(&scene.settings);
+    World::build_levels(&scene.objects, top, bottom)
+}
+
+/// The structure kinds of a world's top level and of its instances, as
+/// `settings` ask for them.
+fn world_kinds(settings: &RenderSettings) -> (AccelKind, AccelKind) {
+    (
         settings.accel_top.unwrap_or(settings.accel),
         settings.accel_bottom.unwrap_or(settings.accel),
+    )
+}
+
+/// [`resources::charge_world`] for the world [`build_world`] builds of
+/// `scene`.
+fn charge_world_of(scene: &Scene) -> Result<Charge, MemoryError> {
+    resources::charge_world(
+        &scene.objects,
+        world_kinds(&scene.settings),
+        MemoryBudget::current(),
     )
 }
 

@@ -14,7 +14,7 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use crate::integrator::CausticMap;
-use crate::limits::MemoryBudget;
+use crate::limits::{Charge, MemoryBudget};
 use crate::render::photon_pass::{self, PhotonReport};
 use crate::render::{
     Aov, Camera, PixelSelection, Progress, RenderError, RenderOutput, RenderSettings, Scene,
@@ -68,6 +68,8 @@ pub struct Prepared<'s> {
     pub(super) world: World<'s>,
     pub(super) caustics: Option<(CausticMap, PhotonReport)>,
     build_seconds: f64,
+    /// The world's estimated memory, charged while it lives.
+    _world_charge: Charge,
 }
 
 impl<'s> Prepared<'s> {
@@ -79,6 +81,7 @@ impl<'s> Prepared<'s> {
         settings.check()?;
         super::check_objects(&scene.objects)?;
         super::resources::check_memory(settings, MemoryBudget::current())?;
+        let world_charge = super::charge_world_of(scene)?;
         let start = Instant::now();
         let world = super::build_world(scene);
         let build_seconds = start.elapsed().as_secs_f64();
@@ -94,6 +97,7 @@ impl<'s> Prepared<'s> {
             world,
             caustics,
             build_seconds,
+            _world_charge: world_charge,
         })
     }
 

@@ -4,10 +4,11 @@
 
 use std::fmt;
 
+use crate::accel::AccelKind;
 use crate::integrator::SECONDARY_RAY_BUDGET;
 use crate::limits::{Charge, MemoryBudget, MemoryError};
 use crate::render::{Aov, RenderSettings};
-use crate::world::MaterialId;
+use crate::world::{MaterialId, Objects};
 
 /// Bytes per pixel of encoding the largest output: an EXR's copy of three
 /// float channels and its compressed blocks.
@@ -56,6 +57,28 @@ pub(super) fn charge_memory(
         &films_named(settings),
         memory_needed(settings),
         FILMS_REMEDY,
+    )
+}
+
+/// Charges a world of `objects` with structures of kind `top` and
+/// `bottom` as [`Objects::estimated_world_bytes`] estimates it (its
+/// geometry and structures), before it is built: hold the charge as long
+/// as the world.
+pub fn charge_world(
+    objects: &Objects,
+    (top, bottom): (AccelKind, AccelKind),
+    budget: MemoryBudget,
+) -> Result<Charge, MemoryError> {
+    let structures = if top == bottom {
+        format!("its {} structures", top.name())
+    } else {
+        format!("its {} and {} structures", top.name(), bottom.name())
+    };
+    budget.charge(
+        &format!("the scene's geometry with {structures}"),
+        objects.estimated_world_bytes(top, bottom),
+        "use a smaller model, or a structure that takes less (the kd-tree takes the most, \
+         then the BVH)",
     )
 }
 

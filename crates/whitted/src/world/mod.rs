@@ -29,6 +29,7 @@
 //! [`World::placement`] splits into an instance and a primitive in it.
 
 mod entry;
+mod estimate;
 mod hit;
 mod instance;
 mod interiors;
@@ -271,13 +272,8 @@ impl<'a> World<'a> {
             next += definition(i).primitive_count as u32;
         }
         let n = next as usize;
-        // A mesh placed more than once, or moved, is kept as an instance.
-        let mut placements = vec![0u32; objects.meshes.len()];
-        for m in &objects.mesh_instances {
-            placements[m.mesh.0 as usize] += 1;
-        }
-        let instanced =
-            |m: &MeshInstance| m.transform.is_some() || placements[m.mesh.0 as usize] > 1;
+        let placements = objects.placements();
+        let instanced = |m: &MeshInstance| Objects::kept_as_instance(m, &placements);
         let mut mesh_structures: Vec<Option<MeshStructure>> =
             objects.meshes.iter().map(|_| None).collect();
         for m in objects.mesh_instances.iter().filter(|m| instanced(m)) {
