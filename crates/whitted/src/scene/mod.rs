@@ -21,7 +21,9 @@ pub use diagnostic::{
 };
 pub use nff::{load_nff, parse_nff};
 pub use obj::{load_obj, parse_obj};
-pub use toml_format::{load_scene, parse_scene};
+pub use toml_format::{
+    load_scene, load_scene_with_warnings, parse_scene, parse_scene_with_warnings,
+};
 pub use whole_number::{WholeNumberError, parse_whole_number};
 
 use std::path::Path;
@@ -68,10 +70,7 @@ pub fn load_any_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene, 
             warnings: Vec::new(),
         }
     } else if is("toml") {
-        LoadedScene {
-            scene: load_scene(path)?,
-            warnings: Vec::new(),
-        }
+        load_scene_with_warnings(path)?
     } else if is("obj") {
         load_obj(path)?
     } else if is("bpt") {

@@ -288,8 +288,17 @@ fn load_maps(
                 Diagnostic::warning(path, source, unknown.span.clone(), message)
             });
         }
-        let data = match images.load(&statement.file, decoding(statement)) {
-            Ok(data) => data,
+        // As the library writes it.
+        let name = source.get(statement.span.clone()).unwrap_or_default();
+        let data = match images.load_noting(&statement.file, name, decoding(statement)) {
+            Ok((data, note)) => {
+                if let Some(note) = note {
+                    push_limited(diagnostics, Severity::Warning, || {
+                        Diagnostic::warning(path, source, statement.span.clone(), note)
+                    });
+                }
+                data
+            }
             Err(error) => {
                 let message = format!("{error}; {}", statement.slot.fallback());
                 push_limited(diagnostics, Severity::Warning, || {
@@ -545,6 +554,39 @@ mod tests {
         };
         assert!(std::sync::Arc::ptr_eq(&ks.data, &lamp.data));
         assert_eq!(images.len(), 1);
+    }
+
+    #[test]
+    fn a_large_texture_is_noted_once_where_it_is_first_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let png = crate::shading::texture::png_bytes(4, 4, &[255; 48]);
+        std::fs::write(dir.path().join("big.png"), png).unwrap();
+        let source = "newmtl a\nmap_Kd big.png\nnewmtl b\nmap_Kd big.png\n";
+        // 4x4 texels at 3 bytes and 4 for the mipmap: 112 bytes charged.
+        let mut images = ImageCache::noting_above(100);
+        let lib = read_library(source, &dir.path().join("m.mtl"), &mut images);
+        let notes: Vec<_> = lib
+            .diagnostics
+            .iter()
+            .map(|d| (d.line, &d.message))
+            .collect();
+        assert_eq!(
+            notes,
+            [(
+                2,
+                &"the image `big.png` takes 112 bytes as a texture (4x4 texels and their \
+                  mipmap): a smaller image would take less memory"
+                    .to_string()
+            )]
+        );
+        assert!(
+            lib.diagnostics
+                .iter()
+                .all(|d| d.severity == Severity::Warning)
+        );
+        let mut images = ImageCache::noting_above(112);
+        let lib = read_library(source, &dir.path().join("m.mtl"), &mut images);
+        assert!(lib.diagnostics.is_empty(), "{:?}", lib.diagnostics);
     }
 
     #[test]

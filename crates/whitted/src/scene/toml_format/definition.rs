@@ -145,8 +145,8 @@ pub(super) fn read_definitions(
 }
 
 /// The meshes of the OBJ file `mesh` names, with their materials. The
-/// file's errors, and its warnings (a definition must read cleanly: the
-/// TOML reader has no warnings to pass on), are reported at `mesh`.
+/// file's errors are reported at `mesh`; its warnings are passed on, at
+/// their own places.
 fn read_mesh(
     r: &mut Reader<'_>,
     value: &Value<'_>,
@@ -169,13 +169,7 @@ fn read_mesh(
         }
         Err(other) => return Err(r.error(span, other.to_string())),
     };
-    if !loaded.warnings.is_empty() {
-        let message = format!(
-            "the model `{name}` reads with warnings, which a definition does not allow:\n{}",
-            problems(&loaded.warnings)
-        );
-        return Err(r.error(span, message));
-    }
+    r.pass_on_warnings(loaded.warnings);
     let mut scene = loaded.scene;
     let meshes = std::mem::take(&mut scene.objects.meshes);
     Ok(scene
@@ -478,5 +472,33 @@ mod tests {
         assert_eq!(quad.meshes[0].len(), 2);
         assert_eq!(s.materials.len(), 1);
         assert_eq!(s.objects.primitive_count(), 2);
+    }
+
+    #[test]
+    fn a_models_warnings_are_passed_on_at_their_own_place() {
+        let folder = tempfile::tempdir().unwrap();
+        std::fs::write(
+            folder.path().join("quad.obj"),
+            "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n",
+        )
+        .unwrap();
+        let source = format!(
+            "{CAMERA}[definitions.quad]\nmesh = 'quad.obj'\n\
+             [[objects]]\ninstance = 'quad'\n"
+        );
+        let loaded =
+            crate::scene::parse_scene_with_warnings(&source, &folder.path().join("scene.toml"))
+                .unwrap();
+        assert_eq!(loaded.scene.objects.primitive_count(), 1);
+        let [warning] = &loaded.warnings[..] else {
+            panic!("{:?}", loaded.warnings);
+        };
+        assert_eq!(warning.path, folder.path().join("quad.obj"));
+        assert_eq!(warning.line, 1);
+        assert!(
+            warning.message.contains("missing.mtl"),
+            "{}",
+            warning.message
+        );
     }
 }

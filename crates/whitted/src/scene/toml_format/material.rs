@@ -390,6 +390,39 @@ mod tests {
     }
 
     #[test]
+    fn a_large_texture_is_a_warning_where_it_is_first_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let png = crate::shading::texture::png_bytes(4, 4, &[255; 48]);
+        std::fs::write(dir.path().join("big.png"), png).unwrap();
+        let source = format!(
+            "{CAMERA}[materials.a]\ndiffuse = {{ image = 'big.png' }}\n\
+             [materials.b]\nemission = {{ image = 'big.png' }}\n"
+        );
+        let path = dir.path().join("s.toml");
+        let root = toml_span::parse(&source).unwrap();
+        let warnings = |bytes: u64| {
+            let mut reader = Reader::new(&source, &path).noting_images_above(bytes);
+            let scene = super::super::read_document(&mut reader, &root);
+            let (_, warnings) = reader.finish_with_warnings(scene).unwrap();
+            warnings
+                .iter()
+                .map(|w| format!("{}:{}: {}", w.line, w.column, w.message))
+                .collect::<Vec<_>>()
+        };
+        // 4x4 texels at 3 bytes and 4 for the mipmap: 112 bytes charged.
+        assert_eq!(
+            warnings(100),
+            [
+                "5:21: the image `big.png` takes 112 bytes as a texture (4x4 texels and their \
+              mipmap): a smaller image would take less memory"
+            ]
+        );
+        assert!(warnings(112).is_empty());
+        let loaded = super::super::parse_scene_with_warnings(&source, &path).unwrap();
+        assert!(loaded.warnings.is_empty());
+    }
+
+    #[test]
     fn a_display_scene_reads_colour_images_as_stored() {
         let dir = tempfile::tempdir().unwrap();
         let png = crate::shading::texture::png_bytes(1, 1, &[128, 128, 128]);

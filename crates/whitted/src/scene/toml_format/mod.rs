@@ -60,7 +60,7 @@ use crate::math::Vec3;
 use crate::render::{Camera, CameraError};
 use crate::render::{MAX_DEPTH, MAX_SAMPLES, MAX_SIDE, check_image_size};
 use crate::render::{ObjectSource, RenderSettings, Scene};
-use crate::scene::{Diagnostic, SceneError, without_bom};
+use crate::scene::{Diagnostic, LoadedScene, SceneError, without_bom};
 use crate::shading::Color;
 use crate::shading::Material;
 use crate::world::MaterialId;
@@ -68,6 +68,11 @@ use crate::world::MaterialId;
 /// Reads a scene from the text of a scene file; `path` is only used in
 /// messages.
 pub fn parse_scene(source: &str, path: &Path) -> Result<Scene, SceneError> {
+    parse_scene_with_warnings(source, path).map(|loaded| loaded.scene)
+}
+
+/// [`parse_scene`], keeping the reader's warnings.
+pub fn parse_scene_with_warnings(source: &str, path: &Path) -> Result<LoadedScene, SceneError> {
     let source = without_bom(source);
     let root = toml_span::parse(source).map_err(|error| {
         let span = error.span.start..error.span.end;
@@ -86,7 +91,8 @@ pub fn parse_scene(source: &str, path: &Path) -> Result<Scene, SceneError> {
     })?;
     let mut reader = Reader::new(source, path);
     let scene = read_document(&mut reader, &root);
-    reader.finish(scene)
+    let (scene, warnings) = reader.finish_with_warnings(scene)?;
+    Ok(LoadedScene { scene, warnings })
 }
 
 /// True when `text` is a whole number (an optional sign, then digits)
@@ -99,11 +105,16 @@ fn is_too_large_integer(text: &str) -> bool {
 
 /// Reads a scene file.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
+    load_scene_with_warnings(path).map(|loaded| loaded.scene)
+}
+
+/// [`load_scene`], keeping the reader's warnings.
+pub fn load_scene_with_warnings(path: &Path) -> Result<LoadedScene, SceneError> {
     let source = crate::limits::read_input_text(path).map_err(|source| SceneError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    parse_scene(&source, path)
+    parse_scene_with_warnings(&source, path)
 }
 
 /// The keys allowed at the top level.

@@ -43,6 +43,8 @@ pub(super) struct Reader<'s> {
     source: &'s str,
     path: &'s Path,
     diagnostics: Vec<Diagnostic>,
+    /// Warnings: the file is still read.
+    warnings: Vec<Diagnostic>,
     /// Images decoded so far, shared by every material naming them.
     images: ImageCache,
     /// How colour images are decoded: through the sRGB curve for a linear
@@ -112,9 +114,18 @@ impl<'s> Reader<'s> {
             source,
             path,
             diagnostics: Vec::new(),
+            warnings: Vec::new(),
             images: ImageCache::default(),
             color_images: Decoding::Color,
         }
+    }
+
+    /// The walk, noting images that take more than `bytes` as textures
+    /// (for tests of the note).
+    #[cfg(test)]
+    pub(super) fn noting_images_above(mut self, bytes: u64) -> Self {
+        self.images = ImageCache::noting_above(bytes);
+        self
     }
 
     /// Takes the scene's colours to mean `color_space` from now on: colour
@@ -133,7 +144,8 @@ impl<'s> Reader<'s> {
 
     /// The image file named `name` (relative to the scene file), decoded
     /// once as `decoding`; an error at `span` naming the file when it cannot
-    /// be read.
+    /// be read, and a warning there when it is first decoded into a large
+    /// texture ([`ImageCache::load_noting`]).
     pub(super) fn image(
         &mut self,
         name: &str,
@@ -141,14 +153,30 @@ impl<'s> Reader<'s> {
         decoding: Decoding,
     ) -> Parsed<Arc<ImageData>> {
         let file = self.path.parent().unwrap_or(Path::new("")).join(name);
-        self.images
-            .load(&file, decoding)
-            .map_err(|error| self.error(span, error.to_string()))
+        let (image, note) = self
+            .images
+            .load_noting(&file, name, decoding)
+            .map_err(|error| self.error(span, error.to_string()))?;
+        if let Some(note) = note {
+            let (path, source) = (self.path, self.source);
+            push_limited(&mut self.warnings, Severity::Warning, || {
+                Diagnostic::warning(path, source, span.start..span.end, note)
+            });
+        }
+        Ok(image)
     }
 
     /// The file `name`, relative to the scene file's folder.
     pub(super) fn beside(&self, name: &str) -> std::path::PathBuf {
         self.path.parent().unwrap_or(Path::new("")).join(name)
+    }
+
+    /// Passes on the warnings of a file this one reads (a model), each at
+    /// its own place.
+    pub(super) fn pass_on_warnings(&mut self, warnings: Vec<Diagnostic>) {
+        for warning in warnings {
+            push_limited(&mut self.warnings, Severity::Warning, || warning);
+        }
     }
 
     /// Records an error at `span`.
@@ -161,10 +189,19 @@ impl<'s> Reader<'s> {
     }
 
     /// The result of the walk: `value` when nothing was wrong, otherwise
-    /// every error in the order they appear in the file.
-    pub(super) fn finish<T>(mut self, value: Parsed<T>) -> Result<T, SceneError> {
+    /// every error in the order they appear in the file; with the warnings,
+    /// in the same order.
+    pub(super) fn finish_with_warnings<T>(
+        mut self,
+        value: Parsed<T>,
+    ) -> Result<(T, Vec<Diagnostic>), SceneError> {
         match value {
-            Ok(value) if self.diagnostics.is_empty() => Ok(value),
+            Ok(value) if self.diagnostics.is_empty() => {
+                // Grouped by file (a model's are passed on), in order.
+                self.warnings
+                    .sort_by(|a, b| (&a.path, a.line, a.column).cmp(&(&b.path, b.line, b.column)));
+                Ok((value, self.warnings))
+            }
             _ => {
                 self.diagnostics.sort_by_key(|d| (d.line, d.column));
                 Err(SceneError::Invalid {
@@ -525,12 +562,15 @@ mod tests {
         let root = toml_span::parse(source).unwrap();
         let mut reader = Reader::new(source, Path::new("t.toml"));
         let value = read(&mut reader, root.pointer("/x").unwrap(), "x");
-        reader.finish(value).map_err(|e| match e {
-            SceneError::Invalid { diagnostics } => {
-                diagnostics.into_iter().map(|d| d.message).collect()
-            }
-            other => panic!("{other}"),
-        })
+        reader
+            .finish_with_warnings(value)
+            .map(|(value, _)| value)
+            .map_err(|e| match e {
+                SceneError::Invalid { diagnostics } => {
+                    diagnostics.into_iter().map(|d| d.message).collect()
+                }
+                other => panic!("{other}"),
+            })
     }
 
     #[test]

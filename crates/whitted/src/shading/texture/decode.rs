@@ -18,7 +18,7 @@ use std::io::Cursor;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use super::image::{ImageData, Texels};
+use super::image::{ImageData, LARGE_TEXTURE_BYTES, Texels};
 use crate::limits::{Charge, MemoryBudget, MemoryError};
 
 /// Why an image file gave no texture.
@@ -59,12 +59,52 @@ pub enum Decoding {
 
 /// Decoded images by canonical path and decoding, so that every material
 /// naming a file shares one copy of its texels.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct ImageCache {
     images: HashMap<(PathBuf, Decoding), Arc<ImageData>>,
+    /// Textures taking more bytes are noted when first decoded.
+    note_above: u64,
+}
+
+impl Default for ImageCache {
+    /// A cache that notes textures over [`LARGE_TEXTURE_BYTES`].
+    fn default() -> Self {
+        Self {
+            images: HashMap::new(),
+            note_above: LARGE_TEXTURE_BYTES,
+        }
+    }
 }
 
 impl ImageCache {
+    /// A cache that notes textures over `bytes`, for tests of the note.
+    #[cfg(test)]
+    pub(crate) fn noting_above(bytes: u64) -> Self {
+        Self {
+            note_above: bytes,
+            ..Self::default()
+        }
+    }
+
+    /// [`ImageCache::load`], with a note when this call decoded the file
+    /// into a texture of more than 1 GiB ([`LARGE_TEXTURE_BYTES`]), which
+    /// calls `name` as the scene names it.
+    pub fn load_noting(
+        &mut self,
+        path: &Path,
+        name: &str,
+        decoding: Decoding,
+    ) -> Result<(Arc<ImageData>, Option<String>), ImageLoadError> {
+        let decoded = self.images.len();
+        let image = self.load(path, decoding)?;
+        let note = if self.images.len() > decoded {
+            image.large_texture_note(name, self.note_above)
+        } else {
+            None
+        };
+        Ok((image, note))
+    }
+
     /// The texels of the file at `path` read as `decoding`, decoded on
     /// first use.
     pub fn load(

@@ -17,6 +17,10 @@ use crate::shading::Color;
 
 use crate::math::DVec2;
 
+/// Textures taking more than this are noted where the scene names them
+/// (1 GiB, see [`ImageCache::load_noting`](super::ImageCache::load_noting)).
+pub const LARGE_TEXTURE_BYTES: u64 = 1 << 30;
+
 /// Texels as stored: linear RGB values, or the image's own 8-bit or
 /// 16-bit samples with the table of the values they stand for (each value
 /// then read from the table: the same numbers, in a quarter or half of the
@@ -152,6 +156,28 @@ impl ImageData {
     /// The mean of all texels.
     pub fn mean(&self) -> Color {
         self.mean
+    }
+
+    /// The bytes charged for it in the memory ledger while it is kept
+    /// (its texels and mipmap, see [`ImageData::holding`]); 0 for an image
+    /// made in code.
+    pub fn charged_bytes(&self) -> u64 {
+        self.held.bytes()
+    }
+
+    /// A note for a texture charged more than `threshold` bytes (`name`
+    /// is how the scene names its file), `None` for others.
+    pub fn large_texture_note(&self, name: &str, threshold: u64) -> Option<String> {
+        let bytes = self.charged_bytes();
+        (bytes > threshold).then(|| {
+            format!(
+                "the image `{name}` takes {} as a texture ({}x{} texels and their mipmap): \
+                 a smaller image would take less memory",
+                crate::limits::format_bytes(bytes),
+                self.width,
+                self.height
+            )
+        })
     }
 
     /// Width in texels.

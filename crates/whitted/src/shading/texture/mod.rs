@@ -20,7 +20,7 @@ pub use self::checker::Checker;
 pub(crate) use self::decode::tests::{png_bytes, rgba_png_bytes};
 pub use self::decode::{Decoding, ImageCache, ImageLoadError, decode_image};
 pub use self::dissolve::DissolveMap;
-pub use self::image::{ImageData, ImageTexture, Texels, Wrap};
+pub use self::image::{ImageData, ImageTexture, LARGE_TEXTURE_BYTES, Texels, Wrap};
 use crate::math::DVec2;
 use crate::shading::Color;
 
