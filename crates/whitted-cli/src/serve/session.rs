@@ -364,6 +364,7 @@ impl Session {
         inner.scene = None;
         inner.world = None;
         drop(inner);
+        self.explaining.cancel_unless(None);
         let message = crate::report::bounded(message);
         self.publish("error", json!({ "request": request, "message": message }));
     }
@@ -391,6 +392,8 @@ impl Session {
             inner.scene = Some(Arc::clone(&full));
             inner.world = Some(Arc::clone(world));
         }
+        // A tree of another scene or camera is stale now.
+        self.explaining.cancel_unless(Some((world, &full.camera)));
         let passes: &[(&str, u32)] = if view.preview {
             &[("preview", 4)]
         } else {

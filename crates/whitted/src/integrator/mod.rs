@@ -16,7 +16,7 @@ mod shadow_cache;
 mod visibility;
 mod whitted;
 
-pub use observer::{FirstHit, RayObserver, ShadowStep, Unobserved};
+pub use observer::{Cancellable, FirstHit, RayObserver, ShadowStep, Unobserved};
 pub use photon_map::{CausticMap, PhotonSettings};
 pub use ray_counts::{RayCounts, RayKind};
 pub use ray_tree::{

@@ -19,6 +19,8 @@
 //! branch  = ray_start ray_hit [shade] ray_end | branch_skipped
 //! ```
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use crate::integrator::RayKind;
 use crate::math::{Ray, Vec3};
 use crate::shading::{Color, LightSample};
@@ -112,6 +114,15 @@ pub trait RayObserver {
     /// ray: the sample's colour).
     #[inline(always)]
     fn ray_end(&mut self, _color: Color) {}
+
+    /// Whether the answer is no longer wanted (an explanation superseded):
+    /// the integrator then starts no further shadow or secondary rays, and
+    /// the colour it returns is not the sample's. Never, unless an
+    /// observer says so.
+    #[inline(always)]
+    fn stopped(&self) -> bool {
+        false
+    }
 }
 
 /// The observer that watches nothing: what the renderer passes.
@@ -120,6 +131,20 @@ pub struct Unobserved;
 
 impl RayObserver for Unobserved {
     const READS_UV: bool = false;
+}
+
+/// The observer that watches nothing and stops the sample once `0` is set
+/// ([`RayObserver::stopped`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Cancellable<'c>(pub &'c AtomicBool);
+
+impl RayObserver for Cancellable<'_> {
+    const READS_UV: bool = false;
+
+    #[inline(always)]
+    fn stopped(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
 }
 
 /// The observer that keeps the camera ray's first hit and its surface,

@@ -17,6 +17,8 @@
 //! they are what the integrator added up; they are shown one by one, and
 //! their sum may differ from the node's colour in the last bits.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use crate::accel::{QueryContext, TraversalCounters};
 use crate::integrator::observer::{RayObserver, ShadowStep};
 use crate::integrator::{RayKind, RecursionLimits, Shading};
@@ -225,6 +227,8 @@ pub struct RayTreeRecorder<'a> {
     /// counted already (taken with its first shadow ray, so that no
     /// shadow ray is held without its verdict).
     verdict_taken: bool,
+    /// Set when the tree is no longer wanted ([`RayObserver::stopped`]).
+    cancel: Option<&'a AtomicBool>,
 }
 
 impl<'a> RayTreeRecorder<'a> {
@@ -249,6 +253,15 @@ impl<'a> RayTreeRecorder<'a> {
             left_out: 0,
             skipping: 0,
             verdict_taken: false,
+            cancel: None,
+        }
+    }
+
+    /// The recorder, stopping the sample once `cancel` is set.
+    pub fn with_cancel(self, cancel: &'a AtomicBool) -> Self {
+        Self {
+            cancel: Some(cancel),
+            ..self
         }
     }
 
@@ -299,6 +312,10 @@ impl<'a> RayTreeRecorder<'a> {
 }
 
 impl RayObserver for RayTreeRecorder<'_> {
+    fn stopped(&self) -> bool {
+        self.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+
     fn ray_start(&mut self, kind: RayKind, ray: &Ray, coefficient: Color, weight: f64) {
         if !self.take(1) {
             self.skipping += 1;

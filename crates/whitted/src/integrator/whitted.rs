@@ -315,6 +315,9 @@ impl<'a> Whitted<'a> {
         let mut origins = RayOrigins::new(s.point, s.point_error, s.normal);
         if alpha != Color::ZERO && (diffuse != Color::ZERO || specular != Color::ZERO) {
             for (index, light, sample) in direct_samples(self.shading.lights, s.point).ahead() {
+                if tally.observer.stopped() {
+                    break;
+                }
                 let n_dot_l = n.dot(sample.to_light);
                 if n_dot_l <= 0.0 || (bumped && facing.dot(sample.to_light) <= 0.0) {
                     tally.observer.light(index, Some(&sample), None);
@@ -348,6 +351,9 @@ impl<'a> Whitted<'a> {
 
         if depth >= self.limits.max_depth {
             tally.observer.depth_limit();
+            return color;
+        }
+        if tally.observer.stopped() {
             return color;
         }
         let kr = m.reflection.filtered(s.uv, footprint);

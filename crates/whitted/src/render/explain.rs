@@ -16,11 +16,12 @@
 //! leaves out, and [`PixelExplanation::left_out`] says how much that is.
 
 use std::collections::HashMap;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::accel::AccelKind;
 use crate::integrator::{
-    CausticMap, DEFAULT_MAX_TREE_RAYS, Integrator, RayCounts, RayNode, RayTreeRecorder,
-    RecursionLimits, SECONDARY_RAY_BUDGET, Unobserved,
+    Cancellable, CausticMap, DEFAULT_MAX_TREE_RAYS, Integrator, RayCounts, RayNode, RayObserver,
+    RayTreeRecorder, RecursionLimits, SECONDARY_RAY_BUDGET,
 };
 use crate::limits::Charge;
 use crate::math::DVec2;
@@ -102,6 +103,10 @@ pub enum ExplainError {
         /// The samples per pixel.
         samples: u32,
     },
+    /// The explanation was cancelled before it was done
+    /// ([`Explainer::explain_unless`]).
+    #[error("the explanation was cancelled: a newer scene or camera replaced it")]
+    Cancelled,
 }
 
 /// Explains sample `sample` of pixel (`x`, `y`) of `scene` rendered with
@@ -164,8 +169,21 @@ impl<'s> Explainer<'s> {
     pub fn explain(
         &self,
         camera: &Camera,
+        pixel: (u32, u32),
+        sample: u32,
+    ) -> Result<PixelExplanation, ExplainError> {
+        self.explain_unless(camera, pixel, sample, &AtomicBool::new(false))
+    }
+
+    /// [`Self::explain`], given up once `cancel` is set: the tracing then
+    /// starts no further shadow or secondary rays and no further sample of
+    /// the pixel, and the answer is [`ExplainError::Cancelled`].
+    pub fn explain_unless(
+        &self,
+        camera: &Camera,
         (x, y): (u32, u32),
         sample: u32,
+        cancel: &AtomicBool,
     ) -> Result<PixelExplanation, ExplainError> {
         let settings = &self.scene.settings;
         let (width, height) = (settings.width, settings.height);
@@ -182,7 +200,7 @@ impl<'s> Explainer<'s> {
             return Err(ExplainError::SampleOutside { sample, samples });
         }
         on_deep_stack(settings.max_depth, || {
-            self.trace_pixel(camera, (x, y), sample)
+            self.trace_pixel(camera, (x, y), sample, cancel)
         })?
     }
 
@@ -193,7 +211,9 @@ impl<'s> Explainer<'s> {
         camera: &Camera,
         (x, y): (u32, u32),
         sample: u32,
+        cancel: &AtomicBool,
     ) -> Result<PixelExplanation, ExplainError> {
+        let cancelled = || cancel.load(Ordering::Relaxed);
         let (scene, world) = (self.scene, &self.world);
         let settings = &scene.settings;
         let shading = shading_of(scene);
@@ -204,7 +224,8 @@ impl<'s> Explainer<'s> {
         let mut counts = RayCounts::default();
         let (pixel, samples) = match settings.aa {
             AntiAliasing::Stratified => {
-                stratified_samples(scene, camera, &integrator, (x, y), &mut counts)
+                let watch = &mut Cancellable(cancel);
+                stratified_samples(scene, camera, &integrator, (x, y), &mut counts, watch)
             }
             AntiAliasing::Adaptive(adaptive) => {
                 let pixels =
@@ -216,6 +237,9 @@ impl<'s> Explainer<'s> {
                 pixels.pixel_alone(x, y, &mut cost)
             }
         };
+        if cancelled() {
+            return Err(ExplainError::Cancelled);
+        }
         let count = samples.len() as u32;
         let Some(&(position, _)) = samples.get(sample as usize) else {
             return Err(ExplainError::SampleOutside {
@@ -233,8 +257,12 @@ impl<'s> Explainer<'s> {
             }
             AntiAliasing::Adaptive(_) => position_differential(camera, settings, position, 1.0),
         };
-        let mut recorder = RayTreeRecorder::new(world, shading, limits, self.max_tree_rays);
+        let mut recorder =
+            RayTreeRecorder::new(world, shading, limits, self.max_tree_rays).with_cancel(cancel);
         integrator.trace_primary_observed(&ray, differential, &mut counts, &mut recorder);
+        if cancelled() {
+            return Err(ExplainError::Cancelled);
+        }
         let (tree, left_out) = recorder.finish().ok_or(ExplainError::SampleOutside {
             sample,
             samples: count,
@@ -294,6 +322,7 @@ fn stratified_samples(
     integrator: &Integrator<'_>,
     (x, y): (u32, u32),
     counts: &mut RayCounts,
+    watch: &mut Cancellable<'_>,
 ) -> (Color, Vec<(DVec2, Color)>) {
     let settings = &scene.settings;
     let spp = settings.samples_per_pixel;
@@ -301,10 +330,13 @@ fn stratified_samples(
     let mut sum = Color::ZERO;
     let mut samples = Vec::with_capacity(spp as usize);
     for s in 0..spp {
+        if watch.stopped() {
+            break;
+        }
         let ray = sample_ray(camera, settings, (x, y), pattern, s);
         let differential = sample_differential(camera, settings, (x, y), pattern, s);
         let color = integrator
-            .trace_primary_observed(&ray, differential, counts, &mut Unobserved)
+            .trace_primary_observed(&ray, differential, counts, watch)
             .color;
         let offset = crate::math::sampling::pixel_sample(s, spp, pattern);
         samples.push((
@@ -314,4 +346,95 @@ fn stratified_samples(
         sum += color;
     }
     (sum / f64::from(spp), samples)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrator::{RayKind, Unobserved};
+    use crate::math::DVec2;
+
+    /// A glass ball in a mirror box, its tree as deep as the budget allows.
+    fn glass_in_mirrors() -> Scene {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/hostile_scenes/glass_in_mirrors.toml");
+        crate::scene::load_any(&path).unwrap()
+    }
+
+    #[test]
+    fn a_stopped_sample_starts_no_shadow_or_secondary_ray() {
+        let scene = glass_in_mirrors();
+        let world = super::super::build_world(&scene);
+        let settings = &scene.settings;
+        let integrator = Integrator::new(
+            settings.integrator,
+            &world,
+            shading_of(&scene),
+            limits_of(settings),
+        );
+        let ray = position_ray(&scene.camera, settings, DVec2::new(4.0, 4.0));
+        let counts = |stop: bool| {
+            let mut counts = RayCounts::default();
+            let flag = AtomicBool::new(stop);
+            integrator.trace_primary_observed(&ray, None, &mut counts, &mut Cancellable(&flag));
+            counts
+        };
+        let mut unobserved = RayCounts::default();
+        integrator.trace_primary_observed(&ray, None, &mut unobserved, &mut Unobserved);
+        // Not stopped: the same work as without the watch.
+        assert_eq!(counts(false), unobserved);
+        assert!(unobserved[RayKind::Reflected] > 100, "{unobserved:?}");
+        let stopped = counts(true);
+        assert_eq!(stopped[RayKind::Primary], 1);
+        assert_eq!(
+            stopped.total(),
+            1,
+            "only the camera ray is traced: {stopped:?}"
+        );
+    }
+
+    /// The glass ball in its mirror box lit by an area light of 4096
+    /// samples, whose pixel takes millions of shadow rays: cancelled while
+    /// it is traced, it ends at once.
+    #[test]
+    fn an_explanation_cancelled_while_traced_ends_at_once() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/hostile_scenes/glass_in_mirrors.toml");
+        let source = std::fs::read_to_string(&path).unwrap().replace(
+            "type = \"point\"\nposition = [0, 1, -1]",
+            "type = \"rect\"\norigin = [-0.5, 1.9, -0.5]\nedge_u = [1, 0, 0]\n\
+             edge_v = [0, 0, 1]\nradiance = 1\nsamples = 4096",
+        );
+        assert!(source.contains("samples = 4096"));
+        let scene = crate::scene::parse_scene(&source, &path).unwrap();
+        let explainer = Explainer::new(&scene).unwrap();
+        let cancel = AtomicBool::new(false);
+        let start = std::time::Instant::now();
+        let answer = std::thread::scope(|scope| {
+            let explaining =
+                scope.spawn(|| explainer.explain_unless(&scene.camera, (4, 4), 0, &cancel));
+            std::thread::sleep(std::time::Duration::from_millis(200));
+            cancel.store(true, Ordering::Relaxed);
+            explaining.join().unwrap()
+        });
+        assert!(matches!(answer, Err(ExplainError::Cancelled)), "{answer:?}");
+        let elapsed = start.elapsed();
+        assert!(elapsed < std::time::Duration::from_secs(10), "{elapsed:?}");
+    }
+
+    #[test]
+    fn a_cancelled_explanation_says_so() {
+        let scene = glass_in_mirrors();
+        let explainer = Explainer::new(&scene).unwrap();
+        let cancelled = explainer.explain_unless(&scene.camera, (4, 4), 0, &AtomicBool::new(true));
+        let error = cancelled.unwrap_err();
+        assert!(matches!(error, ExplainError::Cancelled));
+        assert_eq!(
+            error.to_string(),
+            "the explanation was cancelled: a newer scene or camera replaced it"
+        );
+        let kept = explainer.explain_unless(&scene.camera, (4, 4), 0, &AtomicBool::new(false));
+        let whole = explainer.explain(&scene.camera, (4, 4), 0);
+        assert_eq!(kept.unwrap().tree, whole.unwrap().tree);
+    }
 }
