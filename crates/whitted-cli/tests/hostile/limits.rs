@@ -569,25 +569,8 @@ fn every_reader_reads_one_long_line_in_time_linear_in_its_length() {
 /// own limits.
 #[test]
 fn the_default_budget_honours_the_address_space_limit() {
-    use std::os::unix::process::CommandExt;
     let dir = tempfile::tempdir().unwrap();
-    let limited = |args: &[&str]| {
-        let mut command = super::support::whitted(args, dir.path());
-        // SAFETY: setrlimit is async-signal-safe, as pre_exec requires.
-        unsafe {
-            command.pre_exec(|| {
-                let limit = libc::rlimit {
-                    rlim_cur: 4 << 30,
-                    rlim_max: 4 << 30,
-                };
-                if libc::setrlimit(libc::RLIMIT_AS, &limit) != 0 {
-                    return Err(std::io::Error::last_os_error());
-                }
-                Ok(())
-            });
-        }
-        super::support::run(command)
-    };
+    let limited = |args: &[&str]| with_address_space(4 << 30, args, dir.path());
     let p = limited(&[
         "render", "--width", "16384", "--height", "16384", "-o", "big.png",
     ]);
@@ -815,4 +798,55 @@ fn geometry_and_structures_beyond_the_budget_are_refused_before_they_are_built()
         "{}",
         p.stderr
     );
+}
+
+/// A probe of `whitted args` run in `dir` under `ulimit -v` of `bytes`.
+fn with_address_space(bytes: u64, args: &[&str], dir: &Path) -> super::support::Probe {
+    use std::os::unix::process::CommandExt;
+    let mut command = super::support::whitted(args, dir);
+    // SAFETY: setrlimit is async-signal-safe, as pre_exec requires.
+    unsafe {
+        command.pre_exec(move || {
+            let limit = libc::rlimit {
+                rlim_cur: bytes,
+                rlim_max: bytes,
+            };
+            if libc::setrlimit(libc::RLIMIT_AS, &limit) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    super::support::run(command)
+}
+
+/// Issue 50, item 6: memory the budget allows (a budget given above the
+/// process's limit) but the system refuses is an error, not an abort:
+/// under `ulimit -v 2G`, a 16384² film of 3 GiB with `--max-memory 64G`.
+#[test]
+fn a_film_the_system_refuses_is_an_error_not_an_abort() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "render",
+        "--width",
+        "16384",
+        "--height",
+        "16384",
+        "--max-memory",
+        "64G",
+        "-o",
+        "big.png",
+    ];
+    let p = with_address_space(2 << 30, &args, dir.path());
+    assert_eq!(p.code(), Some(1), "{}", p.stderr);
+    assert!(
+        p.stderr.contains(
+            "error: the system refused the 3.0 GiB of a 16384x16384 film (3 values a pixel); \
+             free memory, raise the process's limit (ulimit -v), or render a smaller image"
+        ),
+        "{}",
+        p.stderr
+    );
+    assert!(!dir.path().join("big.png").exists());
+    assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 0);
 }

@@ -146,7 +146,49 @@ impl ImageFormat {
     }
 }
 
+/// The system refused the memory of a film (a limit such as `ulimit -v`,
+/// or memory taken by others), though the budget allowed it.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "the system refused the {} of a {width}x{height} film ({channels} values a pixel); \
+     free memory, raise the process's limit (ulimit -v), or render a smaller image",
+    crate::limits::format_bytes(*bytes)
+)]
+pub struct FilmAllocError {
+    /// The film's width.
+    pub width: u32,
+    /// The film's height.
+    pub height: u32,
+    /// Its values per pixel.
+    pub channels: usize,
+    /// The bytes asked for.
+    pub bytes: u64,
+}
+
 impl Film {
+    /// [`Film::new`], with a refusal of the memory by the system an error
+    /// rather than an abort.
+    pub fn try_new(width: u32, height: u32, channels: usize) -> Result<Self, FilmAllocError> {
+        let values = width as usize * height as usize * channels;
+        let mut data = Vec::new();
+        if data.try_reserve_exact(values).is_err() {
+            return Err(FilmAllocError {
+                width,
+                height,
+                channels,
+                bytes: (values as u64).saturating_mul(4),
+            });
+        }
+        data.resize(values, 0.0);
+        Ok(Self {
+            width,
+            height,
+            channels,
+            color_space: ColorSpace::Linear,
+            data,
+        })
+    }
+
     /// A black film of linear values.
     pub fn new(width: u32, height: u32, channels: usize) -> Self {
         Self {

@@ -77,6 +77,10 @@ pub enum MergeError {
     /// The merged films would exceed the memory budget.
     #[error(transparent)]
     Memory(#[from] MemoryError),
+    /// The system refused the merged films' memory, which the budget
+    /// allowed.
+    #[error(transparent)]
+    FilmAlloc(#[from] crate::image::FilmAllocError),
 }
 
 /// Reads the parts at `paths` and merges them into one frame.
@@ -127,12 +131,12 @@ impl<'a> Merge<'a> {
             "merge on a machine with more memory, or give a larger --max-memory",
         )?;
         Ok(Self {
-            image: Film::new(width, height, 3).with_color_space(header.color_space),
+            image: Film::try_new(width, height, 3)?.with_color_space(header.color_space),
             aovs: header
                 .aovs
                 .iter()
-                .map(|&a| (a, Film::new(width, height, a.channels())))
-                .collect(),
+                .map(|&a| Ok((a, Film::try_new(width, height, a.channels())?)))
+                .collect::<Result<_, MergeError>>()?,
             owners: vec![0; pixels as usize],
             paths: Vec::new(),
             shares: Vec::new(),

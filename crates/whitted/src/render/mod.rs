@@ -49,7 +49,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Mutex, PoisonError};
 
 use crate::accel::{AccelKind, QueryContext};
-use crate::image::{ColorSpace, Film};
+use crate::image::{ColorSpace, Film, FilmAllocError};
 use crate::integrator::{
     FirstHit, Integrator, RayCounts, RayKind, RecursionLimits, SECONDARY_RAY_BUDGET, Shading,
     Unobserved,
@@ -216,6 +216,9 @@ pub enum RenderError {
     /// The films would exceed the memory budget.
     #[error(transparent)]
     Memory(#[from] MemoryError),
+    /// The system refused a film's memory, which the budget allowed.
+    #[error(transparent)]
+    FilmAlloc(#[from] FilmAllocError),
     /// Some pixels' colours came out infinite or NaN: the scene's numbers
     /// (each bounded as it is read, see [`crate::shading::factor`])
     /// multiplied over many bounces beyond what a 32-bit float holds. The
@@ -451,12 +454,12 @@ fn trace_pixels(
     let total = selection.pixel_count();
     let done = AtomicU64::new(0);
     let mut films = Films {
-        image: Film::new(width, height, 3).with_color_space(scene.color_space),
+        image: Film::try_new(width, height, 3)?.with_color_space(scene.color_space),
         aovs: settings
             .aovs
             .iter()
-            .map(|&a| (a, Film::new(width, height, a.channels())))
-            .collect(),
+            .map(|&a| Ok((a, Film::try_new(width, height, a.channels())?)))
+            .collect::<Result<_, FilmAllocError>>()?,
         rays: RayCounts::default(),
         cuts: HashMap::new(),
         non_finite: NonFinite::default(),
