@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
-"""Runs the worst probe of each defect class of the hostile-input audit
-(issue 23) against one `whitted` binary and prints a table: exit code, wall
-time, peak resident memory and the first line of what it said.
+"""Runs the worst probe of each defect class of a hostile-input audit
+(issue 23, or with --round 3 issue 50) against one `whitted` binary and
+prints a table: exit code, wall time, peak resident memory and the first
+line of what it said.
 
-    python3 scripts/hostile-probes.py target/release/whitted
+    python3 scripts/hostile-probes.py target/release/whitted [--round 3]
 
 Each probe runs in a fresh temporary folder, killed after --timeout seconds
 (default 60) and limited to --max-gib GiB of address space (default 16), so
@@ -219,6 +220,130 @@ PROBES = [
 ]
 
 
+SPHERE = '[[objects]]\nshape = "sphere"\ncenter = [0,0,0]\nradius = 1\nmaterial = "m"\n'
+
+
+def rect_lit_mirrors(samples):
+    with open(GLASS_IN_MIRRORS) as f:
+        return f.read().replace(
+            'type = "point"\nposition = [0, 1, -1]',
+            'type = "rect"\norigin = [-0.5, 1.9, -0.5]\nedge_u = [1, 0, 0]\n'
+            f'edge_v = [0, 0, 1]\nradiance = 1\nsamples = {samples}',
+        )
+
+
+def setup_output_over_texture(d):
+    write(d, "tex.png", big_png(64, 64))
+    write(d, "t.toml", SCENE_HEAD.replace("diffuse = 0.5", 'diffuse = { image = "tex.png" }') + SPHERE)
+
+
+def setup_rect_mirrors(d):
+    write(d, "m.toml", rect_lit_mirrors(4096))
+
+
+def setup_wrapping_count(d):
+    text = SCENE_HEAD + '[[objects]]\nshape = "plane"\npoint = [0, -1, 0]\nnormal = [0, 1, 0]\nmaterial = "m"\n'
+    text += '[definitions.d0]\nobjects = [{ shape = "sphere", radius = 0.1, material = "m" }]\n'
+    for level in range(1, 8):
+        placements = ", ".join([f'{{ instance = "d{level - 1}" }}'] * 256)
+        text += f"[definitions.d{level}]\nobjects = [{placements}]\n"
+    text += '[[objects]]\ninstance = "d7"\n' * 256
+    write(d, "w.toml", text)
+
+
+def setup_three_textures(d):
+    write(d, "a.png", big_png(7000, 7000))
+    write(d, "b.png", big_png(7001, 7000))
+    write(d, "c.png", big_png(7002, 7000))
+    write(
+        d,
+        "x.toml",
+        SCENE_HEAD.replace(
+            "diffuse = 0.5",
+            'diffuse = { image = "a.png" }\nspecular = { image = "b.png" }\n'
+            'bump_map = { image = "c.png" }',
+        )
+        + SPHERE,
+    )
+
+
+def setup_patches(d):
+    state = 12345
+    lines = ["100000"]
+    for p in range(100000):
+        lines.append("3 3")
+        for _ in range(16):
+            coords = []
+            for _ in range(3):
+                state = (state * 6364136223846793005 + 1442695040888963407) % (1 << 64)
+                coords.append((state >> 11) / (1 << 53))
+            lines.append(f"{coords[0] + p % 20} {coords[1] + p // 20 % 50} {coords[2]}")
+    write(d, "crumpled.bpt", "\n".join(lines) + "\n")
+
+
+def setup_nff_line(d):
+    spheres = " ".join(f"s {i % 100} {i // 100} 0 0.4" for i in range(200000))
+    write(d, "line.nff", "v\nfrom 0 0 -10\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\n"
+          "resolution 32 24\nl 0 10 -10\nf 1 1 1 1 0 0 0 1\n" + spheres + "\n")
+
+
+def setup_slow_implicit(d):
+    with open(os.path.join(REPOSITORY, "crates/whitted/tests/hostile_scenes/slow_implicit.toml")) as f:
+        write(d, "i.toml", f.read())
+
+
+def setup_long_name(d):
+    name = "n" * 10_000_000
+    write(d, "long.toml", SCENE_HEAD + SPHERE.replace('material = "m"', f'material = "{name}"'))
+
+
+def setup_utf16(d):
+    write(d, "u.toml", "\ufeff[camera]\n".encode("utf-16-le"))
+
+
+def setup_mtl_dissolve(d):
+    write(d, "d.mtl", "newmtl m\nKd 1 1 1\nd -1\nTr 2\nNs -5\n")
+    write(d, "d.obj", "mtllib d.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n")
+
+
+def setup_huge_number(d):
+    write(d, "h.toml", SCENE_HEAD + SPHERE.replace("radius = 1", "radius = -1e300"))
+
+
+def setup_grid_model(d):
+    n = 600
+    lines = [f"v {i} {j} {(i * j) % 3}" for i in range(n) for j in range(n)]
+    for i in range(n - 1):
+        for j in range(n - 1):
+            a = i * n + j + 1
+            lines.append(f"f {a} {a + 1} {a + n}")
+            lines.append(f"f {a + 1} {a + n + 1} {a + n}")
+    write(d, "grid.obj", "\n".join(lines) + "\n")
+
+
+# Issue 50 (round 3): the worst probe of each class that a command line can
+# reach; the server's items (4, 20-22) and the races and full disks (11,
+# 13) are measured by their tests.
+PROBES_3 = [
+    ("1", "-o over the scene's texture", setup_output_over_texture, ["render", "t.toml", "-o", "tex.png"], None),
+    ("2", "explain, 4096-sample light in mirrors", setup_rect_mirrors, ["explain", "m.toml", "--pixel", "4,4", "--json", "-q"], None),
+    ("3", "256^8 placements + a plane", setup_wrapping_count, ["render", "w.toml"], None),
+    ("5", "three 7000² textures, --max-memory 1G", setup_three_textures, ["render", "x.toml", "--max-memory", "1G", "--width", "32", "--height", "24"], None),
+    ("5", "1.1 M-triangle grid, kd-tree, --max-memory 256M", setup_grid_model, ["render", "grid.obj", "--accel", "kdtree", "--max-memory", "256M", "--width", "32", "--height", "24"], None),
+    ("6", "16384² under ulimit -v 4G", None, ["render", "--width", "16384", "--height", "16384", "-o", "big.png"], "ulimit-v-4G"),
+    ("6", "16384², --max-memory 64G, ulimit -v 2G", None, ["render", "--width", "16384", "--height", "16384", "--max-memory", "64G", "-o", "big.png"], "ulimit-v-2G"),
+    ("7", "100,000 crumpled patches, --max-memory 256M", setup_patches, ["render", "crumpled.bpt", "--max-memory", "256M", "--width", "64", "--height", "48"], None),
+    ("9", "NFF, 200,000 spheres on one line", setup_nff_line, ["render", "line.nff", "--width", "32", "--height", "24"], None),
+    ("10", "implicit, max_gradient 1e30", setup_slow_implicit, ["render", "i.toml"], None),
+    ("12", "-o x.exr under ulimit -f 200", None, ["render", "--width", "2000", "--height", "2000", "-o", "x.exr"], "ulimit-f-200K"),
+    ("14", "explain >&-", None, ["explain", "--pixel", "1,1"], "closed-stdout"),
+    ("16", "10 MB material name", setup_long_name, ["render", "long.toml"], None),
+    ("17", "UTF-16 scene", setup_utf16, ["render", "u.toml"], None),
+    ("18", "MTL d -1, Tr 2, Ns -5", setup_mtl_dissolve, ["render", "d.obj", "--width", "32", "--height", "24"], None),
+    ("19", "radius -1e300", setup_huge_number, ["render", "h.toml"], None),
+]
+
+
 def build_in_child(setup, folder):
     """Runs `setup` in a forked child, so that this process stays small: a
     child's peak memory (ru_maxrss) starts at its parent's size when forked."""
@@ -231,9 +356,18 @@ def build_in_child(setup, folder):
     os.waitpid(pid, 0)
 
 
-def limit(max_bytes):
+def limit(max_bytes, special=None):
     def apply():
-        resource.setrlimit(resource.RLIMIT_AS, (max_bytes, max_bytes))
+        address_space = max_bytes
+        if special == "ulimit-v-4G":
+            address_space = 4 << 30
+        elif special == "ulimit-v-2G":
+            address_space = 2 << 30
+        resource.setrlimit(resource.RLIMIT_AS, (address_space, address_space))
+        if special == "ulimit-f-200K":
+            resource.setrlimit(resource.RLIMIT_FSIZE, (200 << 10, 200 << 10))
+        if special == "closed-stdout":
+            os.close(1)
         os.setsid()
 
     return apply
@@ -252,7 +386,7 @@ def run(binary, folder, args, special, timeout, max_bytes):
             os.close(writer)
         else:
             proc = subprocess.Popen([binary] + args, cwd=folder, stdout=err, stderr=err,
-                                    stdin=subprocess.DEVNULL, preexec_fn=limit(max_bytes))
+                                    stdin=subprocess.DEVNULL, preexec_fn=limit(max_bytes, special))
     killed = False
     signalled = False
     while True:
@@ -295,12 +429,14 @@ def main():
     parser.add_argument("binary")
     parser.add_argument("--timeout", type=float, default=60)
     parser.add_argument("--max-gib", type=float, default=16)
+    parser.add_argument("--round", type=int, choices=(2, 3), default=2,
+                        help="the audit's probes: 2 for issue 23's (default), 3 for issue 50's")
     options = parser.parse_args()
     binary = os.path.realpath(options.binary)
     max_bytes = int(options.max_gib * (1 << 30))
     print("| item | probe | outcome | time | peak | new files | stderr bytes | first line said |")
     print("|---|---|---|---|---|---|---|---|")
-    for item, what, setup, args, special in PROBES:
+    for item, what, setup, args, special in PROBES if options.round == 2 else PROBES_3:
         with tempfile.TemporaryDirectory() as folder:
             if setup:
                 build_in_child(setup, folder)
