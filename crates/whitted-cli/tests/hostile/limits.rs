@@ -619,7 +619,7 @@ fn textures_are_weighed_together_against_the_budget() {
     assert!(
         alone.stderr.contains(
             "cannot decode the image `b.png`: decoding its 1000x1000 texels needs 7.6 MiB \
-             beside the 6.7 MiB the run holds already (textures, patches, images); the memory \
+             beside the 6.7 MiB the run holds already (textures, models, patches, worlds, images); the memory \
              budget is 12.0 MiB (as given)"
         ),
         "{}",
@@ -849,4 +849,61 @@ fn a_film_the_system_refuses_is_an_error_not_an_abort() {
     );
     assert!(!dir.path().join("big.png").exists());
     assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+/// Item 5's rule while a model is read: the OBJ reader charges its
+/// vertices and faces as they grow, so a model that would not fit is
+/// refused at the line where it passes the budget, before the rest is read,
+/// and the meshes it builds are charged before they are built.
+#[test]
+fn a_model_past_the_budget_is_refused_where_reading_passes_it() {
+    use std::io::Write;
+    let dir = tempfile::tempdir().unwrap();
+    // 718,802 triangles, about 20 MB, written a line at a time so that this
+    // process stays small (a child's peak counts its parent's).
+    let n = 600;
+    let file = fs::File::create(dir.path().join("grid.obj")).unwrap();
+    let mut out = std::io::BufWriter::new(file);
+    for i in 0..n {
+        for j in 0..n {
+            writeln!(out, "v {i} {j} {}", (i * j) % 3).unwrap();
+        }
+    }
+    for i in 0..n - 1 {
+        for j in 0..n - 1 {
+            let a = i * n + j + 1;
+            writeln!(out, "f {a} {} {}", a + 1, a + n).unwrap();
+            writeln!(out, "f {} {} {}", a + 1, a + n + 1, a + n).unwrap();
+        }
+    }
+    out.flush().unwrap();
+    drop(out);
+    let render = |budget: &str| {
+        let args = ["render", "grid.obj", "--max-memory", budget, "--width", "8"];
+        probe(
+            &[&args[..], &["--height", "8", "-o", "g.png"]].concat(),
+            dir.path(),
+        )
+    };
+    let p = render("24M");
+    assert_eq!(p.code(), Some(1), "{}", p.stderr);
+    assert!(
+        p.stderr.contains(
+            "grid.obj:622145:1: error: reading the model's vertices and faces needs 16.0 MiB \
+             beside the 16.0 MiB the run holds already"
+        ),
+        "{}",
+        p.stderr
+    );
+    assert!(p.stderr.ends_with("1 error\n"), "{}", p.stderr);
+    let p = render("96M");
+    assert_eq!(p.code(), Some(1), "{}", p.stderr);
+    assert!(
+        p.stderr
+            .contains("error: building the model's meshes needs 76.0 MiB beside the 76.0 MiB"),
+        "{}",
+        p.stderr
+    );
+    assert!(!dir.path().join("g.png").exists());
+    assert!(p.peak_bytes < 200 * MIB, "{}", p.peak_bytes);
 }

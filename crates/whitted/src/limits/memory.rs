@@ -86,7 +86,7 @@ impl fmt::Display for MemoryError {
         if self.held > 0 {
             write!(
                 f,
-                " beside the {} the run holds already (textures, patches, images)",
+                " beside the {} the run holds already (textures, models, patches, worlds, images)",
                 format_bytes(self.held)
             )?;
         }
@@ -472,8 +472,8 @@ mod tests {
         assert_eq!(
             error.to_string(),
             "a texture needs 200.0 GiB beside the 900.0 GiB the run holds already (textures, \
-             patches, images); the memory budget is 1.0 TiB (as given): use a smaller one, or \
-             raise the budget with --max-memory"
+             models, patches, worlds, images); the memory budget is 1.0 TiB (as given): use a \
+             smaller one, or raise the budget with --max-memory"
         );
         assert!(second.grow(&budget, "c", 200 << 30, "less").is_err());
         assert_eq!(

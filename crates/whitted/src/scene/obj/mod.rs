@@ -31,6 +31,7 @@ use self::build::build_meshes;
 use self::file_names::library_paths;
 use self::mtl::read_library;
 use self::reader::{NONE, ObjData, read_obj};
+use crate::limits::MemoryBudget;
 use crate::math::{Aabb, Transform};
 use crate::render::Camera;
 use crate::render::{LineIndex, ObjectSource, RenderSettings, Scene};
@@ -99,6 +100,17 @@ pub fn parse_obj(source: &str, path: &Path) -> Result<LoadedScene, SceneError> {
             diagnostics: errors,
         });
     }
+    // The meshes take about what the data read takes, beside it until
+    // they are built (the world charges them again before it is built).
+    let _meshes = MemoryBudget::current()
+        .charge(
+            "building the model's meshes",
+            data.heap_bytes(),
+            "use a smaller model",
+        )
+        .map_err(|error| SceneError::Invalid {
+            diagnostics: vec![Diagnostic::new(path, source, 0..0, error.to_string())],
+        })?;
     let scene = build_scene(&data, &materials, path, source, &mut warnings)?;
     Ok(LoadedScene {
         scene,

@@ -8,6 +8,7 @@ use std::ops::Range;
 use std::path::Path;
 
 use super::text::{Line, Words, lines};
+use crate::limits::{Charge, MemoryBudget, MemoryError};
 use crate::math::{DVec2, Vec3, magnitude};
 use crate::scene::{Diagnostic, Severity, push_limited};
 
@@ -51,6 +52,23 @@ pub(super) struct ObjData {
     pub(super) smoothing_given: bool,
     /// Errors and warnings, in file order.
     pub(super) diagnostics: Vec<Diagnostic>,
+    /// The memory its vertices and faces are charged, while it lives.
+    pub(super) charge: Charge,
+}
+
+/// How far the read data may grow past what it is charged before the next
+/// charge (so that a file is charged a few times, not per statement).
+const CHARGE_STEP: u64 = 16 << 20;
+
+impl ObjData {
+    /// The bytes its vertices, corners and faces take.
+    pub(super) fn heap_bytes(&self) -> u64 {
+        (self.positions.capacity() * size_of::<Vec3>()
+            + self.uvs.capacity() * size_of::<DVec2>()
+            + self.normals.capacity() * size_of::<Vec3>()
+            + self.corners.capacity() * size_of::<Corner>()
+            + self.faces.capacity() * size_of::<Face>()) as u64
+    }
 }
 
 /// Reads the statements of `source`, named `path` in messages.
@@ -64,8 +82,15 @@ pub(super) fn read_obj(source: &str, path: &Path) -> ObjData {
         warned: HashSet::new(),
         material_slots: HashMap::new(),
     };
+    let budget = MemoryBudget::current();
     for line in lines(source) {
+        let at = line.start..line.start;
         reader.statement(line);
+        if let Err(error) = reader.charge(&budget) {
+            // Reading stops here: what is left would only take more.
+            reader.error(at, error.to_string());
+            break;
+        }
     }
     reader.data
 }
@@ -86,6 +111,22 @@ struct Reader<'a> {
 struct Reported;
 
 impl Reader<'_> {
+    /// Charges what the data took since the last charge, once it is
+    /// [`CHARGE_STEP`] more.
+    fn charge(&mut self, budget: &MemoryBudget) -> Result<(), MemoryError> {
+        let data = &mut self.data;
+        let more = data.heap_bytes().saturating_sub(data.charge.bytes());
+        if more < CHARGE_STEP {
+            return Ok(());
+        }
+        data.charge.grow(
+            budget,
+            "reading the model's vertices and faces",
+            more,
+            "use a smaller model",
+        )
+    }
+
     fn error(&mut self, span: Range<usize>, message: impl Into<String>) -> Reported {
         let (path, source) = (self.path, self.source);
         push_limited(&mut self.data.diagnostics, Severity::Error, || {
