@@ -329,7 +329,7 @@ PROBES_3 = [
     ("2", "explain, 4096-sample light in mirrors", setup_rect_mirrors, ["explain", "m.toml", "--pixel", "4,4", "--json", "-q"], None),
     ("3", "256^8 placements + a plane", setup_wrapping_count, ["render", "w.toml"], None),
     ("5", "three 7000² textures, --max-memory 1G", setup_three_textures, ["render", "x.toml", "--max-memory", "1G", "--width", "32", "--height", "24"], None),
-    ("5", "1.1 M-triangle grid, kd-tree, --max-memory 256M", setup_grid_model, ["render", "grid.obj", "--accel", "kdtree", "--max-memory", "256M", "--width", "32", "--height", "24"], None),
+    ("5", "718k-triangle grid, kd-tree, --max-memory 256M", setup_grid_model, ["render", "grid.obj", "--accel", "kdtree", "--max-memory", "256M", "--width", "32", "--height", "24"], None),
     ("6", "16384² under ulimit -v 4G", None, ["render", "--width", "16384", "--height", "16384", "-o", "big.png"], "ulimit-v-4G"),
     ("6", "16384², --max-memory 64G, ulimit -v 2G", None, ["render", "--width", "16384", "--height", "16384", "--max-memory", "64G", "-o", "big.png"], "ulimit-v-2G"),
     ("7", "100,000 crumpled patches, --max-memory 256M", setup_patches, ["render", "crumpled.bpt", "--max-memory", "256M", "--width", "64", "--height", "48"], None),

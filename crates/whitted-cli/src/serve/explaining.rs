@@ -38,6 +38,25 @@ pub struct Answer {
     pub explain_seconds: f64,
 }
 
+/// What the pixels are seen in now: unknown until told, a scene's world
+/// through a camera, or nothing (the scene could not be read).
+enum Current {
+    Unknown,
+    Seen(Arc<Scene>, Camera),
+    Nothing,
+}
+
+impl Current {
+    /// Whether a pixel seen in `world` through `camera` is stale.
+    fn makes_stale(&self, world: &Arc<Scene>, camera: &Camera) -> bool {
+        match self {
+            Current::Unknown => false,
+            Current::Seen(w, c) => !Arc::ptr_eq(w, world) || c != camera,
+            Current::Nothing => true,
+        }
+    }
+}
+
 /// The pixel being explained: what it is seen in, and the flag that gives
 /// it up.
 struct Running {
@@ -46,11 +65,17 @@ struct Running {
     cancel: Arc<AtomicBool>,
 }
 
+/// What the explaining thread is doing, and what is current.
+struct State {
+    current: Current,
+    running: Option<Running>,
+}
+
 /// The queue of pixels to explain and the thread's end of it.
 pub struct Explaining {
     jobs: Mutex<Sender<Job>>,
     queue: Mutex<Option<Receiver<Job>>>,
-    running: Mutex<Option<Running>>,
+    state: Mutex<State>,
 }
 
 impl Explaining {
@@ -60,22 +85,51 @@ impl Explaining {
         Self {
             jobs: Mutex::new(jobs),
             queue: Mutex::new(Some(queue)),
-            running: Mutex::new(None),
+            state: Mutex::new(State {
+                current: Current::Unknown,
+                running: None,
+            }),
         }
     }
 
-    /// Gives up the pixel being explained, if any, unless it is seen in
-    /// `world` through `camera` (`None`: whatever it is seen in): its
-    /// answer is then an error saying it was cancelled.
+    fn lock(&self) -> std::sync::MutexGuard<'_, State> {
+        self.state.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// Makes `current` what pixels are seen in (`None`: nothing, the scene
+    /// could not be read), and gives up the pixel being explained, or any
+    /// waiting to be, seen in something else: its answer is then an error
+    /// saying it was cancelled.
     pub fn cancel_unless(&self, current: Option<(&Arc<Scene>, &Camera)>) {
-        let running = self.running.lock().unwrap_or_else(PoisonError::into_inner);
-        if let Some(r) = running.as_ref() {
-            let same = current
-                .is_some_and(|(world, camera)| Arc::ptr_eq(world, &r.world) && *camera == r.camera);
-            if !same {
-                r.cancel.store(true, Ordering::Relaxed);
-            }
+        let mut state = self.lock();
+        state.current = match current {
+            Some((world, camera)) => Current::Seen(Arc::clone(world), camera.clone()),
+            None => Current::Nothing,
+        };
+        if let Some(r) = &state.running
+            && state.current.makes_stale(&r.world, &r.camera)
+        {
+            r.cancel.store(true, Ordering::Relaxed);
         }
+    }
+
+    /// Marks `job` as the one being explained, from before its world is
+    /// built: the flag that gives it up, set already when it is stale.
+    fn begin(&self, job: &Job) -> Arc<AtomicBool> {
+        let mut state = self.lock();
+        let stale = state.current.makes_stale(&job.world, &job.camera);
+        let cancel = Arc::new(AtomicBool::new(stale));
+        state.running = Some(Running {
+            world: Arc::clone(&job.world),
+            camera: job.camera.clone(),
+            cancel: Arc::clone(&cancel),
+        });
+        cancel
+    }
+
+    /// No job is being explained.
+    fn end(&self) {
+        self.lock().running = None;
     }
 
     /// Explains a pixel on the explaining thread and waits for the answer.
@@ -122,17 +176,12 @@ impl Explaining {
         &self,
         explainer: &Explainer<'_>,
         job: &Job,
+        cancel: &AtomicBool,
     ) -> Result<PixelExplanation, String> {
-        let cancel = Arc::new(AtomicBool::new(false));
-        *self.running.lock().unwrap_or_else(PoisonError::into_inner) = Some(Running {
-            world: Arc::clone(&job.world),
-            camera: job.camera.clone(),
-            cancel: Arc::clone(&cancel),
-        });
         let explanation = explainer
-            .explain_unless(&job.camera, job.pixel, job.sample, &cancel)
+            .explain_unless(&job.camera, job.pixel, job.sample, cancel)
             .map_err(|e| e.to_string());
-        *self.running.lock().unwrap_or_else(PoisonError::into_inner) = None;
+        self.end();
         explanation
     }
 
@@ -141,11 +190,13 @@ impl Explaining {
     fn serve(&self, queue: &Receiver<Job>) {
         let mut next = queue.recv().ok();
         while let Some(job) = next.take() {
+            let mut cancel = self.begin(&job);
             let world = Arc::clone(&job.world);
             let start = Instant::now();
             let explainer = match Explainer::new(&world) {
                 Ok(explainer) => explainer,
                 Err(e) => {
+                    self.end();
                     let _ = job.reply.send(Answer {
                         explanation: Err(e.to_string()),
                         build_seconds: start.elapsed().as_secs_f64(),
@@ -159,7 +210,7 @@ impl Explaining {
             let mut job = job;
             loop {
                 let start = Instant::now();
-                let explanation = self.explain_job(&explainer, &job);
+                let explanation = self.explain_job(&explainer, &job, &cancel);
                 let _ = job.reply.send(Answer {
                     explanation,
                     build_seconds,
@@ -167,7 +218,10 @@ impl Explaining {
                 });
                 build_seconds = 0.0;
                 match queue.recv() {
-                    Ok(same) if Arc::ptr_eq(&same.world, &world) => job = same,
+                    Ok(same) if Arc::ptr_eq(&same.world, &world) => {
+                        cancel = self.begin(&same);
+                        job = same;
+                    }
                     other => {
                         next = other.ok();
                         break;
@@ -197,7 +251,7 @@ mod tests {
     }
 
     #[test]
-    fn a_newer_scene_gives_up_the_pixel_being_explained() {
+    fn a_newer_scene_gives_up_the_pixels_being_explained_and_waiting() {
         let explaining = Arc::new(Explaining::new());
         let server = Arc::clone(&explaining);
         // Serves until the process ends.
@@ -205,28 +259,37 @@ mod tests {
         let world = Arc::new(heavy_scene());
         let camera = world.camera.clone();
         let start = Instant::now();
-        let answer = std::thread::scope(|scope| {
+        let answers = std::thread::scope(|scope| {
             let asked =
                 scope.spawn(|| explaining.explain(Arc::clone(&world), camera.clone(), (4, 4), 0));
             std::thread::sleep(Duration::from_millis(300));
+            // A second pixel waits behind the first.
+            let waiting =
+                scope.spawn(|| explaining.explain(Arc::clone(&world), camera.clone(), (3, 3), 0));
+            std::thread::sleep(Duration::from_millis(100));
             // The same scene and camera do not cancel it; another scene does.
             explaining.cancel_unless(Some((&world, &camera)));
-            let running = explaining.running.lock().unwrap();
-            let flag = &running
+            let state = explaining.lock();
+            let flag = &state
+                .running
                 .as_ref()
                 .expect("the pixel is being explained")
                 .cancel;
             assert!(!flag.load(Ordering::Relaxed));
-            drop(running);
+            drop(state);
             let newer = Arc::new(Scene::clone(&world));
             explaining.cancel_unless(Some((&newer, &camera)));
-            asked.join().unwrap()
+            [asked.join().unwrap(), waiting.join().unwrap()]
         });
-        let error = answer.unwrap().explanation.unwrap_err();
-        assert_eq!(
-            error,
-            "the explanation was cancelled: a newer scene or camera replaced it"
-        );
+        // Both: the one under way, and the one that was waiting, given up
+        // as it was taken from the queue.
+        for answer in answers {
+            let error = answer.unwrap().explanation.unwrap_err();
+            assert_eq!(
+                error,
+                "the explanation was cancelled: a newer scene or camera replaced it"
+            );
+        }
         assert!(
             start.elapsed() < Duration::from_secs(20),
             "{:?}",

@@ -859,7 +859,7 @@ fn a_film_the_system_refuses_is_an_error_not_an_abort() {
 fn a_model_past_the_budget_is_refused_where_reading_passes_it() {
     use std::io::Write;
     let dir = tempfile::tempdir().unwrap();
-    // 718,802 triangles, about 20 MB, written a line at a time so that this
+    // 717,602 triangles, about 20 MB, written a line at a time so that this
     // process stays small (a child's peak counts its parent's).
     let n = 600;
     let file = fs::File::create(dir.path().join("grid.obj")).unwrap();

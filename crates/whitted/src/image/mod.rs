@@ -146,6 +146,26 @@ impl ImageFormat {
     }
 }
 
+/// `count` zeros, or `None` when the system refuses their memory. Asked
+/// of the allocator as zeroed memory, as `vec![0.0; count]` does, so that
+/// no page is touched here ([`Film::map_pages`] maps them, in parallel and
+/// in huge pages where it can).
+fn zeroed_values(count: usize) -> Option<Vec<f32>> {
+    if count == 0 {
+        return Some(Vec::new());
+    }
+    let layout = std::alloc::Layout::array::<f32>(count).ok()?;
+    // SAFETY: `layout` has a non-zero size (`count > 0`).
+    let pointer = unsafe { std::alloc::alloc_zeroed(layout) }.cast::<f32>();
+    if pointer.is_null() {
+        return None;
+    }
+    // SAFETY: `pointer` was allocated by the global allocator with the
+    // layout of `count` `f32`s, all of them initialised (zero bits are
+    // `0.0`), and is owned by nothing else.
+    Some(unsafe { Vec::from_raw_parts(pointer, count, count) })
+}
+
 /// The system refused the memory of a film (a limit such as `ulimit -v`,
 /// or memory taken by others), though the budget allowed it.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -170,16 +190,13 @@ impl Film {
     /// rather than an abort.
     pub fn try_new(width: u32, height: u32, channels: usize) -> Result<Self, FilmAllocError> {
         let values = width as usize * height as usize * channels;
-        let mut data = Vec::new();
-        if data.try_reserve_exact(values).is_err() {
-            return Err(FilmAllocError {
-                width,
-                height,
-                channels,
-                bytes: (values as u64).saturating_mul(4),
-            });
-        }
-        data.resize(values, 0.0);
+        let refused = FilmAllocError {
+            width,
+            height,
+            channels,
+            bytes: (values as u64).saturating_mul(4),
+        };
+        let data = zeroed_values(values).ok_or(refused)?;
         Ok(Self {
             width,
             height,
@@ -599,6 +616,13 @@ mod tests {
         let info = reader.next_frame(&mut buf).unwrap();
         buf.truncate(info.buffer_size());
         buf
+    }
+
+    #[test]
+    fn a_film_made_fallibly_is_the_black_film() {
+        for (w, h, c) in [(0, 5, 3), (7, 0, 1), (1, 1, 1), (640, 480, 3), (33, 17, 4)] {
+            assert_eq!(Film::try_new(w, h, c).unwrap(), Film::new(w, h, c));
+        }
     }
 
     #[test]

@@ -176,8 +176,10 @@ impl<'s> Explainer<'s> {
     }
 
     /// [`Self::explain`], given up once `cancel` is set: the tracing then
-    /// starts no further shadow or secondary rays and no further sample of
-    /// the pixel, and the answer is [`ExplainError::Cancelled`].
+    /// starts no further shadow or secondary rays, nor (with stratified
+    /// samples) a further sample of the pixel, and the answer is
+    /// [`ExplainError::Cancelled`]. Adaptive anti-aliasing's corners, a few
+    /// hundred camera rays at most, are traced whole first.
     pub fn explain_unless(
         &self,
         camera: &Camera,

@@ -213,7 +213,8 @@ pub enum RenderError {
     /// readers refuse them with a located message).
     #[error("the scene's instances are invalid: {0}")]
     Instances(#[from] crate::world::InstanceError),
-    /// The films would exceed the memory budget.
+    /// The films, or the world as estimated, would exceed the memory
+    /// budget.
     #[error(transparent)]
     Memory(#[from] MemoryError),
     /// The system refused a film's memory, which the budget allowed.

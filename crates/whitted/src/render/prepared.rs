@@ -80,8 +80,9 @@ impl<'s> Prepared<'s> {
         let settings = &scene.settings;
         settings.check()?;
         super::check_objects(&scene.objects)?;
-        super::resources::check_memory(settings, MemoryBudget::current())?;
+        // The world first, so that the films are weighed beside it.
         let world_charge = super::charge_world_of(scene)?;
+        super::resources::check_memory(settings, MemoryBudget::current())?;
         let start = Instant::now();
         let world = super::build_world(scene);
         let build_seconds = start.elapsed().as_secs_f64();

@@ -5,6 +5,7 @@ use super::entry::Entry;
 use super::objects::{MeshInstance, Objects};
 use crate::accel::AccelKind;
 use crate::math::Aabb;
+use crate::mesh::TriangleMesh;
 
 /// What each slot of a level's structure takes besides the structure: its
 /// entry and the box it is built from.
@@ -28,25 +29,58 @@ impl Objects {
         m.transform.is_some() || placements[m.mesh.0 as usize] > 1
     }
 
+    /// Per definition of [`Objects::definitions`], whether something
+    /// placed places it: the world prepares those alone. A definition
+    /// places only earlier ones, so one pass from the last finds them all.
+    pub(super) fn placed_definitions(&self) -> Vec<bool> {
+        let mut placed = vec![false; self.definitions.len()];
+        for i in &self.instances {
+            placed[i.definition.0 as usize] = true;
+        }
+        for d in (0..placed.len()).rev() {
+            if placed[d] {
+                for i in &self.definitions[d].instances {
+                    placed[i.definition.0 as usize] = true;
+                }
+            }
+        }
+        placed
+    }
+
     /// An estimate of the most bytes the objects and the world built from
     /// them take together, with structures of kind `top` at the top level
     /// and `bottom` below: the meshes' vertices and triangles, each
     /// level's entries and boxes, and each structure as
     /// [`AccelKind::bytes_per_primitive`] estimates it. Instances count
     /// once per definition or mesh, not per placement, as the world keeps
-    /// them. Saturates rather than wrap.
+    /// them; a definition nothing places, only its meshes' data.
+    /// Saturates rather than wrap.
     pub fn estimated_world_bytes(&self, top: AccelKind, bottom: AccelKind) -> u64 {
         self.definitions
             .iter()
-            .map(|d| d.level_bytes(bottom, bottom))
+            .zip(self.placed_definitions())
+            .map(|(d, placed)| {
+                if placed {
+                    d.level_bytes(bottom, bottom)
+                } else {
+                    d.mesh_bytes()
+                }
+            })
             .fold(self.level_bytes(top, bottom), u64::saturating_add)
+    }
+
+    /// The bytes of this level's meshes' vertices and triangles.
+    fn mesh_bytes(&self) -> u64 {
+        self.meshes
+            .iter()
+            .map(TriangleMesh::heap_bytes)
+            .fold(0, u64::saturating_add)
     }
 
     /// [`Objects::estimated_world_bytes`] of this level alone, its
     /// structure of kind `kind`, its meshes kept as instances under `bottom`.
     fn level_bytes(&self, kind: AccelKind, bottom: AccelKind) -> u64 {
         let placements = self.placements();
-        let mut mesh_data = 0u64;
         let mut instanced = vec![false; self.meshes.len()];
         let mut slots = (self.primitives.len() + self.instances.len()) as u64;
         for m in &self.mesh_instances {
@@ -60,13 +94,12 @@ impl Objects {
         }
         let mut instanced_triangles = 0u64;
         for (mesh, instanced) in self.meshes.iter().zip(instanced) {
-            mesh_data = mesh_data.saturating_add(mesh.heap_bytes());
             if instanced {
                 instanced_triangles = instanced_triangles.saturating_add(mesh.len() as u64);
             }
         }
         let per_slot = |kind: AccelKind| SLOT_BYTES + kind.bytes_per_primitive();
-        mesh_data
+        self.mesh_bytes()
             .saturating_add(slots.saturating_mul(per_slot(kind)))
             .saturating_add(instanced_triangles.saturating_mul(per_slot(bottom)))
     }
@@ -76,7 +109,6 @@ impl Objects {
 mod tests {
     use super::*;
     use crate::math::{Transform, Vec3};
-    use crate::mesh::TriangleMesh;
     use crate::shape::{Shape, Sphere};
     use crate::world::MaterialId;
 
@@ -134,6 +166,17 @@ mod tests {
         assert_eq!(
             objects.estimated_world_bytes(AccelKind::Grid, AccelKind::Linear),
             50 * per_slot(AccelKind::Grid) + 10 * per_slot(AccelKind::Linear)
+        );
+        // A definition nothing places adds its meshes' data alone.
+        let mut unplaced = Objects::default();
+        let model = unplaced.add_mesh(mesh(100));
+        unplaced.add_mesh_instance(model, MaterialId(0), Transform::IDENTITY);
+        objects.add_definition(unplaced);
+        assert_eq!(
+            objects.estimated_world_bytes(AccelKind::Grid, AccelKind::Linear),
+            50 * per_slot(AccelKind::Grid)
+                + 10 * per_slot(AccelKind::Linear)
+                + mesh(100).heap_bytes()
         );
     }
 }

@@ -219,19 +219,7 @@ impl<'a> World<'a> {
         if let Err(error) = objects.check_instances() {
             panic!("the world's instances are invalid: {error}");
         }
-        // Which definitions something placed places (a definition places
-        // only earlier ones, so one pass from the last finds them all).
-        let mut placed = vec![false; objects.definitions.len()];
-        for i in &objects.instances {
-            placed[i.definition.0 as usize] = true;
-        }
-        for d in (0..placed.len()).rev() {
-            if placed[d] {
-                for i in &objects.definitions[d].instances {
-                    placed[i.definition.0 as usize] = true;
-                }
-            }
-        }
+        let placed = objects.placed_definitions();
         let mut definitions: Vec<World<'a>> = Vec::with_capacity(placed.len());
         for (d, definition) in objects.definitions.iter().enumerate() {
             let level = Self::build_level(
