@@ -77,13 +77,17 @@ pub fn run(args: ServeArgs) -> Result<(), String> {
     ))?;
     let session = Session::new(args.scene);
     let slots = Slots::default();
+    // Stamped before the render loop first reads the file, so that an edit
+    // made right after that read is seen.
+    let watched = session
+        .file()
+        .map(|path| (path.to_path_buf(), session::file_stamp(path)));
     std::thread::scope(|scope| {
         scope.spawn(|| session.render_loop());
         scope.spawn(|| session.explaining.run());
-        if let Some(path) = session.file() {
-            let path = path.to_path_buf();
+        if let Some((path, stamp)) = watched {
             let session = &session;
-            scope.spawn(move || session.watch_file(path));
+            scope.spawn(move || session.watch_file(path, stamp));
         }
         for stream in listener.incoming() {
             let Ok(stream) = stream else { continue };

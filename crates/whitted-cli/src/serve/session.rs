@@ -10,7 +10,7 @@
 //! view asked for while the mouse moves gets only a 1/4 pass.
 
 use std::collections::VecDeque;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, SystemTime};
@@ -138,6 +138,15 @@ pub struct Session {
     cancel: AtomicBool,
     /// The thread that explains clicked pixels, and its queue.
     pub explaining: Explaining,
+}
+
+/// A file's modification time and size.
+pub type FileStamp = (SystemTime, u64);
+
+/// The stamp of the file at `path`, if it can be read.
+pub fn file_stamp(path: &Path) -> Option<FileStamp> {
+    let meta = std::fs::metadata(path).ok()?;
+    Some((meta.modified().ok()?, meta.len()))
 }
 
 impl Session {
@@ -268,17 +277,14 @@ impl Session {
         self.changed.notify_all();
     }
 
-    /// Watches the scene file: when its time or size changes, it is read
-    /// again and rendered. Runs forever.
-    pub fn watch_file(&self, path: PathBuf) {
-        let stamp = |path: &PathBuf| -> Option<(SystemTime, u64)> {
-            let meta = std::fs::metadata(path).ok()?;
-            Some((meta.modified().ok()?, meta.len()))
-        };
-        let mut last = stamp(&path);
+    /// Watches the scene file: when its time or size changes from `last`
+    /// ([`file_stamp`], taken before the file is first read, so that no
+    /// change after that read goes unseen), it is read again and rendered.
+    /// Runs forever.
+    pub fn watch_file(&self, path: PathBuf, mut last: Option<FileStamp>) {
         loop {
             std::thread::sleep(Duration::from_millis(150));
-            let now = stamp(&path);
+            let now = file_stamp(&path);
             if now != last {
                 last = now;
                 let mut inner = self.lock();
