@@ -80,9 +80,11 @@ impl<'s> Prepared<'s> {
         let settings = &scene.settings;
         settings.check()?;
         super::check_objects(&scene.objects)?;
-        // The world first, so that the films are weighed beside it.
-        let world_charge = super::charge_world_of(scene)?;
+        // The films alone first, for an image too large whatever the
+        // scene; they are weighed again beside the world when the render
+        // takes them.
         super::resources::check_memory(settings, MemoryBudget::current())?;
+        let world_charge = super::charge_world_of(scene)?;
         let start = Instant::now();
         let world = super::build_world(scene);
         let build_seconds = start.elapsed().as_secs_f64();
