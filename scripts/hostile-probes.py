@@ -223,22 +223,14 @@ PROBES = [
 SPHERE = '[[objects]]\nshape = "sphere"\ncenter = [0,0,0]\nradius = 1\nmaterial = "m"\n'
 
 
-def rect_lit_mirrors(samples):
-    with open(GLASS_IN_MIRRORS) as f:
-        return f.read().replace(
-            'type = "point"\nposition = [0, 1, -1]',
-            'type = "rect"\norigin = [-0.5, 1.9, -0.5]\nedge_u = [1, 0, 0]\n'
-            f'edge_v = [0, 0, 1]\nradiance = 1\nsamples = {samples}',
-        )
-
-
 def setup_output_over_texture(d):
     write(d, "tex.png", big_png(64, 64))
     write(d, "t.toml", SCENE_HEAD.replace("diffuse = 0.5", 'diffuse = { image = "tex.png" }') + SPHERE)
 
 
 def setup_rect_mirrors(d):
-    write(d, "m.toml", rect_lit_mirrors(4096))
+    with open(os.path.join(REPOSITORY, "crates/whitted/tests/hostile_scenes/glass_in_mirrors_area_light.toml")) as f:
+        write(d, "m.toml", f.read())
 
 
 def setup_wrapping_count(d):

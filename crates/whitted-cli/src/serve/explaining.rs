@@ -241,13 +241,8 @@ mod tests {
     /// samples: a pixel that takes millions of shadow rays.
     fn heavy_scene() -> Scene {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../whitted/tests/hostile_scenes/glass_in_mirrors.toml");
-        let source = std::fs::read_to_string(&path).unwrap().replace(
-            "type = \"point\"\nposition = [0, 1, -1]",
-            "type = \"rect\"\norigin = [-0.5, 1.9, -0.5]\nedge_u = [1, 0, 0]\n\
-             edge_v = [0, 0, 1]\nradiance = 1\nsamples = 4096",
-        );
-        whitted::scene::parse_scene(&source, &path).unwrap()
+            .join("../whitted/tests/hostile_scenes/glass_in_mirrors_area_light.toml");
+        whitted::scene::load_any(&path).unwrap()
     }
 
     #[test]
