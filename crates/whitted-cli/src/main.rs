@@ -15,6 +15,8 @@ mod explain_text;
 mod merge_command;
 mod outputs;
 mod progress;
+#[cfg(unix)]
+mod refused_memory;
 mod render_command;
 mod render_stats;
 mod report;
@@ -29,6 +31,10 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::report::note;
+
+#[cfg(unix)]
+#[global_allocator]
+static ALLOCATOR: refused_memory::Noting = refused_memory::Noting;
 
 /// A classic (Whitted-style) ray tracer: exact primitives, Phong shading,
 /// shadows, mirror reflection and refraction.
@@ -64,6 +70,10 @@ fn main() -> ExitCode {
             return ExitCode::from(e.exit_code().clamp(0, 255) as u8);
         }
     };
+    #[cfg(unix)]
+    if let Err(message) = refused_memory::end_refusals_as_errors() {
+        note!("warning: {message}; memory the system refuses will abort the run");
+    }
     #[cfg(unix)]
     if let Err(message) = signals::remove_partial_files_on_signals() {
         note!("warning: {message}; an interrupted render may leave .partial files behind");

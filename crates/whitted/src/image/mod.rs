@@ -22,7 +22,7 @@ mod partial;
 pub use color_space::{ColorSpace, encode_display8, encode_srgb8};
 pub use destination::{Destination, check_destination, check_text_destination};
 pub use heat_map::{heat_map, ramp};
-pub use partial::{PartialFilesRemoved, remove_partial_files};
+pub use partial::{PartialFilesRemoved, remove_partial_files, remove_partial_files_now};
 
 use destination::{existing_file, folder_of, keep_attributes, resolve};
 use partial::{IN_FLIGHT, PartialFile};

@@ -39,6 +39,20 @@ impl Registry {
         }
         list
     }
+
+    /// Removes every listed file when the list is not locked, without
+    /// waiting for it and without allocating (each path is passed to the
+    /// system from the stack when shorter than a few hundred bytes, as
+    /// `std::fs` does). Returns whether the list could be read.
+    fn remove_all_now(&self) -> bool {
+        let Ok(list) = self.0.try_lock() else {
+            return false;
+        };
+        for path in list.iter() {
+            let _ = std::fs::remove_file(path);
+        }
+        true
+    }
 }
 
 /// The partial files of this process.
@@ -123,6 +137,17 @@ pub fn remove_partial_files() -> PartialFilesRemoved {
     }
 }
 
+/// Removes every partial file this process has on disk, for a process
+/// being aborted (in a `SIGABRT` handler, after an allocation the system
+/// refused): it neither waits for the registry's lock nor allocates
+/// memory for the paths of usual length. Returns false, removing nothing,
+/// when another thread held the registry at that moment (one creating,
+/// renaming or removing a partial file: its file is then being dealt
+/// with).
+pub fn remove_partial_files_now() -> bool {
+    IN_FLIGHT.remove_all_now()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -132,6 +157,7 @@ mod tests {
     /// while it runs beside it.
     static LISTED: Registry = Registry::new();
     static EMPTIED: Registry = Registry::new();
+    static ABORTED: Registry = Registry::new();
 
     /// The files `registry` lists.
     fn listed(registry: &Registry) -> Vec<PathBuf> {
@@ -175,6 +201,22 @@ mod tests {
         // Dropping it afterwards finds nothing to remove and no entry.
         drop(partial);
         assert!(!listed(&EMPTIED).contains(&path));
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+
+    #[test]
+    fn removing_at_an_abort_neither_waits_nor_needs_the_list_free() {
+        let dir = tempfile::tempdir().unwrap();
+        let partial = PartialFile::create_in(dir.path(), &ABORTED).unwrap();
+        let path = partial.temp.as_ref().unwrap().path().to_path_buf();
+        {
+            let _held = ABORTED.lock();
+            assert!(!ABORTED.remove_all_now());
+        }
+        assert!(path.exists());
+        assert!(ABORTED.remove_all_now());
+        assert!(!path.exists());
+        drop(partial);
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     }
 }

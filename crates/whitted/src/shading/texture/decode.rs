@@ -187,7 +187,8 @@ fn decode_png(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
     };
     let (charge, decoding_charge) =
         charge_texel_memory(width, height, size as u64, 3 * sample_bytes)?;
-    let mut buffer = vec![0; size];
+    let mut buffer = reserved::<u8>(size)?;
+    buffer.resize(size, 0);
     let info = reader.next_frame(&mut buffer).map_err(|e| e.to_string())?;
     let channels = match info.color_type {
         png::ColorType::Grayscale => 1,
@@ -217,23 +218,38 @@ fn decode_png(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
             .flat_map(|row| row.chunks_exact(channels * sample_bytes).take(width))
     };
     let texels = if wide {
-        let words = pixels()
-            .map(|p| samples(p, &|at| u16::from_be_bytes([at[0], at[1]])))
-            .collect();
+        let mut words = reserved(width * height)?;
+        words.extend(pixels().map(|p| samples(p, &|at| u16::from_be_bytes([at[0], at[1]]))));
         let table: Arc<[f32]> = (0..=u16::MAX)
             .map(|v| texel_value(f32::from(v) / 65535.0, decoding))
             .collect();
         Texels::Words(words, table)
     } else {
-        let bytes = pixels()
-            .map(|p| samples(p, &|at| u16::from(at[0])).map(|v| v as u8))
-            .collect();
+        let mut bytes = reserved(width * height)?;
+        bytes.extend(pixels().map(|p| samples(p, &|at| u16::from(at[0])).map(|v| v as u8)));
         Texels::Bytes(bytes, Arc::new(eight_bit_table(decoding)))
     };
     drop((buffer, decoding_charge));
     ImageData::stored(width, height, texels)
         .map(|data| data.holding(charge))
         .ok_or_else(|| "the image data is truncated".to_string())
+}
+
+/// An empty vector with room for `count` items, or the message for the
+/// system's refusal of that memory (which the budget allowed: a budget
+/// given above what the process may use), so that a server reading a new
+/// scene stays up.
+fn reserved<T>(count: usize) -> Result<Vec<T>, String> {
+    let mut items = Vec::new();
+    items.try_reserve_exact(count).map_err(|_| {
+        let bytes = (count as u64).saturating_mul(std::mem::size_of::<T>() as u64);
+        format!(
+            "the system refused the {} its texels need; free memory, raise the process's \
+             limit (ulimit -v), or use a smaller image",
+            crate::limits::format_bytes(bytes)
+        )
+    })?;
+    Ok(items)
 }
 
 /// The most bytes deflate (PNG's compression) can expand one byte into
@@ -315,7 +331,8 @@ fn decode_jpeg(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
         charge_texel_memory(width as u32, height as u32, claimed * 3, 3)?;
     let pixels = decoder.decode().map_err(|e| e.to_string())?;
     let (width, height) = decoder.dimensions().ok_or("no image size")?;
-    let texels = pixels.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+    let mut texels = reserved(pixels.len() / 3)?;
+    texels.extend(pixels.chunks_exact(3).map(|p| [p[0], p[1], p[2]]));
     drop((pixels, decoding_charge));
     let texels = Texels::Bytes(texels, Arc::new(eight_bit_table(decoding)));
     ImageData::stored(width, height, texels)
