@@ -130,7 +130,7 @@ fn load(path: &Path, width: u32, height: u32) -> Result<Scene, String> {
     let aspect = f64::from(width) / f64::from(height);
     let camera = Camera::framing(&soup.bounds(), aspect, 50.0)
         .map_err(|e| format!("{}: cannot frame the mesh: {e}", path.display()))?;
-    soup.to_scene(camera)
+    soup.into_scene(camera)
         .map_err(|e| format!("{}: {e}", path.display()))
 }
 

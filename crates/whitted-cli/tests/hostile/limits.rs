@@ -917,6 +917,36 @@ fn a_model_past_the_budget_is_refused_where_reading_passes_it() {
     assert!(p.peak_bytes < 200 * MIB, "{}", p.peak_bytes);
 }
 
+/// Item 5's rule in `bench`'s own OBJ reader (positions and faces only):
+/// it charges what it reads as it grows, and stops at the line where that
+/// passes the budget: 2 million vertices (16 MB of text, 48 MB as read) at
+/// `--max-memory 24M`.
+#[test]
+fn bench_stops_reading_a_model_where_it_passes_the_budget() {
+    use std::io::Write;
+    let dir = tempfile::tempdir().unwrap();
+    let file = fs::File::create(dir.path().join("verts.obj")).unwrap();
+    let mut out = std::io::BufWriter::new(file);
+    for _ in 0..2_000_000 {
+        out.write_all(b"v 1 2 3\n").unwrap();
+    }
+    out.write_all(b"f 1 2 3\n").unwrap();
+    out.flush().unwrap();
+    drop(out);
+    let args = ["bench", "verts.obj", "--width", "16", "--height", "16"];
+    let p = probe(&[&args[..], &["--max-memory", "24M"]].concat(), dir.path());
+    assert_eq!(p.code(), Some(1), "{}", p.stderr);
+    assert!(
+        p.stderr.contains(
+            "verts.obj:1048577:1: error: reading the model's vertices and faces needs 24.0 MiB \
+             beside the 24.0 MiB the run holds already"
+        ),
+        "{}",
+        p.stderr
+    );
+    assert!(p.peak_bytes < 100 * MIB, "{}", p.peak_bytes);
+}
+
 /// Writes a model of 717,602 triangles (about 20 MB) to `path`, a line at
 /// a time so that this process stays small (a child's peak counts its
 /// parent's).

@@ -11,6 +11,7 @@
 use std::ops::Range;
 use std::path::Path;
 
+use crate::limits::{Charge, MemoryBudget};
 use crate::math::{Aabb, Transform, Vec3};
 use crate::mesh::{MeshError, TriangleMesh};
 use crate::render::Camera;
@@ -33,13 +34,19 @@ impl TriangleSoup {
         Aabb::from_points(self.positions.iter().copied())
     }
 
+    /// The bytes its positions and triangles take.
+    fn heap_bytes(&self) -> u64 {
+        (self.positions.capacity() * size_of::<Vec3>()
+            + self.triangles.capacity() * size_of::<[u32; 3]>()) as u64
+    }
+
     /// A scene of one mesh of these triangles, all of one grey material,
     /// seen by `camera`. Every triangle keeps its index in the file as its
     /// primitive number, zero-area ones included (they are never hit).
-    pub fn to_scene(&self, camera: Camera) -> Result<Scene, MeshError> {
+    pub fn into_scene(self, camera: Camera) -> Result<Scene, MeshError> {
         let mut scene = Scene::new(camera);
         let material = scene.add_material(Material::default());
-        let mesh = TriangleMesh::new(self.positions.clone(), self.triangles.clone())?;
+        let mesh = TriangleMesh::new(self.positions, self.triangles)?;
         let mesh = scene.add_mesh(mesh);
         scene.add_mesh_instance(mesh, material, Transform::IDENTITY);
         Ok(scene)
@@ -56,9 +63,14 @@ pub fn load_obj_positions(path: &Path) -> Result<TriangleSoup, SceneError> {
 }
 
 /// Parses OBJ text; `path` is only used in messages. Every malformed line is
-/// reported.
+/// reported. The positions and triangles are charged to the memory ledger
+/// while they are read ([`Charge::follow`]); reading stops at the line
+/// where they pass the budget. The charge ends with the reading: a scene
+/// made of them is charged with its world before that is built.
 pub fn parse_obj_positions(source: &str, path: &Path) -> Result<TriangleSoup, SceneError> {
     let source = without_bom(source);
+    let budget = MemoryBudget::current();
+    let mut charge = Charge::none();
     let mut soup = TriangleSoup::default();
     let mut diagnostics = Vec::new();
     let mut face: Vec<u32> = Vec::new();
@@ -126,6 +138,19 @@ pub fn parse_obj_positions(source: &str, path: &Path) -> Result<TriangleSoup, Sc
                 }
             }
             _ => {}
+        }
+        let charged = charge.follow(
+            &budget,
+            "reading the model's vertices and faces",
+            soup.heap_bytes(),
+            "use a smaller model",
+        );
+        if let Err(error) = charged {
+            // Reading stops here: what is left would only take more.
+            push_limited(&mut diagnostics, Severity::Error, || {
+                Diagnostic::new(path, source, start..start, error.to_string())
+            });
+            break;
         }
     }
     if diagnostics.is_empty() {
@@ -229,7 +254,7 @@ mod tests {
     fn the_scene_numbers_triangles_as_the_file_does_zero_area_ones_included() {
         let soup = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 4\nf 1 2 3\n").unwrap();
         let camera = Camera::framing(&soup.bounds(), 1.0, 50.0).unwrap();
-        let scene = soup.to_scene(camera).unwrap();
+        let scene = soup.into_scene(camera).unwrap();
         let world = crate::world::World::new(&scene.objects);
         assert_eq!(world.len(), 2);
         let ray = crate::math::Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z);

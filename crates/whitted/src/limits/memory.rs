@@ -152,7 +152,29 @@ impl Charge {
         std::mem::forget(added);
         Ok(())
     }
+
+    /// Follows data that grows as it is read: once its `bytes` pass what
+    /// the charge holds by [`GROWTH_STEP`] or more, grows the charge to
+    /// them (so that a file is charged a few times, not per statement).
+    /// Refused as [`Charge::grow`] is.
+    pub fn follow(
+        &mut self,
+        budget: &MemoryBudget,
+        what: &str,
+        bytes: u64,
+        remedy: &str,
+    ) -> Result<(), MemoryError> {
+        let more = bytes.saturating_sub(self.bytes);
+        if more < GROWTH_STEP {
+            return Ok(());
+        }
+        self.grow(budget, what, more, remedy)
+    }
 }
+
+/// How far data read from a file may grow past what it is charged before
+/// [`Charge::follow`] charges it again.
+pub const GROWTH_STEP: u64 = 16 << 20;
 
 impl Drop for Charge {
     fn drop(&mut self) {
@@ -504,6 +526,35 @@ mod tests {
         drop(third);
         assert_eq!(OWN.held.load(Ordering::Relaxed), 0);
         assert!(charge(1 << 40).is_ok());
+    }
+
+    #[test]
+    fn a_charge_follows_growing_data_a_step_at_a_time() {
+        static OWN: Ledger = Ledger {
+            held: AtomicU64::new(0),
+        };
+        let budget = MemoryBudget::given(100 << 20);
+        let mut charge = Charge {
+            bytes: 0,
+            ledger: &OWN,
+        };
+        let follow = |charge: &mut Charge, bytes| charge.follow(&budget, "a model", bytes, "less");
+        follow(&mut charge, GROWTH_STEP - 1).unwrap();
+        assert_eq!(charge.bytes(), 0, "less than a step is not charged yet");
+        follow(&mut charge, 40 << 20).unwrap();
+        assert_eq!(charge.bytes(), 40 << 20);
+        follow(&mut charge, (40 << 20) + GROWTH_STEP - 1).unwrap();
+        assert_eq!(charge.bytes(), 40 << 20);
+        follow(&mut charge, 10 << 20).unwrap();
+        assert_eq!(
+            charge.bytes(),
+            40 << 20,
+            "data that shrank is not given back"
+        );
+        assert!(follow(&mut charge, 120 << 20).is_err());
+        assert_eq!(charge.bytes(), 40 << 20, "a refusal holds what it held");
+        drop(charge);
+        assert_eq!(OWN.held.load(Ordering::Relaxed), 0);
     }
 
     #[test]

@@ -12,6 +12,6 @@ mod memory;
 
 pub use input::{InputFile, identify_input, inputs_read, read_input, read_input_text};
 pub use memory::{
-    BudgetOrigin, ByteSize, Charge, Held, MemoryBudget, MemoryError, MemoryLimit, format_bytes,
-    parse_size,
+    BudgetOrigin, ByteSize, Charge, GROWTH_STEP, Held, MemoryBudget, MemoryError, MemoryLimit,
+    format_bytes, parse_size,
 };

@@ -153,7 +153,7 @@ fn run_obj_positions(workspace: &Workspace, parts: &[Vec<u8>], accel: AccelKind)
         .or_else(|_| Camera::new(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 50.0));
     let scene = camera
         .map_err(drop)
-        .and_then(|c| soup.to_scene(c).map_err(drop));
+        .and_then(|c| soup.into_scene(c).map_err(drop));
     scene.map(|scene| exercise(scene, accel)).is_ok()
 }
 

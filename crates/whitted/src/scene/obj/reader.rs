@@ -56,10 +56,6 @@ pub(super) struct ObjData {
     pub(super) charge: Charge,
 }
 
-/// How far the read data may grow past what it is charged before the next
-/// charge (so that a file is charged a few times, not per statement).
-const CHARGE_STEP: u64 = 16 << 20;
-
 impl ObjData {
     /// The bytes its vertices, corners and faces take.
     pub(super) fn heap_bytes(&self) -> u64 {
@@ -111,18 +107,15 @@ struct Reader<'a> {
 struct Reported;
 
 impl Reader<'_> {
-    /// Charges what the data took since the last charge, once it is
-    /// [`CHARGE_STEP`] more.
+    /// Charges what the data took since the last charge (see
+    /// [`crate::limits::Charge::follow`]).
     fn charge(&mut self, budget: &MemoryBudget) -> Result<(), MemoryError> {
         let data = &mut self.data;
-        let more = data.heap_bytes().saturating_sub(data.charge.bytes());
-        if more < CHARGE_STEP {
-            return Ok(());
-        }
-        data.charge.grow(
+        let bytes = data.heap_bytes();
+        data.charge.follow(
             budget,
             "reading the model's vertices and faces",
-            more,
+            bytes,
             "use a smaller model",
         )
     }
