@@ -2,7 +2,9 @@
 """Runs the worst probe of each defect class of a hostile-input audit
 (issue 23, or with --round 3 issue 50) against one `whitted` binary and
 prints a table: exit code, wall time, peak resident memory and the first
-line of what it said.
+line of what it said. Round 3 then probes `whitted serve` (slow clients,
+event streams, HEAD, Host headers, long heads, another bound address) and
+prints a second table with the server's peak memory.
 
     python3 scripts/hostile-probes.py target/release/whitted [--round 3]
 
@@ -17,6 +19,7 @@ import argparse
 import os
 import resource
 import signal
+import socket
 import struct
 import subprocess
 import sys
@@ -314,8 +317,8 @@ def setup_grid_model(d):
 
 
 # Issue 50 (round 3): the worst probe of each class that a command line can
-# reach; the server's items (4, 20-22) and the races and full disks (11,
-# 13) are measured by their tests.
+# reach; the server's (20-22) are SERVE_PROBES_3 below; item 4 and the races
+# and full disks (11, 13) are measured by their tests.
 PROBES_3 = [
     ("1", "-o over the scene's texture", setup_output_over_texture, ["render", "t.toml", "-o", "tex.png"], None),
     ("2", "explain, 4096-sample light in mirrors", setup_rect_mirrors, ["explain", "m.toml", "--pixel", "4,4", "--json", "-q"], None),
@@ -416,6 +419,173 @@ def run(binary, folder, args, special, timeout, max_bytes):
     return outcome, seconds, usage.ru_maxrss / 1024, first, len(said), ", ".join(written)
 
 
+class Server:
+    """`whitted serve` of the built-in scene on a free port of `bind`."""
+
+    def __init__(self, binary, bind="127.0.0.1"):
+        self.proc = subprocess.Popen(
+            [binary, "serve", "--port", "0", "--bind", bind, "--width", "64", "--height", "48"],
+            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, text=True)
+        line = self.proc.stdout.readline()
+        address = line.split("http://", 1)[1].split("/", 1)[0]
+        self.host, port = address.rsplit(":", 1)
+        self.port = int(port)
+
+    def connect(self, timeout=30):
+        return socket.create_connection((self.host, self.port), timeout=timeout)
+
+    def exchange(self, head, timeout=30):
+        """Sends a request head and reads the whole answer (the server closes
+        after one): its status and the bytes after its head."""
+        with self.connect(timeout) as s:
+            s.sendall(head)
+            answer = b""
+            try:
+                while chunk := s.recv(65536):
+                    answer += chunk
+                    if b"text/event-stream" in answer:
+                        break
+            except ConnectionResetError:
+                # A refusal may close before reading what was sent.
+                pass
+        status = int(answer.split(b" ", 2)[1]) if answer.startswith(b"HTTP/") else 0
+        return status, len(answer.split(b"\r\n\r\n", 1)[-1]) if b"\r\n\r\n" in answer else 0
+
+    def get(self, path="/", extra=b""):
+        return self.exchange(b"GET " + path.encode() + b" HTTP/1.1\r\nHost: "
+                             + f"{self.host}:{self.port}".encode() + b"\r\n" + extra + b"\r\n")
+
+    def peak_mib(self):
+        with open(f"/proc/{self.proc.pid}/status") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024
+        return float("nan")
+
+    def stop(self):
+        self.proc.terminate()
+        self.proc.wait()
+
+
+def probe_slow_clients(server, count):
+    """Item 20: `count` connections sending their request head a byte every
+    second; when a page is first answered with 200, and what the slow ones
+    get."""
+    slow = []
+    for _ in range(count):
+        s = server.connect()
+        s.sendall(b"G")
+        slow.append(s)
+    start = time.monotonic()
+    statuses = []
+    while time.monotonic() - start < 20:
+        status, _ = server.get("/")
+        statuses.append(status)
+        if status == 200:
+            break
+        for s in slow:
+            try:
+                s.sendall(b"E")
+            except OSError:
+                pass
+        time.sleep(1)
+    answered = time.monotonic() - start
+    timed_out = 0
+    for s in slow:
+        s.settimeout(15)
+        try:
+            while True:
+                s.sendall(b"E")
+                answer = s.recv(64)
+                if answer.startswith(b"HTTP/1.1 408"):
+                    timed_out += 1
+                if answer:
+                    break
+                time.sleep(1)
+        except OSError:
+            pass
+        s.close()
+    refused = sum(1 for st in statuses if st == 503)
+    return (f"page 200 after {answered:.1f} s ({refused} tries answered 503 first); "
+            f"{timed_out} of {count} slow heads answered 408")
+
+
+def probe_event_streams(server):
+    """Item 20: 64 event streams held open, then a page."""
+    streams, refused = [], 0
+    for _ in range(64):
+        s = server.connect()
+        s.sendall(b"GET /events HTTP/1.1\r\nHost: " + f"{server.host}:{server.port}".encode() + b"\r\n\r\n")
+        head = s.recv(4096)
+        if head.startswith(b"HTTP/1.1 503"):
+            refused += 1
+            s.close()
+        else:
+            streams.append(s)
+    start = time.monotonic()
+    status, _ = server.get("/")
+    answered = time.monotonic() - start
+    for s in streams:
+        s.close()
+    return f"{len(streams)} streams open, {refused} answered 503; page {status} in {answered * 1000:.0f} ms"
+
+
+def probe_other_bind(binary):
+    """Item 21: a server bound to 127.0.0.2 answers requests naming it."""
+    server = Server(binary, "127.0.0.2")
+    try:
+        status, _ = server.get("/")
+        return f"GET / with Host 127.0.0.2: {status}", server.peak_mib()
+    finally:
+        server.stop()
+
+
+def probe_head(server):
+    status, body = server.exchange(b"HEAD / HTTP/1.1\r\nHost: " + f"{server.host}:{server.port}".encode() + b"\r\n\r\n")
+    return f"HEAD /: {status}, {body} body bytes"
+
+
+def probe_two_hosts(server):
+    status, _ = server.get("/", b"Host: evil.example\r\n")
+    return f"a second Host: {status}"
+
+
+def probe_long_head(server):
+    status, _ = server.get("/", b"X-Pad: " + b"a" * (17 << 10) + b"\r\n")
+    return f"a 17 KiB head: {status}"
+
+
+SERVE_PROBES_3 = [
+    ("20", "70 slow request heads", lambda server: probe_slow_clients(server, 70)),
+    ("20", "300 slow request heads", lambda server: probe_slow_clients(server, 300)),
+    ("20", "64 event streams", probe_event_streams),
+    ("22", "HEAD /", probe_head),
+    ("22", "two Host headers", probe_two_hosts),
+    ("22", "17 KiB request head", probe_long_head),
+]
+
+
+def serve_probes(binary):
+    """The server's probes of round 3, each on a fresh server, with the time
+    it took and the server's peak resident memory."""
+    print()
+    print("| item | probe | outcome | time | server peak |")
+    print("|---|---|---|---|---|")
+    for item, what, probe in SERVE_PROBES_3:
+        server = Server(binary)
+        try:
+            start = time.monotonic()
+            outcome = probe(server)
+            seconds = time.monotonic() - start
+            print(f"| {item} | {what} | {outcome} | {seconds:.2f} s | {server.peak_mib():.0f} MiB |")
+        finally:
+            server.stop()
+        sys.stdout.flush()
+    start = time.monotonic()
+    outcome, peak = probe_other_bind(binary)
+    print(f"| 21 | --bind 127.0.0.2 | {outcome} | {time.monotonic() - start:.2f} s | {peak:.0f} MiB |")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("binary")
@@ -441,6 +611,8 @@ def main():
             f"| {said} | `{first}` |"
         )
         sys.stdout.flush()
+    if options.round == 3:
+        serve_probes(binary)
 
 
 if __name__ == "__main__":
