@@ -18,7 +18,7 @@ use whitted::bench::{
 use whitted::limits::MemoryBudget;
 use whitted::render::Camera;
 use whitted::render::Scene;
-use whitted::scene::load_any;
+use whitted::scene::{LoadOptions, load_any_with};
 use whitted::world::World;
 
 use crate::arguments;
@@ -117,14 +117,18 @@ fn kinds(list: &str) -> Result<Vec<AccelKind>, String> {
     Ok(kinds)
 }
 
-/// The scene to measure: a scene file, or a mesh framed by the anchor
-/// harness's default camera.
+/// The scene to measure: a scene file (its reader's warnings printed), or
+/// a mesh framed by the anchor harness's default camera.
 fn load(path: &Path, width: u32, height: u32) -> Result<Scene, String> {
     let is_obj = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
     if !is_obj {
-        return load_any(path).map_err(|e| e.to_string());
+        let loaded = load_any_with(path, &LoadOptions::default()).map_err(|e| e.to_string())?;
+        for warning in &loaded.warnings {
+            note!("{warning}\n");
+        }
+        return Ok(loaded.scene);
     }
     let soup = load_obj_positions(path).map_err(|e| e.to_string())?;
     let aspect = f64::from(width) / f64::from(height);

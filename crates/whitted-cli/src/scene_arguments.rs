@@ -157,15 +157,23 @@ impl SceneArgs {
     /// arguments to it; unless `quiet`, reports the reader's warnings and
     /// what was read.
     pub fn load(&self, quiet: bool) -> Result<Scene, String> {
+        self.load_with_warnings(quiet).map(|(scene, _)| scene)
+    }
+
+    /// [`SceneArgs::load`], also giving the reader's warnings as they
+    /// are printed (for a caller that shows them elsewhere too).
+    pub fn load_with_warnings(&self, quiet: bool) -> Result<(Scene, Vec<String>), String> {
         let options = LoadOptions {
             camera: self.camera_override(),
         };
+        let mut warnings = Vec::new();
         let mut scene = match &self.scene {
             Some(path) => {
                 let start = Instant::now();
                 let loaded = load_any_with(path, &options).map_err(|e| e.to_string())?;
+                warnings = loaded.warnings.iter().map(ToString::to_string).collect();
                 if !quiet {
-                    for warning in &loaded.warnings {
+                    for warning in &warnings {
                         note!("{warning}\n");
                     }
                     let primitives = match loaded.scene.objects.checked_primitive_count() {
@@ -202,6 +210,6 @@ impl SceneArgs {
         settings.texture_filter = self.texture_filter.unwrap_or(settings.texture_filter);
         settings.packets &= !self.no_packets;
         settings.fast_paths &= !self.no_fast_paths;
-        Ok(scene)
+        Ok((scene, warnings))
     }
 }

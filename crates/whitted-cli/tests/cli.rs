@@ -534,6 +534,30 @@ fn camera_overrides_replace_parts_of_the_scene_camera_and_bad_ones_are_refused()
 }
 
 #[test]
+fn bench_prints_the_scene_readers_warnings() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("tri.obj"),
+        "mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("s.toml"),
+        "[camera]\neye = [0.3, 0.3, 3]\nlook_at = [0.3, 0.3, 0]\nfov = 40\n\
+         [definitions.tri]\nmesh = 'tri.obj'\n[[objects]]\ninstance = 'tri'\n",
+    )
+    .unwrap();
+    let args = ["bench", "s.toml", "--width", "8", "--height", "6"];
+    let out = whitted(&[&args[..], &["--accel", "bvh"]].concat(), dir.path());
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("tri.obj:1:8: warning: cannot read the material library"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
 fn an_obj_model_renders_with_its_warnings_printed() {
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("tri.obj");

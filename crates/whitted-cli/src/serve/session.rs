@@ -320,11 +320,15 @@ impl Session {
             let (mut view, reload) = next.take().unwrap_or_else(|| self.next_request(&mut done));
             if reload {
                 base = None;
-                match self.args.load(true) {
-                    Ok(scene) => {
-                        let warnings: Vec<String> = whitted::render::slow_implicit_surfaces(&scene)
-                            .iter()
-                            .map(|slow| format!("warning: {slow}"))
+                match self.args.load_with_warnings(true) {
+                    Ok((scene, read)) => {
+                        // The reader's (each with its place), then the
+                        // slow surfaces'.
+                        let slow = whitted::render::slow_implicit_surfaces(&scene);
+                        let warnings: Vec<String> = read
+                            .into_iter()
+                            .chain(slow.iter().map(|slow| format!("warning: {slow}")))
+                            .map(|warning| crate::report::bounded(&warning).into_owned())
                             .collect();
                         for warning in &warnings {
                             crate::report::note!("{warning}");

@@ -398,6 +398,40 @@ fn refusals_quote_long_requests_at_a_lines_width() {
     assert!(text.contains("…"), "{text}");
 }
 
+/// The scene reader's warnings (here a model's, passed on by a
+/// definition) are printed and shown on the page as `render` prints them.
+#[test]
+fn the_readers_warnings_are_shown_on_the_page() {
+    let scene = format!(
+        "{}[definitions.tri]\nmesh = 'tri.obj'\n[[objects]]\ninstance = 'tri'\n",
+        scene_text()
+    );
+    let server = Server::start(
+        "[camera]\neye = [0, 0, 4]\nlook_at = [0, 0, 0]\nfov = 40\n",
+        &["--width", "4", "--height", "4"],
+    );
+    let mut events = server.events();
+    std::fs::write(
+        server.dir.path().join("tri.obj"),
+        "mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::write(server.scene(), scene).unwrap();
+    let (_, warnings) = events
+        .until(|name, data| name == "warnings" && data["messages"] != serde_json::json!([]))
+        .pop()
+        .unwrap();
+    let messages = warnings["messages"].as_array().unwrap();
+    assert_eq!(messages.len(), 1, "{warnings}");
+    assert!(
+        messages[0]
+            .as_str()
+            .unwrap()
+            .contains("tri.obj:1:8: warning: cannot read the material library"),
+        "{warnings}"
+    );
+}
+
 /// Issue 50, item 10: an implicit surface estimated slow is warned of on
 /// the page, and the warning goes when the scene is fixed.
 #[test]

@@ -160,7 +160,12 @@ fn read_mesh(
     let loaded = match load_obj(&path) {
         Ok(loaded) => loaded,
         Err(SceneError::Invalid { diagnostics }) => {
-            let message = format!("the model `{name}` is invalid:\n{}", problems(&diagnostics));
+            // Its own errors say what is wrong: the file, or the memory
+            // budget it passed.
+            let message = format!(
+                "the model `{name}` cannot be read:\n{}",
+                problems(&diagnostics)
+            );
             return Err(r.error(span, message));
         }
         Err(SceneError::Io { path, source }) => {
@@ -500,5 +505,49 @@ mod tests {
             "{}",
             warning.message
         );
+    }
+
+    #[test]
+    fn a_models_errors_are_reported_at_the_definition_with_their_places() {
+        let folder = tempfile::tempdir().unwrap();
+        std::fs::write(folder.path().join("bad.obj"), "v 0 0 0\nf 1 2 3\n").unwrap();
+        let source = format!(
+            "{CAMERA}[definitions.bad]\nmesh = 'bad.obj'\n\
+             [[objects]]\ninstance = 'bad'\n"
+        );
+        let error =
+            crate::scene::parse_scene_with_warnings(&source, &folder.path().join("scene.toml"))
+                .unwrap_err()
+                .to_string();
+        assert!(
+            error.contains("error: the model `bad.obj` cannot be read:\n"),
+            "{error}"
+        );
+        assert!(error.contains("bad.obj:2:"), "{error}");
+    }
+
+    #[test]
+    fn warnings_of_a_library_two_models_share_are_given_once() {
+        let folder = tempfile::tempdir().unwrap();
+        std::fs::write(folder.path().join("shared.mtl"), "newmtl m\nd -1\n").unwrap();
+        for name in ["a.obj", "b.obj"] {
+            std::fs::write(
+                folder.path().join(name),
+                "mtllib shared.mtl\nusemtl m\nv 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n",
+            )
+            .unwrap();
+        }
+        let source = format!(
+            "{CAMERA}[definitions.a]\nmesh = 'a.obj'\n[definitions.b]\nmesh = 'b.obj'\n\
+             [[objects]]\ninstance = 'a'\n[[objects]]\ninstance = 'b'\n"
+        );
+        let loaded =
+            crate::scene::parse_scene_with_warnings(&source, &folder.path().join("scene.toml"))
+                .unwrap();
+        let [warning] = &loaded.warnings[..] else {
+            panic!("{:?}", loaded.warnings);
+        };
+        assert_eq!(warning.path, folder.path().join("shared.mtl"));
+        assert_eq!(warning.line, 2);
     }
 }

@@ -172,10 +172,13 @@ impl<'s> Reader<'s> {
     }
 
     /// Passes on the warnings of a file this one reads (a model), each at
-    /// its own place.
+    /// its own place, once: a file read again (a material library two
+    /// models share) does not repeat them.
     pub(super) fn pass_on_warnings(&mut self, warnings: Vec<Diagnostic>) {
         for warning in warnings {
-            push_limited(&mut self.warnings, Severity::Warning, || warning);
+            if !self.warnings.contains(&warning) {
+                push_limited(&mut self.warnings, Severity::Warning, || warning);
+            }
         }
     }
 
