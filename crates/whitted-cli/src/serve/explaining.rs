@@ -5,14 +5,20 @@
 //! read again, another structure chosen (the session hands a new
 //! [`Arc<Scene>`] then, and the same one while only the camera or the
 //! view moves). A pixel being explained is given up when a newer scene or
-//! camera makes its tree stale ([`Explaining::cancel_unless`]).
+//! camera makes its tree stale ([`Explaining::cancel_unless`]); the world
+//! kept is let go, with its memory charge, once another scene (or none)
+//! is shown.
 
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::{Receiver, Sender, channel};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, channel};
 use std::sync::{Arc, Mutex, PoisonError};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use whitted::render::{Camera, Explainer, PixelExplanation, Scene};
+
+/// How often the idle explaining thread looks whether the world it keeps
+/// is still the one shown.
+const IDLE_CHECK: Duration = Duration::from_millis(100);
 
 /// One pixel to explain.
 pub struct Job {
@@ -47,6 +53,15 @@ enum Current {
 }
 
 impl Current {
+    /// Whether pixels are seen in `world` (or may be: unknown yet).
+    fn shows(&self, world: &Arc<Scene>) -> bool {
+        match self {
+            Current::Unknown => true,
+            Current::Seen(w, _) => Arc::ptr_eq(w, world),
+            Current::Nothing => false,
+        }
+    }
+
     /// Whether a pixel seen in `world` through `camera` is stale.
     fn makes_stale(&self, world: &Arc<Scene>, camera: &Camera) -> bool {
         match self {
@@ -186,45 +201,67 @@ impl Explaining {
     }
 
     /// Answers the jobs of `queue`, keeping the world of the last one's
-    /// scene.
+    /// scene while it is shown.
     fn serve(&self, queue: &Receiver<Job>) {
         let mut next = queue.recv().ok();
         while let Some(job) = next.take() {
-            let mut cancel = self.begin(&job);
-            let world = Arc::clone(&job.world);
-            let start = Instant::now();
-            let explainer = match Explainer::new(&world) {
-                Ok(explainer) => explainer,
-                Err(e) => {
-                    self.end();
-                    let _ = job.reply.send(Answer {
-                        explanation: Err(e.to_string()),
-                        build_seconds: start.elapsed().as_secs_f64(),
-                        explain_seconds: 0.0,
-                    });
-                    next = queue.recv().ok();
-                    continue;
-                }
-            };
-            let mut build_seconds = start.elapsed().as_secs_f64();
-            let mut job = job;
-            loop {
-                let start = Instant::now();
-                let explanation = self.explain_job(&explainer, &job, &cancel);
+            // Waiting with nothing kept once the scene's world is let go.
+            next = self.serve_scene(queue, job).or_else(|| queue.recv().ok());
+        }
+    }
+
+    /// Builds the world of `job`'s scene and answers `job` and the jobs
+    /// after it of the same scene. Returns the first job of another scene,
+    /// or `None` once the scene is no longer shown (or the session ends),
+    /// having let go of the world.
+    fn serve_scene(&self, queue: &Receiver<Job>, job: Job) -> Option<Job> {
+        let mut cancel = self.begin(&job);
+        let world = Arc::clone(&job.world);
+        let start = Instant::now();
+        let explainer = match Explainer::new(&world) {
+            Ok(explainer) => explainer,
+            Err(e) => {
+                self.end();
                 let _ = job.reply.send(Answer {
-                    explanation,
-                    build_seconds,
-                    explain_seconds: start.elapsed().as_secs_f64(),
+                    explanation: Err(e.to_string()),
+                    build_seconds: start.elapsed().as_secs_f64(),
+                    explain_seconds: 0.0,
                 });
-                build_seconds = 0.0;
-                match queue.recv() {
-                    Ok(same) if Arc::ptr_eq(&same.world, &world) => {
-                        cancel = self.begin(&same);
-                        job = same;
-                    }
-                    other => {
-                        next = other.ok();
-                        break;
+                return None;
+            }
+        };
+        let mut build_seconds = start.elapsed().as_secs_f64();
+        let mut job = job;
+        loop {
+            let start = Instant::now();
+            let explanation = self.explain_job(&explainer, &job, &cancel);
+            let _ = job.reply.send(Answer {
+                explanation,
+                build_seconds,
+                explain_seconds: start.elapsed().as_secs_f64(),
+            });
+            build_seconds = 0.0;
+            match self.next_while_current(queue, &world) {
+                Some(same) if Arc::ptr_eq(&same.world, &world) => {
+                    cancel = self.begin(&same);
+                    job = same;
+                }
+                other => return other,
+            }
+        }
+    }
+
+    /// The next job, or `None` once `world` is no longer what pixels are
+    /// seen in (another scene read, or none) while none came, so that the
+    /// world kept for it is let go. Also `None` when the session ends.
+    fn next_while_current(&self, queue: &Receiver<Job>, world: &Arc<Scene>) -> Option<Job> {
+        loop {
+            match queue.recv_timeout(IDLE_CHECK) {
+                Ok(job) => return Some(job),
+                Err(RecvTimeoutError::Disconnected) => return None,
+                Err(RecvTimeoutError::Timeout) => {
+                    if !self.lock().current.shows(world) {
+                        return None;
                     }
                 }
             }
@@ -290,5 +327,29 @@ mod tests {
             "{:?}",
             start.elapsed()
         );
+    }
+
+    #[test]
+    fn the_world_kept_is_let_go_once_another_scene_is_shown() {
+        let explaining = Arc::new(Explaining::new());
+        let server = Arc::clone(&explaining);
+        // Serves until the process ends.
+        std::thread::spawn(move || server.run());
+        let shown = Arc::new(whitted::scene::default_scene());
+        let camera = shown.camera.clone();
+        let answer = explaining.explain(Arc::clone(&shown), camera.clone(), (1, 1), 0);
+        assert!(answer.unwrap().explanation.is_ok());
+        // Kept for the next pixel while the scene is shown.
+        std::thread::sleep(3 * IDLE_CHECK);
+        assert!(Arc::strong_count(&shown) > 1);
+        let newer = Arc::new(Scene::clone(&shown));
+        explaining.cancel_unless(Some((&newer, &camera)));
+        let start = Instant::now();
+        while Arc::strong_count(&shown) > 2 && start.elapsed() < Duration::from_secs(10) {
+            std::thread::sleep(IDLE_CHECK / 4);
+        }
+        // Only this test's and the state's "current" would remain, and the
+        // state now names the newer scene.
+        assert_eq!(Arc::strong_count(&shown), 1, "{:?}", start.elapsed());
     }
 }
