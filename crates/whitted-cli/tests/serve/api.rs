@@ -436,18 +436,9 @@ fn the_readers_warnings_are_shown_on_the_page() {
 /// the page, and the warning goes when the scene is fixed.
 #[test]
 fn a_slow_implicit_surface_is_warned_of_on_the_page() {
-    let slow = std::fs::read_to_string(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../whitted/tests/hostile_scenes/slow_implicit.toml"),
-    )
-    .unwrap();
-    let scene = |max_gradient: &str| {
-        slow.replace(
-            "max_gradient = 1e30",
-            &format!("max_gradient = {max_gradient}"),
-        )
-    };
-    let server = Server::start(&scene("1e30"), &["--width", "4", "--height", "4"]);
+    let slow = include_str!("../../../whitted/tests/hostile_scenes/slow_implicit.toml");
+    let fixed = include_str!("../../../whitted/tests/hostile_scenes/slow_implicit_fixed.toml");
+    let server = Server::start(slow, &["--width", "4", "--height", "4"]);
     let mut events = server.events();
     let (_, warnings) = events.until(|name, _| name == "warnings").pop().unwrap();
     let messages = warnings["messages"].as_array().unwrap();
@@ -459,7 +450,7 @@ fn a_slow_implicit_surface_is_warned_of_on_the_page() {
             .starts_with("warning: the implicit surface objects[0]"),
         "{warnings}"
     );
-    std::fs::write(server.scene(), scene("8")).unwrap();
+    std::fs::write(server.scene(), fixed).unwrap();
     let (_, warnings) = events.until(|name, _| name == "warnings").pop().unwrap();
     assert_eq!(warnings["messages"], serde_json::json!([]), "{warnings}");
 }
