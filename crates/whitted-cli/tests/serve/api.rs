@@ -421,15 +421,17 @@ fn the_readers_warnings_are_shown_on_the_page() {
         .until(|name, data| name == "warnings" && data["messages"] != serde_json::json!([]))
         .pop()
         .unwrap();
-    let messages = warnings["messages"].as_array().unwrap();
-    assert_eq!(messages.len(), 1, "{warnings}");
     assert!(
-        messages[0]
-            .as_str()
-            .unwrap()
-            .contains("tri.obj:1:8: warning: cannot read the material library"),
+        only_warning(&warnings).contains("tri.obj:1:8: warning: cannot read the material library"),
         "{warnings}"
     );
+}
+
+/// The one message of a `warnings` event.
+fn only_warning(warnings: &serde_json::Value) -> &str {
+    let messages = warnings["messages"].as_array().unwrap();
+    assert_eq!(messages.len(), 1, "{warnings}");
+    messages[0].as_str().unwrap()
 }
 
 /// Issue 50, item 10: an implicit surface estimated slow is warned of on
@@ -441,13 +443,8 @@ fn a_slow_implicit_surface_is_warned_of_on_the_page() {
     let server = Server::start(slow, &["--width", "4", "--height", "4"]);
     let mut events = server.events();
     let (_, warnings) = events.until(|name, _| name == "warnings").pop().unwrap();
-    let messages = warnings["messages"].as_array().unwrap();
-    assert_eq!(messages.len(), 1, "{warnings}");
     assert!(
-        messages[0]
-            .as_str()
-            .unwrap()
-            .starts_with("warning: the implicit surface objects[0]"),
+        only_warning(&warnings).starts_with("warning: the implicit surface objects[0]"),
         "{warnings}"
     );
     std::fs::write(server.scene(), fixed).unwrap();
