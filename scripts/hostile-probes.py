@@ -316,6 +316,10 @@ def setup_grid_model(d):
     write(d, "grid.obj", "\n".join(lines) + "\n")
 
 
+def setup_vertices(d):
+    write(d, "verts.obj", "v 1 2 3\n" * 2_000_000 + "f 1 2 3\n")
+
+
 # Issue 50 (round 3): the worst probe of each class that a command line can
 # reach; the server's (20-22) are SERVE_PROBES_3 below; item 4 and the races
 # and full disks (11, 13) are measured by their tests.
@@ -327,6 +331,8 @@ PROBES_3 = [
     ("5", "718k-triangle grid, kd-tree, --max-memory 256M", setup_grid_model, ["render", "grid.obj", "--accel", "kdtree", "--max-memory", "256M", "--width", "32", "--height", "24"], None),
     ("6", "16384² under ulimit -v 4G", None, ["render", "--width", "16384", "--height", "16384", "-o", "big.png"], "ulimit-v-4G"),
     ("6", "16384², --max-memory 64G, ulimit -v 2G", None, ["render", "--width", "16384", "--height", "16384", "--max-memory", "64G", "-o", "big.png"], "ulimit-v-2G"),
+    ("6", "718k-triangle kd-tree, --max-memory 64G, ulimit -v 300M", setup_grid_model, ["render", "grid.obj", "--accel", "kdtree", "--max-memory", "64G", "--width", "8", "--height", "8"], "ulimit-v-300M"),
+    ("5", "bench, 2M vertices, --max-memory 24M", setup_vertices, ["bench", "verts.obj", "--width", "16", "--height", "16", "--max-memory", "24M"], None),
     ("7", "100,000 crumpled patches, --max-memory 256M", setup_patches, ["render", "crumpled.bpt", "--max-memory", "256M", "--width", "64", "--height", "48"], None),
     ("9", "NFF, 200,000 spheres on one line", setup_nff_line, ["render", "line.nff", "--width", "32", "--height", "24"], None),
     ("10", "implicit, max_gradient 1e30", setup_slow_implicit, ["render", "i.toml"], None),
@@ -358,6 +364,8 @@ def limit(max_bytes, special=None):
             address_space = 4 << 30
         elif special == "ulimit-v-2G":
             address_space = 2 << 30
+        elif special == "ulimit-v-300M":
+            address_space = 300 << 20
         resource.setrlimit(resource.RLIMIT_AS, (address_space, address_space))
         if special == "ulimit-f-200K":
             resource.setrlimit(resource.RLIMIT_FSIZE, (200 << 10, 200 << 10))
