@@ -24,6 +24,9 @@ use std::sync::OnceLock;
 #[cfg(target_arch = "x86_64")]
 use super::bvh::SlabsAvx;
 use super::bvh::{Halves, SlabTest};
+#[cfg(target_arch = "x86_64")]
+use crate::shape::AvxLanes;
+use crate::shape::{FourLanes, OneByOne};
 
 /// The environment variable that picks a backend by name
 /// ([`Isa::name`]): no wider than the processor runs.
@@ -158,6 +161,8 @@ pub(crate) trait Kernel {
     const ISA: Isa;
     /// The BVH's slab test of a node's eight children.
     type Slabs: SlabTest;
+    /// The leaf tests of four primitives at once.
+    type Lanes: FourLanes;
 }
 
 /// The portable kernel.
@@ -166,6 +171,7 @@ pub(crate) struct Sse2Kernel;
 impl Kernel for Sse2Kernel {
     const ISA: Isa = Isa::Sse2;
     type Slabs = Halves;
+    type Lanes = OneByOne;
 }
 
 /// The AVX kernel.
@@ -176,6 +182,7 @@ pub(crate) struct AvxKernel;
 impl Kernel for AvxKernel {
     const ISA: Isa = Isa::Avx;
     type Slabs = SlabsAvx;
+    type Lanes = AvxLanes;
 }
 
 /// The AVX2 + FMA kernel.
@@ -186,7 +193,18 @@ pub(crate) struct Avx2Kernel;
 impl Kernel for Avx2Kernel {
     const ISA: Isa = Isa::Avx2;
     type Slabs = SlabsAvx;
+    type Lanes = AvxLanes;
 }
+
+/// The leaf tests of the kernels packets are walked together in (the AVX
+/// ones: a packet walk on any other returns at once, unwalked), for the
+/// packets' leaf callbacks, which cannot name their kernel.
+#[cfg(target_arch = "x86_64")]
+pub(crate) type PacketLanes = AvxLanes;
+
+/// As above: no kernel walks packets together on this target.
+#[cfg(not(target_arch = "x86_64"))]
+pub(crate) type PacketLanes = OneByOne;
 
 /// Work generic over the kernel it runs with. [`KernelTask::run`] should
 /// be `#[inline(always)]`, and so should what it calls that is hot, so that

@@ -315,9 +315,9 @@ impl Accelerator {
     ) -> Option<f64> {
         match self {
             Accelerator::Bvh(bvh) => bvh.closest_with::<K>(ray, &mut ctx.counters, leaves),
-            other => {
-                other.intersect_in_leaf_order(ray, ctx, |range, t_max| leaves.closest(range, t_max))
-            }
+            other => other.intersect_in_leaf_order(ray, ctx, |range, t_max| {
+                leaves.closest::<K>(range, t_max)
+            }),
         }
     }
 
@@ -332,7 +332,7 @@ impl Accelerator {
     ) -> bool {
         match self {
             Accelerator::Bvh(bvh) => bvh.any_with::<K>(ray, &mut ctx.counters, leaves),
-            other => other.occluded_in_leaf_order(ray, ctx, |range| leaves.occludes(range)),
+            other => other.occluded_in_leaf_order(ray, ctx, |range| leaves.occludes::<K>(range)),
         }
     }
 }

@@ -27,6 +27,7 @@ mod csg;
 mod cylinder;
 mod disk;
 pub mod implicit;
+mod lanes;
 mod outline;
 mod parallelogram;
 mod plane;
@@ -52,6 +53,9 @@ pub use csg::{COINCIDENT, Csg, CsgChild, CsgError, CsgOperation, MAX_LEAVES};
 pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use implicit::{Expression, ExpressionError, Implicit, MIN_STEP, NAN_STEP};
+#[cfg(target_arch = "x86_64")]
+pub(crate) use lanes::AvxLanes;
+pub(crate) use lanes::{FourLanes, Hits4, LANES, OneByOne};
 pub use parallelogram::Parallelogram;
 pub use plane::Plane;
 #[cfg(target_arch = "x86_64")]
@@ -61,13 +65,12 @@ pub use quadric::Quadric;
 pub use small_mesh::{OpenEdge, SmallMesh};
 pub use solid::{Crossing, Crossings, Solidity};
 pub use sphere::Sphere;
-pub(crate) use sphere_avx::sphere_candidates4;
 pub use superellipsoid::{MAX_EXPONENT, MIN_EXPONENT, Superellipsoid, exponent};
 pub use torus::Torus;
 pub use triangle::{RayShear, Triangle, watertight};
 pub(crate) use triangle_clip::clipped_triangle_bounds;
 #[cfg(target_arch = "x86_64")]
-pub(crate) use watertight_avx::{Hits4, LANES, RayLanes4, watertight_rays4, watertight4};
+pub(crate) use watertight_avx::{RayLanes4, watertight_rays4};
 
 use crate::math::magnitude::{self, MagnitudeError};
 use crate::math::{Aabb, DVec2, Ray, Vec3};

@@ -25,8 +25,8 @@ use std::arch::x86_64::{
     _mm256_set1_pd, _mm256_setr_pd, _mm256_setzero_pd, _mm256_sub_pd, _mm256_xor_pd,
 };
 
+use super::lanes::LANES;
 use super::sphere::BEYOND_MARGIN;
-use super::watertight_avx::LANES;
 use crate::math::{Ray, Vec3, gamma};
 
 /// The lanes (bit `i` for `centers[i]`, `radii[i]`) whose sphere the

@@ -21,26 +21,9 @@ use std::arch::x86_64::{
     _mm256_storeu_pd, _mm256_sub_pd,
 };
 
+use super::lanes::{Hits4, LANES};
 use super::triangle::RayShear;
 use crate::math::{Ray, Vec3, gamma};
-
-/// Lanes per test.
-pub const LANES: usize = 4;
-
-/// What [`watertight4`] or [`watertight_rays4`] found: which lanes hit,
-/// and each lane's `t` and
-/// barycentric coordinates (meaningful for the lanes that hit).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Hits4 {
-    /// Bit `i` set when lane `i` hit.
-    pub mask: u32,
-    /// The ray parameter per lane.
-    pub t: [f64; LANES],
-    /// The barycentric coordinate `b1` per lane.
-    pub u: [f64; LANES],
-    /// The barycentric coordinate `b2` per lane.
-    pub v: [f64; LANES],
-}
 
 /// A corner of each lane's triangle in the ray's sheared space.
 #[derive(Clone, Copy)]

@@ -10,8 +10,7 @@
 use std::ops::Range;
 
 use crate::math::{Ray, Vec3};
-#[cfg(target_arch = "x86_64")]
-use crate::shape::{Hits4, LANES, sphere_candidates4, watertight4};
+use crate::shape::{FourLanes, Hits4, LANES};
 use crate::shape::{Polygon, RayShear, ShapeHit, Sphere, plane_hit, watertight};
 
 /// The margin of [`Entry::axis_missed`], relative to the sizes it adds.
@@ -285,19 +284,18 @@ pub(super) fn intersect_triangle(
 /// `other(entry, t_max, rest)` (what the test in place left, [`Rest`]),
 /// which returns the number to report and the hit.
 /// `found(number, hit)` is told of each nearer hit; returns the closest `t`.
-/// Where `wide` (the processor has AVX), runs of two to four spheres are
-/// culled at once and only the spheres kept are tested, one by one in
-/// order, so the answers are those of one by one. Triangles are tested one
+/// Where the backend's lanes `L` have a four-sphere cull, runs of two to
+/// four spheres are culled at once and only the spheres kept are tested,
+/// one by one in order, so the answers are those of one by one. Triangles are tested one
 /// at a time: tried testing runs of them four at a time as
 /// [`leaf_occludes`] does: slower, see docs/performance-log.md (four-at-once
 /// triangle test).
 #[inline(always)]
-pub(super) fn leaf_hit(
+pub(super) fn leaf_hit<L: FourLanes>(
     entries: &[Entry],
     range: Range<u32>,
     query: &Query,
     best: (f64, u32),
-    wide: bool,
     mut other: impl FnMut(&Entry, f64, Rest) -> Option<(u32, ShapeHit)>,
     mut found: impl FnMut(u32, ShapeHit),
 ) -> Option<f64> {
@@ -309,10 +307,9 @@ pub(super) fn leaf_hit(
     let mut entry = range.start;
     while entry < range.end {
         let e = &entries[entry as usize];
-        #[cfg(target_arch = "x86_64")]
-        if wide
+        if L::ANY
             && e.kind == EntryKind::Sphere
-            && let Some((run, mut mask)) = sphere_run(entries, entry, range.end, query, bound)
+            && let Some((run, mut mask)) = sphere_run::<L>(entries, entry, range.end, query, bound)
         {
             while mask != 0 {
                 let e = &entries[(entry + mask.trailing_zeros()) as usize];
@@ -343,7 +340,6 @@ pub(super) fn leaf_hit(
         }
         entry += 1;
     }
-    let _ = wide;
     closest
 }
 
@@ -360,36 +356,35 @@ pub(super) fn nearer((t, number): (f64, u32), (closest, closest_number): (f64, u
 /// An entry of `entries[range]` that lies in the query's ray interval (the
 /// first one found), if any: triangles here, other entries when
 /// `other(entry, rest)` says so (`rest`: what the test in place left).
-/// Where `wide` (the processor has AVX), runs of two to four triangles are
-/// tested at once, and runs of two to four spheres culled at once, with the
-/// same answers as one by one.
+/// Where the backend's lanes `L` have four-lane tests, runs of two to four
+/// triangles are tested at once, and runs of two to four spheres culled at
+/// once, with the same answers as one by one.
 #[inline(always)]
-pub(super) fn leaf_occludes(
+pub(super) fn leaf_occludes<L: FourLanes>(
     entries: &[Entry],
     range: Range<u32>,
     query: &Query,
-    wide: bool,
     other: impl FnMut(&Entry, Rest) -> bool,
 ) -> Option<u32> {
-    leaf_meets(entries, range, query, wide, other, |_| true)
+    leaf_meets::<L>(entries, range, query, other, |_| true)
 }
 
 /// [`leaf_occludes`] that shows `stops` each entry found in the interval,
 /// in order, and ends at the first one it says stops the walk, returning
 /// it; entries that do not are only shown.
 #[inline(always)]
-pub(super) fn leaf_meets(
+pub(super) fn leaf_meets<L: FourLanes>(
     entries: &[Entry],
     range: Range<u32>,
     query: &Query,
-    wide: bool,
     mut other: impl FnMut(&Entry, Rest) -> bool,
     mut stops: impl FnMut(u32) -> bool,
 ) -> Option<u32> {
     let mut entry = range.start;
     while entry < range.end {
-        #[cfg(target_arch = "x86_64")]
-        if wide && let Some((run, hits)) = triangle_run(entries, entry, range.end, query) {
+        if L::ANY
+            && let Some((run, hits)) = triangle_run::<L>(entries, entry, range.end, query)
+        {
             let mut mask = hits.mask;
             while mask != 0 {
                 let hit = entry + mask.trailing_zeros();
@@ -401,11 +396,10 @@ pub(super) fn leaf_meets(
             entry += run;
             continue;
         }
-        #[cfg(target_arch = "x86_64")]
-        if wide
+        if L::ANY
             && entries[entry as usize].kind == EntryKind::Sphere
             && let Some((run, mut mask)) =
-                sphere_run(entries, entry, range.end, query, query.ray.t_max)
+                sphere_run::<L>(entries, entry, range.end, query, query.ray.t_max)
         {
             while mask != 0 {
                 let hit = entry + mask.trailing_zeros();
@@ -427,7 +421,6 @@ pub(super) fn leaf_meets(
         }
         entry += 1;
     }
-    let _ = wide;
     None
 }
 
@@ -435,7 +428,6 @@ pub(super) fn leaf_meets(
 /// (and ends before `end`): its length and each lane's corners, lane `i`
 /// for entry `entry + i`. Lanes past the run repeat the first entry; their
 /// answers are to be masked out. `None` without such a run.
-#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn run_of(
     entries: &[Entry],
@@ -455,14 +447,20 @@ fn run_of(
 
 /// The run of two to [`LANES`] triangles that starts at `entry` (and ends
 /// before `end`), tested at once against the query's ray: its length and
-/// the hits, lane `i` for entry `entry + i`. `None` without such a run.
-/// Only called where the processor has AVX.
-#[cfg(target_arch = "x86_64")]
+/// the hits, lane `i` for entry `entry + i`. `None` without such a run,
+/// or where the lanes `L` have no four-triangle test. Called only in a
+/// kernel whose lanes are `L`.
 #[inline(always)]
-fn triangle_run(entries: &[Entry], entry: u32, end: u32, query: &Query) -> Option<(u32, Hits4)> {
+fn triangle_run<L: FourLanes>(
+    entries: &[Entry],
+    entry: u32,
+    end: u32,
+    query: &Query,
+) -> Option<(u32, Hits4)> {
     let (run, lanes) = run_of(entries, entry, end, EntryKind::Triangle)?;
-    // SAFETY: callers pass `wide` only where the processor has AVX.
-    let hits = unsafe { watertight4(lanes, query.ray, &query.shear(), query.ray.t_max) };
+    // SAFETY: called in a kernel whose lanes are `L`, so the processor
+    // runs their instruction set.
+    let hits = unsafe { L::triangles(lanes, query.ray, &query.shear(), query.ray.t_max) }?;
     let mask = hits.mask & ((1 << run) - 1);
     Some((run, Hits4 { mask, ..hits }))
 }
@@ -471,10 +469,10 @@ fn triangle_run(entries: &[Entry], entry: u32, end: u32, query: &Query) -> Optio
 /// before `end`), culled at once for the query's ray ending at `t_max`: its
 /// length and the spheres kept, bit `i` for entry `entry + i`. A sphere not
 /// kept has no hit closer than `t_max` or any smaller end. `None` without
-/// such a run. Only called where the processor has AVX.
-#[cfg(target_arch = "x86_64")]
+/// such a run, or where the lanes `L` have no four-sphere cull. Called
+/// only in a kernel whose lanes are `L`.
 #[inline(always)]
-fn sphere_run(
+fn sphere_run<L: FourLanes>(
     entries: &[Entry],
     entry: u32,
     end: u32,
@@ -484,8 +482,8 @@ fn sphere_run(
     let (run, lanes) = run_of(entries, entry, end, EntryKind::Sphere)?;
     let centers = lanes.map(|corners| &corners[0]);
     let radii = lanes.map(|corners| &corners[1].x);
-    // SAFETY: callers pass `wide` only where the processor has AVX.
-    let mask = unsafe { sphere_candidates4(centers, radii, query.ray, t_max) };
+    // SAFETY: as in `triangle_run`.
+    let mask = unsafe { L::sphere_candidates(centers, radii, query.ray, t_max) }?;
     Some((run, mask & ((1 << run) - 1)))
 }
 
@@ -494,6 +492,7 @@ mod tests {
     use super::*;
     use crate::math::random::Rng;
     use crate::math::test_support::has_avx_or_skip_allowed;
+    use crate::shape::{AvxLanes, OneByOne};
 
     /// A leaf of overlapping spheres with, now and then, a triangle or an
     /// entry tested through the tables among them, so that runs of every
@@ -532,37 +531,52 @@ mod tests {
             let mut ray = Ray::new(origin, rng.unit_vector() * (0.1 + 3.0 * rng.uniform()));
             ray.t_max = [f64::INFINITY, 1.0, 0.2][rng.below(3) as usize];
             let query = Query::new(&ray, true);
-            let range = 0..entries.len() as u32;
             // Entries tested through the tables hit at a fixed distance.
             let other = |e: &Entry, t_max: f64, _: Rest| {
                 (0.5 < t_max).then_some((e.number, ShapeHit::at(0.5)))
             };
-            let closest = |wide: bool| {
+            fn closest<L: FourLanes>(
+                entries: &[Entry],
+                query: &Query,
+                other: impl FnMut(&Entry, f64, Rest) -> Option<(u32, ShapeHit)>,
+            ) -> (Option<u64>, Vec<(u32, u64)>) {
                 let mut found = Vec::new();
-                let t = leaf_hit(
-                    &entries,
-                    range.clone(),
-                    &query,
-                    (ray.t_max, u32::MAX),
-                    wide,
+                let t = leaf_hit::<L>(
+                    entries,
+                    0..entries.len() as u32,
+                    query,
+                    (query.ray.t_max, u32::MAX),
                     other,
                     |n, h| found.push((n, h.t.to_bits())),
                 );
                 (t.map(f64::to_bits), found)
-            };
-            let one_by_one = closest(false);
-            assert_eq!(closest(true), one_by_one, "{entries:?} {ray:?}");
+            }
+            let one_by_one = closest::<OneByOne>(&entries, &query, other);
+            assert_eq!(
+                closest::<AvxLanes>(&entries, &query, other),
+                one_by_one,
+                "{entries:?} {ray:?}"
+            );
             hits += usize::from(one_by_one.0.is_some());
             let meets = |e: &Entry, _: Rest| e.number.is_multiple_of(2) && 0.5 < ray.t_max;
-            let first = |wide: bool| {
+            fn first<L: FourLanes>(
+                entries: &[Entry],
+                query: &Query,
+                meets: impl FnMut(&Entry, Rest) -> bool,
+            ) -> (Option<u32>, Vec<u32>) {
                 let mut shown = Vec::new();
-                let stop = leaf_meets(&entries, range.clone(), &query, wide, meets, |n| {
+                let range = 0..entries.len() as u32;
+                let stop = leaf_meets::<L>(entries, range, query, meets, |n| {
                     shown.push(n);
                     n % 3 == 2
                 });
                 (stop, shown)
-            };
-            assert_eq!(first(true), first(false), "{entries:?} {ray:?}");
+            }
+            assert_eq!(
+                first::<AvxLanes>(&entries, &query, meets),
+                first::<OneByOne>(&entries, &query, meets),
+                "{entries:?} {ray:?}"
+            );
             culled_runs += usize::from(
                 entries
                     .windows(2)

@@ -10,7 +10,12 @@ use rayon::prelude::*;
 
 use super::entry::{Entry, Query, leaf_hit, leaf_occludes};
 use super::{PARALLEL_CHUNK, build_structure};
-use crate::accel::{AccelKind, AccelerationStructure, Accelerator, QueryContext};
+use std::ops::Range;
+
+use crate::accel::kernel::{self, Kernel, KernelTask};
+use crate::accel::{
+    AccelKind, AccelerationStructure, Accelerator, AnyLeaves, ClosestLeaves, QueryContext,
+};
 use crate::math::{Aabb, Ray};
 use crate::mesh::TriangleMesh;
 use crate::shape::{ShapeHit, clipped_triangle_bounds};
@@ -63,7 +68,8 @@ impl MeshStructure {
     }
 
     /// The closest triangle hit by `ray` (in mesh space) closer than
-    /// `t_max`: its index in the mesh and the hit.
+    /// `t_max`: its index in the mesh and the hit. The walk runs in the
+    /// kernel of `ctx`'s backend.
     #[inline]
     pub(super) fn intersect(
         &self,
@@ -75,29 +81,76 @@ impl MeshStructure {
         clipped.t_max = t_max;
         let query = Query::new(&clipped, true);
         let mut best = None;
-        self.accel
-            .intersect_in_leaf_order(&clipped, ctx, |range, t_max| {
-                let number = best.map_or(u32::MAX, |(triangle, _)| triangle);
-                leaf_hit(
-                    &self.entries,
-                    range,
-                    &query,
-                    (t_max, number),
-                    false,
-                    |_, _, _| None,
-                    |triangle, hit| best = Some((triangle, hit)),
-                )
-            });
+        let leaves = MeshLeaves {
+            entries: &self.entries,
+            query: &query,
+            best: &mut best,
+        };
+        kernel::run(
+            ctx.backend,
+            Walk::<_, false>(&self.accel, &clipped, ctx, leaves),
+        );
         best
     }
 
     /// True when a triangle lies in the interval of `ray` (in mesh space).
+    /// The walk runs in the kernel of `ctx`'s backend.
     #[inline]
-    pub(super) fn occluded(&self, ray: &Ray, wide: bool, ctx: &mut QueryContext) -> bool {
+    pub(super) fn occluded(&self, ray: &Ray, ctx: &mut QueryContext) -> bool {
         let query = Query::new(ray, true);
-        self.accel.occluded_in_leaf_order(ray, ctx, |range| {
-            leaf_occludes(&self.entries, range, &query, wide, |_, _| false).is_some()
-        })
+        let leaves = MeshLeaves {
+            entries: &self.entries,
+            query: &query,
+            best: &mut None,
+        };
+        kernel::run(ctx.backend, Walk::<_, true>(&self.accel, ray, ctx, leaves)).is_some()
+    }
+}
+
+/// A mesh's walk as a kernel's task: any hit with `ANY` (answering
+/// `Some` for one), the closest otherwise.
+struct Walk<'q, L, const ANY: bool>(&'q Accelerator, &'q Ray, &'q mut QueryContext, L);
+
+impl<L: ClosestLeaves + AnyLeaves, const ANY: bool> KernelTask for Walk<'_, L, ANY> {
+    type Output = Option<f64>;
+    #[inline(always)]
+    fn run<K: Kernel>(self) -> Option<f64> {
+        let Walk(accel, ray, ctx, leaves) = self;
+        if ANY {
+            accel.any_with::<K>(ray, ctx, leaves).then_some(0.0)
+        } else {
+            accel.closest_with::<K>(ray, ctx, leaves)
+        }
+    }
+}
+
+/// The leaf tests of a mesh's triangles: the closest hit goes to `best`.
+struct MeshLeaves<'q> {
+    entries: &'q [Entry],
+    query: &'q Query<'q>,
+    best: &'q mut Option<(u32, ShapeHit)>,
+}
+
+impl ClosestLeaves for MeshLeaves<'_> {
+    #[inline(always)]
+    fn closest<K: Kernel>(&mut self, range: Range<u32>, t_max: f64) -> Option<f64> {
+        let best = &mut *self.best;
+        let number = best.map_or(u32::MAX, |(triangle, _)| triangle);
+        leaf_hit::<K::Lanes>(
+            self.entries,
+            range,
+            self.query,
+            (t_max, number),
+            |_, _, _| None,
+            |triangle, hit| *best = Some((triangle, hit)),
+        )
+    }
+}
+
+impl AnyLeaves for MeshLeaves<'_> {
+    #[inline(always)]
+    fn occludes<K: Kernel>(&mut self, range: Range<u32>) -> bool {
+        leaf_occludes::<K::Lanes>(self.entries, range, self.query, |_, _| false).is_some()
     }
 }
 
@@ -118,7 +171,6 @@ mod tests {
         let boxes: Vec<Aabb> = (0..mesh.len() as u32)
             .map(|t| mesh.triangle_bounds(t))
             .collect();
-        let avx = crate::accel::Backend::current().has_avx();
         let oracle = MeshStructure::build(&mesh, AccelKind::Linear);
         let mut hits = 0;
         for kind in AccelKind::ALL {
@@ -143,11 +195,17 @@ mod tests {
                     .map(|h| h.t)
                     .fold(None, |a: Option<f64>, t| Some(a.map_or(t, |a| a.min(t))));
                 assert_eq!(expected.map(|h| h.1.t), direct);
-                for wide in [false, avx] {
+                for backend in crate::accel::Backend::available() {
+                    let mut ctx = QueryContext {
+                        backend,
+                        ..QueryContext::default()
+                    };
+                    let hit = structure.intersect(&ray, ray.t_max, &mut ctx);
+                    assert_eq!(hit.map(|h| h.1.t), expected.map(|h| h.1.t), "{kind:?}");
                     assert_eq!(
-                        structure.occluded(&ray, wide, &mut ctx),
+                        structure.occluded(&ray, &mut ctx),
                         expected.is_some(),
-                        "{kind:?}"
+                        "{kind:?} {backend:?}"
                     );
                 }
                 hits += usize::from(expected.is_some());

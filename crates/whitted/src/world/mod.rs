@@ -629,7 +629,7 @@ impl<'a> World<'a> {
         match e.kind {
             EntryKind::Instance => {
                 let (structure, local) = self.instance_ray(e.number, query.ray);
-                structure.occluded(&local, inner.backend.has_avx(), inner)
+                structure.occluded(&local, inner)
             }
             EntryKind::Placed => {
                 let (definition, local) = self.placed_ray(definitions, e.number, query.ray);

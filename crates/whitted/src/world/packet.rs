@@ -24,6 +24,7 @@
 use std::ops::Range;
 
 use crate::accel::bvh::PACKET_LANES;
+use crate::accel::kernel::PacketLanes;
 use crate::accel::{Accelerator, Backend, Bvh, QueryContext};
 use crate::math::Ray;
 #[cfg(target_arch = "x86_64")]
@@ -143,7 +144,7 @@ impl<'a> World<'a> {
         // leaf needs them, `Some(None)` when a set is not).
         #[cfg(target_arch = "x86_64")]
         let mut across: Option<Option<[RayLanes4; 2]>> = None;
-        let (backend, wide) = (ctx.backend, ctx.backend.has_avx());
+        let backend = ctx.backend;
         let tied = bvh.intersect_packet_by_leaf(
             rays,
             backend,
@@ -182,12 +183,11 @@ impl<'a> World<'a> {
                     let query = queries[lane]
                         .get_or_insert_with(|| Query::new(&rays[lane], self.has_triangles));
                     let number = hits[lane].map_or(u32::MAX, |h| h.primitive.0);
-                    let closest = leaf_hit(
+                    let closest = leaf_hit::<PacketLanes>(
                         &self.entries,
                         range.clone(),
                         query,
                         (t_max[lane], number),
-                        wide,
                         |e, t_max, rest| {
                             self.intersect_other(definitions, e, (query, t_max, rest), &mut inner)
                         },
@@ -327,6 +327,7 @@ pub(super) mod tests {
     use crate::math::random::Rng;
     use crate::math::{Transform, Vec3};
     use crate::mesh::TriangleMesh;
+    use crate::shape::OneByOne;
     use crate::shape::{Cylinder, Plane, Polygon, Shape, Sphere, Torus};
     use crate::world::{MaterialId, Objects};
 
@@ -645,12 +646,11 @@ pub(super) mod tests {
                         let mut own = None;
                         let mut closest = None;
                         if chosen & 1 << lane != 0 {
-                            closest = leaf_hit(
+                            closest = leaf_hit::<OneByOne>(
                                 &world.entries,
                                 range.clone(),
                                 queries[lane].as_ref().unwrap(),
                                 (ends[lane], u32::MAX),
-                                false,
                                 |_, _, _| unreachable!("triangles only"),
                                 |primitive, shape_hit| {
                                     own = Some(Hit {

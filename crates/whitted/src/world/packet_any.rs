@@ -9,6 +9,7 @@
 //! world or a packet that cannot be walked together is answered one ray at
 //! a time.
 
+use crate::accel::kernel::PacketLanes;
 use crate::accel::{Accelerator, Bvh, QueryContext};
 use crate::math::Ray;
 
@@ -61,7 +62,6 @@ impl World<'_> {
                 }
             }
         }
-        let wide = ctx.backend.has_avx();
         let walked = bvh.occluded_packet_by_leaf(
             rays,
             (all & !occluded, ctx.backend),
@@ -74,10 +74,12 @@ impl World<'_> {
                     bits &= bits - 1;
                     let query = queries[lane]
                         .get_or_insert_with(|| Query::new(&rays[lane], self.has_triangles));
-                    let meets =
-                        leaf_occludes(&self.entries, range.clone(), query, wide, |e, rest| {
-                            self.rest_occludes(e.number, query, rest)
-                        });
+                    let meets = leaf_occludes::<PacketLanes>(
+                        &self.entries,
+                        range.clone(),
+                        query,
+                        |e, rest| self.rest_occludes(e.number, query, rest),
+                    );
                     if meets.is_some() {
                         found |= 1 << lane;
                     }

@@ -6,7 +6,7 @@
 //! (a wrong or stale one costs one test).
 
 use crate::accel::kernel::{self, Kernel, KernelTask};
-use crate::accel::{Backend, Isa, QueryContext};
+use crate::accel::{Backend, QueryContext};
 use crate::math::Ray;
 use crate::world::World;
 use crate::world::entry::{EntryKind, Query};
@@ -101,7 +101,6 @@ impl World<'_> {
             world: self,
             definitions: &[],
             query: &query,
-            wide: K::ISA >= Isa::Avx,
             inner: &mut inner,
             blocker: &mut hint.0,
         };

@@ -11,7 +11,7 @@
 use std::ops::Range;
 
 use crate::accel::kernel::{self, Kernel, KernelTask};
-use crate::accel::{AnyLeaves, Backend, Isa, QueryContext};
+use crate::accel::{AnyLeaves, Backend, QueryContext};
 use crate::math::Ray;
 use crate::shape::{Shape, ShapeHit};
 use crate::world::entry::{Entry, EntryKind, Query, leaf_meets};
@@ -268,8 +268,7 @@ impl World<'_> {
         impl KernelTask for Walk<'_, '_> {
             type Output = bool;
             #[inline(always)]
-            fn run<K: Kernel>(mut self) -> bool {
-                self.leaves.wide = K::ISA >= Isa::Avx;
+            fn run<K: Kernel>(self) -> bool {
                 let mut ctx = QueryContext::default();
                 self.world
                     .accel
@@ -280,7 +279,6 @@ impl World<'_> {
             world: self,
             query: &query,
             opaque,
-            wide: false,
             passed: &mut passed,
             hint,
         };
@@ -545,22 +543,19 @@ struct PassingLeaves<'q, 'a> {
     world: &'q World<'a>,
     query: &'q Query<'q>,
     opaque: &'q OpaqueEntries,
-    /// Whether the kernel has AVX's `f64` lanes.
-    wide: bool,
     passed: &'q mut PassedEntries,
     hint: &'q mut ShadowHint,
 }
 
 impl AnyLeaves for PassingLeaves<'_, '_> {
     #[inline(always)]
-    fn occludes(&mut self, range: Range<u32>) -> bool {
+    fn occludes<K: Kernel>(&mut self, range: Range<u32>) -> bool {
         let (world, query, opaque) = (self.world, self.query, self.opaque);
         let passed = &mut *self.passed;
-        let blocker = leaf_meets(
+        let blocker = leaf_meets::<K::Lanes>(
             &world.entries,
             range,
             query,
-            self.wide,
             |e, rest| world.rest_occludes(e.number, query, rest),
             |entry| match opaque.entries[entry as usize] {
                 Passage::Stops => true,

@@ -10,7 +10,7 @@ use std::ops::Range;
 use super::entry::{Query, leaf_hit, leaf_occludes};
 use super::{Hit, PrimitiveId, World};
 use crate::accel::kernel::{self, Kernel, KernelTask};
-use crate::accel::{AnyLeaves, ClosestLeaves, Isa, QueryContext};
+use crate::accel::{AnyLeaves, ClosestLeaves, QueryContext};
 use crate::math::Ray;
 
 impl<'a> World<'a> {
@@ -63,7 +63,6 @@ impl<'a> World<'a> {
             world: self,
             definitions,
             query: &query,
-            wide: K::ISA >= Isa::Avx,
             best: &mut best,
             inner: &mut inner,
         };
@@ -106,7 +105,6 @@ impl<'a> World<'a> {
             ctx.counters += inner.counters;
             return true;
         }
-        let wide = K::ISA >= Isa::Avx;
         if self.instance_count == 0 {
             // One level, no instance walk to count apart (tried one path for
             // both: slower, see docs/performance-log.md).
@@ -114,7 +112,6 @@ impl<'a> World<'a> {
                 world: self,
                 definitions,
                 query: &query,
-                wide,
                 inner: &mut inner,
                 blocker: &mut 0,
             };
@@ -124,7 +121,6 @@ impl<'a> World<'a> {
             world: self,
             definitions,
             query: &query,
-            wide,
             inner: &mut inner,
             blocker: &mut 0,
         };
@@ -167,25 +163,22 @@ struct ClosestInLeaves<'q, 'a> {
     world: &'q World<'a>,
     definitions: &'q [World<'a>],
     query: &'q Query<'q>,
-    /// Whether the kernel has AVX's `f64` lanes.
-    wide: bool,
     best: &'q mut Option<Hit>,
     inner: &'q mut QueryContext,
 }
 
 impl ClosestLeaves for ClosestInLeaves<'_, '_> {
     #[inline(always)]
-    fn closest(&mut self, range: Range<u32>, t_max: f64) -> Option<f64> {
+    fn closest<K: Kernel>(&mut self, range: Range<u32>, t_max: f64) -> Option<f64> {
         let (world, definitions, query) = (self.world, self.definitions, self.query);
         let inner = &mut *self.inner;
         let best = &mut *self.best;
         let number = best.map_or(u32::MAX, |h| h.primitive.0);
-        leaf_hit(
+        leaf_hit::<K::Lanes>(
             &world.entries,
             range,
             query,
             (t_max, number),
-            self.wide,
             |e, t_max, rest| world.intersect_other(definitions, e, (query, t_max, rest), inner),
             |primitive, shape_hit| {
                 *best = Some(Hit {
@@ -204,8 +197,6 @@ pub(super) struct AnyInLeaves<'q, 'a, const INSTANCES: bool> {
     pub(super) world: &'q World<'a>,
     pub(super) definitions: &'q [World<'a>],
     pub(super) query: &'q Query<'q>,
-    /// Whether the kernel has AVX's `f64` lanes.
-    pub(super) wide: bool,
     pub(super) inner: &'q mut QueryContext,
     /// The position in the world's entries of the entry found, if one was.
     pub(super) blocker: &'q mut u32,
@@ -213,10 +204,10 @@ pub(super) struct AnyInLeaves<'q, 'a, const INSTANCES: bool> {
 
 impl<const INSTANCES: bool> AnyLeaves for AnyInLeaves<'_, '_, INSTANCES> {
     #[inline(always)]
-    fn occludes(&mut self, range: Range<u32>) -> bool {
+    fn occludes<K: Kernel>(&mut self, range: Range<u32>) -> bool {
         let (world, definitions, query) = (self.world, self.definitions, self.query);
         let inner = &mut *self.inner;
-        let found = leaf_occludes(&world.entries, range, query, self.wide, |e, rest| {
+        let found = leaf_occludes::<K::Lanes>(&world.entries, range, query, |e, rest| {
             if INSTANCES {
                 world.other_occludes(definitions, e, (query, rest), inner)
             } else {

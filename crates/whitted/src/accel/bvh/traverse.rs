@@ -215,24 +215,24 @@ impl Bvh {
         if self.nodes.is_empty() {
             None
         } else if self.max_depth <= SHALLOW {
-            self.closest::<{ stack_size(SHALLOW) }, K::Slabs>(ray, counters, leaves)
+            self.closest::<{ stack_size(SHALLOW) }, K>(ray, counters, leaves)
         } else if self.max_depth <= MIDDLE {
-            self.closest::<{ stack_size(MIDDLE) }, K::Slabs>(ray, counters, leaves)
+            self.closest::<{ stack_size(MIDDLE) }, K>(ray, counters, leaves)
         } else {
-            self.closest::<{ stack_size(MAX_DEPTH) }, K::Slabs>(ray, counters, leaves)
+            self.closest::<{ stack_size(MAX_DEPTH) }, K>(ray, counters, leaves)
         }
     }
 
     /// [`Self::intersect_in_leaf_order`] with a stack of `N` entries and
-    /// the slab test `S`.
+    /// kernel `K`.
     #[inline(always)]
-    fn closest<const N: usize, S: SlabTest>(
+    fn closest<const N: usize, K: Kernel>(
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
         mut leaves: impl ClosestLeaves,
     ) -> Option<f64> {
-        let slabs = S::new(ray);
+        let slabs = K::Slabs::new(ray);
         let mut closest = ray.t_max;
         let mut far = round_up(closest);
         let mut found = None;
@@ -245,7 +245,7 @@ impl Bvh {
             if current.count > 0 {
                 work.primitives += u64::from(current.count);
                 if let Some(t) =
-                    leaves.closest(current.child..current.child + current.count, closest)
+                    leaves.closest::<K>(current.child..current.child + current.count, closest)
                 {
                     closest = t;
                     found = Some(t);
@@ -350,24 +350,24 @@ impl Bvh {
         if self.nodes.is_empty() {
             false
         } else if self.max_depth <= SHALLOW {
-            self.any::<{ stack_size(SHALLOW) }, K::Slabs>(ray, counters, leaves)
+            self.any::<{ stack_size(SHALLOW) }, K>(ray, counters, leaves)
         } else if self.max_depth <= MIDDLE {
-            self.any::<{ stack_size(MIDDLE) }, K::Slabs>(ray, counters, leaves)
+            self.any::<{ stack_size(MIDDLE) }, K>(ray, counters, leaves)
         } else {
-            self.any::<{ stack_size(MAX_DEPTH) }, K::Slabs>(ray, counters, leaves)
+            self.any::<{ stack_size(MAX_DEPTH) }, K>(ray, counters, leaves)
         }
     }
 
-    /// [`Self::occluded_in_leaf_order`] with a stack of `N` entries and the
-    /// slab test `S`.
+    /// [`Self::occluded_in_leaf_order`] with a stack of `N` entries and
+    /// kernel `K`.
     #[inline(always)]
-    fn any<const N: usize, S: SlabTest>(
+    fn any<const N: usize, K: Kernel>(
         &self,
         ray: &Ray,
         counters: &mut TraversalCounters,
         mut leaves: impl AnyLeaves,
     ) -> bool {
-        let slabs = S::new(ray);
+        let slabs = K::Slabs::new(ray);
         let far = round_up(ray.t_max);
         let mut work = TraversalCounters::default();
         let mut stack = Stack::<Entry, N>::new();
@@ -377,7 +377,7 @@ impl Bvh {
             let first = current.child as usize;
             if current.count > 0 {
                 work.primitives += u64::from(current.count);
-                if leaves.occludes(current.child..current.child + current.count) {
+                if leaves.occludes::<K>(current.child..current.child + current.count) {
                     break true;
                 }
             } else if let Some(node) = self.nodes.get(first) {
@@ -408,8 +408,8 @@ impl Bvh {
 
 #[cfg(test)]
 mod tests {
-    use super::super::slabs::Halves;
     use super::{MAX_DEPTH, stack_size};
+    use crate::accel::kernel::Sse2Kernel;
     use crate::accel::{Bvh, Linear, QueryContext, TraversalCounters};
     use crate::math::random::Rng;
     use crate::math::{Aabb, Ray, Vec3};
@@ -515,17 +515,18 @@ mod tests {
             let expected = linear.intersect(ray, &mut ctx, |i, t| box_entry(boxes, ray, i, t));
             let actual = bvh.intersect(ray, &mut ctx, |i, t| box_entry(boxes, ray, i, t));
             assert_eq!(actual, expected, "{ray:?}");
-            let halves = bvh.closest::<N, Halves>(ray, &mut ctx.counters, |entries, mut t_max| {
-                let mut found = None;
-                for entry in entries {
-                    let i = bvh.indices()[entry as usize];
-                    if let Some(t) = box_entry(boxes, ray, i, t_max) {
-                        t_max = t;
-                        found = Some(t);
+            let halves =
+                bvh.closest::<N, Sse2Kernel>(ray, &mut ctx.counters, |entries, mut t_max| {
+                    let mut found = None;
+                    for entry in entries {
+                        let i = bvh.indices()[entry as usize];
+                        if let Some(t) = box_entry(boxes, ray, i, t_max) {
+                            t_max = t;
+                            found = Some(t);
+                        }
                     }
-                }
-                found
-            });
+                    found
+                });
             assert_eq!(halves, expected, "{ray:?}");
             let occluded = |i: u32| box_entry(boxes, ray, i, ray.t_max).is_some();
             assert_eq!(
@@ -537,7 +538,7 @@ mod tests {
                 entries.any(|entry| occluded(bvh.indices()[entry as usize]))
             };
             assert_eq!(
-                bvh.any::<N, Halves>(ray, &mut ctx.counters, leaf_occluded),
+                bvh.any::<N, Sse2Kernel>(ray, &mut ctx.counters, leaf_occluded),
                 expected.is_some(),
                 "{ray:?}"
             );

@@ -1,0 +1,124 @@
+//! Four primitives tested against one ray at once: what each kernel's
+//! backend offers for it ([`FourLanes`], chosen by the kernel's type in
+//! `accel/kernel.rs`). The portable backend offers nothing, and its
+//! callers test one primitive at a time; the AVX backends test four
+//! triangles ([`watertight4`](super::watertight_avx::watertight4)) or cull
+//! four spheres ([`sphere_candidates4`](super::sphere_avx::sphere_candidates4))
+//! in one register of four `f64`s, with the answers of the one-by-one
+//! tests bit for bit.
+
+use super::triangle::RayShear;
+use crate::math::{Ray, Vec3};
+
+/// Lanes per test.
+pub const LANES: usize = 4;
+
+/// What a four-lane triangle test found: which lanes hit, and each lane's
+/// `t` and barycentric coordinates (meaningful for the lanes that hit).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hits4 {
+    /// Bit `i` set when lane `i` hit.
+    pub mask: u32,
+    /// The ray parameter per lane.
+    pub t: [f64; LANES],
+    /// The barycentric coordinate `b1` per lane.
+    pub u: [f64; LANES],
+    /// The barycentric coordinate `b2` per lane.
+    pub v: [f64; LANES],
+}
+
+/// The four-lane tests of one backend.
+///
+/// # Safety of the methods
+///
+/// Each may be called only where the processor runs the backend's
+/// instruction set: in a kernel of that backend (`accel::kernel::run`
+/// enters one only for a processor that runs it), or after checking.
+pub(crate) trait FourLanes {
+    /// Whether the backend has any four-lane test: where it has none, its
+    /// callers skip looking for runs of primitives to give them.
+    const ANY: bool;
+
+    /// The watertight test of `triangles` against `ray` (sheared by
+    /// `shear`) ending at `t_max`, lane `i` for `triangles[i]`, each lane's
+    /// answer [`watertight`](super::watertight)'s; `None` where the
+    /// backend has no such test (the caller then tests one at a time).
+    ///
+    /// # Safety
+    ///
+    /// See the trait's doc.
+    unsafe fn triangles(
+        triangles: [&[Vec3; 3]; LANES],
+        ray: &Ray,
+        shear: &RayShear,
+        t_max: f64,
+    ) -> Option<Hits4>;
+
+    /// The lanes (bit `i` for `centers[i]`, `radii[i]`) whose sphere the
+    /// one-sphere test would not cull for `ray` ending at `t_max`; the
+    /// others have no hit in `(t_min, t_max)`. `None` where the backend
+    /// has no such test.
+    ///
+    /// # Safety
+    ///
+    /// See the trait's doc.
+    unsafe fn sphere_candidates(
+        centers: [&Vec3; LANES],
+        radii: [&f64; LANES],
+        ray: &Ray,
+        t_max: f64,
+    ) -> Option<u32>;
+}
+
+/// The portable backend's: none, every primitive is tested on its own.
+pub(crate) struct OneByOne;
+
+impl FourLanes for OneByOne {
+    const ANY: bool = false;
+
+    #[inline(always)]
+    unsafe fn triangles(_: [&[Vec3; 3]; LANES], _: &Ray, _: &RayShear, _: f64) -> Option<Hits4> {
+        None
+    }
+
+    #[inline(always)]
+    unsafe fn sphere_candidates(
+        _: [&Vec3; LANES],
+        _: [&f64; LANES],
+        _: &Ray,
+        _: f64,
+    ) -> Option<u32> {
+        None
+    }
+}
+
+/// The AVX backends': four `f64` lanes.
+#[cfg(target_arch = "x86_64")]
+pub(crate) struct AvxLanes;
+
+#[cfg(target_arch = "x86_64")]
+impl FourLanes for AvxLanes {
+    const ANY: bool = true;
+
+    #[inline(always)]
+    unsafe fn triangles(
+        triangles: [&[Vec3; 3]; LANES],
+        ray: &Ray,
+        shear: &RayShear,
+        t_max: f64,
+    ) -> Option<Hits4> {
+        // SAFETY: the caller's contract: the processor has AVX.
+        Some(unsafe { super::watertight_avx::watertight4(triangles, ray, shear, t_max) })
+    }
+
+    #[inline(always)]
+    unsafe fn sphere_candidates(
+        centers: [&Vec3; LANES],
+        radii: [&f64; LANES],
+        ray: &Ray,
+        t_max: f64,
+    ) -> Option<u32> {
+        // SAFETY: the caller's contract: the processor has AVX.
+        Some(unsafe { super::sphere_avx::sphere_candidates4(centers, radii, ray, t_max) })
+    }
+}
