@@ -206,6 +206,33 @@ pub(crate) type PacketLanes = AvxLanes;
 #[cfg(not(target_arch = "x86_64"))]
 pub(crate) type PacketLanes = OneByOne;
 
+/// Runs `f` out of line, compiled with the target features of the kernels
+/// packets are walked together in ([`PacketLanes`]), so that the four-lane
+/// tests `f` inlines are compiled into it rather than called one by one
+/// (a packet's leaf callback, which cannot name its kernel, is compiled
+/// without them). Give `f` `#[inline(always)]`.
+///
+/// # Safety
+///
+/// Call it only where the processor runs those features: in a packet's
+/// walk.
+#[inline(always)]
+pub(crate) unsafe fn with_packet_features<R>(f: impl FnOnce() -> R) -> R {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: the caller's contract.
+    return unsafe { with_avx(f) };
+    #[cfg(not(target_arch = "x86_64"))]
+    f()
+}
+
+/// `f`, compiled for AVX.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+#[inline(never)]
+fn with_avx<R>(f: impl FnOnce() -> R) -> R {
+    f()
+}
+
 /// Work generic over the kernel it runs with. [`KernelTask::run`] should
 /// be `#[inline(always)]`, and so should what it calls that is hot, so that
 /// it is compiled under the kernel's target features.

@@ -4,10 +4,13 @@
 //! callers test one primitive at a time; the AVX backends test four
 //! triangles ([`watertight4`](super::watertight_avx::watertight4)) or cull
 //! four spheres ([`sphere_candidates4`](super::sphere_avx::sphere_candidates4))
-//! in one register of four `f64`s, with the answers of the one-by-one
-//! tests bit for bit.
+//! in one register of four `f64`s, or one triangle against four rays
+//! ([`watertight_rays4`](super::watertight_avx::watertight_rays4), a
+//! packet's leaf), with the answers of the one-by-one tests bit for bit.
 
 use super::triangle::RayShear;
+#[cfg(target_arch = "x86_64")]
+use super::watertight_avx::RayLanes4;
 use crate::math::{Ray, Vec3};
 
 /// Lanes per test.
@@ -68,7 +71,34 @@ pub(crate) trait FourLanes {
         ray: &Ray,
         t_max: f64,
     ) -> Option<u32>;
+
+    /// Four rays set up to be tested together ([`FourLanes::rays`]).
+    type Rays: Copy;
+
+    /// The rays `rays` with their shears `shears` (the same ray in several
+    /// lanes is fine), set up for [`FourLanes::triangle_across`]; `None`
+    /// when the shears do not all make the same axis z, or where the
+    /// backend has no such test.
+    ///
+    /// # Safety
+    ///
+    /// See the trait's doc.
+    unsafe fn rays(rays: [&Ray; LANES], shears: [&RayShear; LANES]) -> Option<Self::Rays>;
+
+    /// The triangle `corners` tested against each of the four rays of
+    /// `rays`, lane `i`'s interval ending at `t_max[i]`: lane by lane what
+    /// [`watertight`](super::watertight) returns for that ray.
+    ///
+    /// # Safety
+    ///
+    /// See the trait's doc.
+    unsafe fn triangle_across(corners: &[Vec3; 3], rays: &Self::Rays, t_max: [f64; LANES])
+    -> Hits4;
 }
+
+/// No rays: the portable backend never sets four up together.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum NoRays {}
 
 /// The portable backend's: none, every primitive is tested on its own.
 pub(crate) struct OneByOne;
@@ -89,6 +119,18 @@ impl FourLanes for OneByOne {
         _: f64,
     ) -> Option<u32> {
         None
+    }
+
+    type Rays = NoRays;
+
+    #[inline(always)]
+    unsafe fn rays(_: [&Ray; LANES], _: [&RayShear; LANES]) -> Option<NoRays> {
+        None
+    }
+
+    #[inline(always)]
+    unsafe fn triangle_across(_: &[Vec3; 3], rays: &NoRays, _: [f64; LANES]) -> Hits4 {
+        match *rays {}
     }
 }
 
@@ -120,5 +162,19 @@ impl FourLanes for AvxLanes {
     ) -> Option<u32> {
         // SAFETY: the caller's contract: the processor has AVX.
         Some(unsafe { super::sphere_avx::sphere_candidates4(centers, radii, ray, t_max) })
+    }
+
+    type Rays = RayLanes4;
+
+    #[inline(always)]
+    unsafe fn rays(rays: [&Ray; LANES], shears: [&RayShear; LANES]) -> Option<RayLanes4> {
+        // SAFETY: the caller's contract: the processor has AVX.
+        unsafe { RayLanes4::new(rays, shears) }
+    }
+
+    #[inline(always)]
+    unsafe fn triangle_across(corners: &[Vec3; 3], rays: &RayLanes4, t_max: [f64; LANES]) -> Hits4 {
+        // SAFETY: the caller's contract: the processor has AVX.
+        unsafe { super::watertight_avx::watertight_rays4(corners, rays, t_max) }
     }
 }

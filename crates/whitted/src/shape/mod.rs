@@ -69,8 +69,6 @@ pub use superellipsoid::{MAX_EXPONENT, MIN_EXPONENT, Superellipsoid, exponent};
 pub use torus::Torus;
 pub use triangle::{RayShear, Triangle, watertight};
 pub(crate) use triangle_clip::clipped_triangle_bounds;
-#[cfg(target_arch = "x86_64")]
-pub(crate) use watertight_avx::{RayLanes4, watertight_rays4};
 
 use crate::math::magnitude::{self, MagnitudeError};
 use crate::math::{Aabb, DVec2, Ray, Vec3};

@@ -20,15 +20,13 @@
 //! triangles, under a pixel, seldom meet several lanes: the test across
 //! them was slower there (docs/performance-log.md).
 
-#[cfg(target_arch = "x86_64")]
 use std::ops::Range;
 
 use crate::accel::bvh::PACKET_LANES;
-use crate::accel::kernel::PacketLanes;
+use crate::accel::kernel::{self, PacketLanes};
 use crate::accel::{Accelerator, Backend, Bvh, QueryContext};
 use crate::math::Ray;
-#[cfg(target_arch = "x86_64")]
-use crate::shape::{LANES, RayLanes4, RayShear, ShapeHit, watertight_rays4};
+use crate::shape::{FourLanes, LANES, RayShear, ShapeHit};
 
 use super::entry::{EntryKind, Query, Rest, leaf_hit, nearer};
 use super::{Hit, PrimitiveId, World};
@@ -38,7 +36,6 @@ pub const PACKET_SIZE: usize = PACKET_LANES;
 
 /// How many lanes of a set of four must reach a leaf of triangles for the
 /// set to be tested across its lanes.
-#[cfg(target_arch = "x86_64")]
 const ACROSS_FROM: u32 = 2;
 
 impl<'a> World<'a> {
@@ -142,8 +139,7 @@ impl<'a> World<'a> {
         // Leaves of triangles alone are tested across the lanes when each
         // of the two sets of four lanes is sheared alike (`None` until a
         // leaf needs them, `Some(None)` when a set is not).
-        #[cfg(target_arch = "x86_64")]
-        let mut across: Option<Option<[RayLanes4; 2]>> = None;
+        let mut across: Option<Option<[<PacketLanes as FourLanes>::Rays; 2]>> = None;
         let backend = ctx.backend;
         let tied = bvh.intersect_packet_by_leaf(
             rays,
@@ -153,8 +149,8 @@ impl<'a> World<'a> {
                 let mut found = 0;
                 // The lanes left to test one by one.
                 let mut alone = lanes;
-                #[cfg(target_arch = "x86_64")]
-                if !self.big_meshes
+                if PacketLanes::ANY
+                    && !self.big_meshes
                     && crowded_halves(lanes) != 0
                     && self.all_triangles(range.clone())
                 {
@@ -163,15 +159,29 @@ impl<'a> World<'a> {
                             queries[lane]
                                 .get_or_insert_with(|| Query::new(ray, self.has_triangles));
                         }
-                        // SAFETY: packets are walked together only where the
-                        // processor has AVX (`packets_allowed`).
-                        unsafe { ray_lanes(rays, &queries) }
+                        // SAFETY: packets are walked together only in the
+                        // kernels whose lanes are `PacketLanes`, with their
+                        // features.
+                        unsafe {
+                            kernel::with_packet_features(
+                                #[inline(always)]
+                                || ray_lanes::<PacketLanes>(rays, &queries),
+                            )
+                        }
                     });
                     if let Some(across) = across {
                         let together = lanes & crowded_halves(lanes);
-                        // SAFETY: as above.
+                        let range = range.clone();
+                        // SAFETY: as above, for both.
                         found = unsafe {
-                            self.triangles_across(range.clone(), together, t_max, across, hits)
+                            kernel::with_packet_features(
+                                #[inline(always)]
+                                || {
+                                    self.triangles_across::<PacketLanes>(
+                                        range, together, t_max, across, hits,
+                                    )
+                                },
+                            )
                         };
                         alone &= !together;
                     }
@@ -211,7 +221,6 @@ impl<'a> World<'a> {
     }
 
     /// Whether the entries `range` are all triangles.
-    #[cfg(target_arch = "x86_64")]
     #[inline]
     fn all_triangles(&self, range: Range<u32>) -> bool {
         self.entries[range.start as usize..range.end as usize]
@@ -229,16 +238,14 @@ impl<'a> World<'a> {
     ///
     /// # Safety
     ///
-    /// Call it only where the processor has AVX.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx")]
-    #[inline(never)]
-    fn triangles_across(
+    /// Call it only in a kernel whose lanes are `L` (see [`FourLanes`]).
+    #[inline(always)]
+    unsafe fn triangles_across<L: FourLanes>(
         &self,
         range: Range<u32>,
         lanes: u32,
         t_max: &mut [f64; PACKET_SIZE],
-        across: &[RayLanes4; 2],
+        across: &[L::Rays; 2],
         hits: &mut [Option<Hit>],
     ) -> u32 {
         let mut found = 0;
@@ -251,7 +258,8 @@ impl<'a> World<'a> {
                 }
                 // One ulp past each lane's closest hit, to see ties.
                 let ends = [0, 1, 2, 3].map(|i| t_max[first + i].next_up());
-                let h = watertight_rays4(&e.corners, rays, ends);
+                // SAFETY: the caller's contract.
+                let h = unsafe { L::triangle_across(&e.corners, rays, ends) };
                 mask &= h.mask;
                 while mask != 0 {
                     let i = mask.trailing_zeros() as usize;
@@ -282,7 +290,6 @@ impl<'a> World<'a> {
 /// The lanes of the sets of four (lanes 0 to 3, 4 to 7) of which at least
 /// [`ACROSS_FROM`] are in `lanes`: the sets worth testing across (one
 /// lane alone is tested faster by itself, with its early outs).
-#[cfg(target_arch = "x86_64")]
 #[inline]
 fn crowded_halves(lanes: u32) -> u32 {
     let crowded = |first: usize| {
@@ -302,20 +309,25 @@ fn crowded_halves(lanes: u32) -> u32 {
 ///
 /// # Safety
 ///
-/// Call it only where the processor has AVX.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx")]
-fn ray_lanes(rays: &[Ray], queries: &[Option<Query>; PACKET_SIZE]) -> Option<[RayLanes4; 2]> {
+/// Call it only in a kernel whose lanes are `L` (see [`FourLanes`]).
+#[inline(always)]
+unsafe fn ray_lanes<L: FourLanes>(
+    rays: &[Ray],
+    queries: &[Option<Query>; PACKET_SIZE],
+) -> Option<[L::Rays; 2]> {
     let last = rays.len() - 1;
     let shears: [RayShear; PACKET_SIZE] = std::array::from_fn(|lane| {
         queries[lane.min(last)].map_or_else(|| RayShear::new(&rays[lane.min(last)]), |q| q.shear())
     });
     let half = |first: usize| {
         let lane = |i: usize| (first + i).min(last);
-        RayLanes4::new(
-            [0, 1, 2, 3].map(|i| &rays[lane(i)]),
-            [0, 1, 2, 3].map(|i| &shears[first + i]),
-        )
+        // SAFETY: the caller's contract.
+        unsafe {
+            L::rays(
+                [0, 1, 2, 3].map(|i| &rays[lane(i)]),
+                [0, 1, 2, 3].map(|i| &shears[first + i]),
+            )
+        }
     };
     Some([half(0)?, half(LANES)?])
 }
@@ -585,22 +597,18 @@ pub(super) mod tests {
         let (together, hits) = assert_packets_agree(&objects, &packets);
         if has_avx() {
             assert!(together > 800, "{together}");
-            #[cfg(target_arch = "x86_64")]
-            {
-                let sheared_alike = |rays: &Vec<Ray>| {
-                    let queries =
-                        std::array::from_fn(|lane| rays.get(lane).map(|ray| Query::new(ray, true)));
-                    // SAFETY: the processor has AVX.
-                    unsafe { ray_lanes(rays, &queries) }.is_some()
-                };
-                let alike = packets.iter().filter(|rays| sheared_alike(rays)).count();
-                assert!(alike > 800 && alike < packets.len(), "{alike}");
-            }
+            let sheared_alike = |rays: &Vec<Ray>| {
+                let queries =
+                    std::array::from_fn(|lane| rays.get(lane).map(|ray| Query::new(ray, true)));
+                // SAFETY: the processor has AVX, which `PacketLanes` need.
+                unsafe { ray_lanes::<PacketLanes>(rays, &queries) }.is_some()
+            };
+            let alike = packets.iter().filter(|rays| sheared_alike(rays)).count();
+            assert!(alike > 800 && alike < packets.len(), "{alike}");
         }
         assert!(hits > 2000, "{hits}");
     }
 
-    #[cfg(target_arch = "x86_64")]
     #[test]
     fn each_lane_tested_across_gets_its_own_loops_hits_and_no_other_lane_changes() {
         if !has_avx() {
@@ -615,8 +623,8 @@ pub(super) mod tests {
         let (mut leaves, mut lanes_hit) = (0, 0);
         for rays in camera_packets(&mut rng, 300, 0.01) {
             let queries = std::array::from_fn(|lane| rays.get(lane).map(|r| Query::new(r, true)));
-            // SAFETY: the processor has AVX.
-            let Some(across) = (unsafe { ray_lanes(&rays, &queries) }) else {
+            // SAFETY: the processor has AVX, which `PacketLanes` need.
+            let Some(across) = (unsafe { ray_lanes::<PacketLanes>(&rays, &queries) }) else {
                 continue;
             };
             let mut counters = crate::accel::TraversalCounters::default();
@@ -634,7 +642,7 @@ pub(super) mod tests {
                     let mut hits = [None; PACKET_SIZE];
                     // SAFETY: as above.
                     let found = unsafe {
-                        world.triangles_across(
+                        world.triangles_across::<PacketLanes>(
                             range.clone(),
                             chosen,
                             &mut t_max,
