@@ -24,9 +24,6 @@ use std::sync::OnceLock;
 #[cfg(target_arch = "x86_64")]
 use super::bvh::SlabsAvx;
 use super::bvh::{Halves, SlabTest};
-#[cfg(target_arch = "x86_64")]
-use crate::shape::AvxLanes;
-use crate::shape::{FourLanes, OneByOne};
 
 /// The environment variable that picks a backend by name
 /// ([`Isa::name`]): no wider than the processor runs.
@@ -161,8 +158,9 @@ pub(crate) trait Kernel {
     const ISA: Isa;
     /// The BVH's slab test of a node's eight children.
     type Slabs: SlabTest;
-    /// The leaf tests of four primitives at once.
-    type Lanes: FourLanes;
+    /// Whether it has AVX's four `f64` lanes, for the leaf tests of four
+    /// primitives at once (the world maps this to its lanes).
+    const F64_LANES: bool;
 }
 
 /// The portable kernel.
@@ -171,7 +169,7 @@ pub(crate) struct Sse2Kernel;
 impl Kernel for Sse2Kernel {
     const ISA: Isa = Isa::Sse2;
     type Slabs = Halves;
-    type Lanes = OneByOne;
+    const F64_LANES: bool = false;
 }
 
 /// The AVX kernel.
@@ -182,7 +180,7 @@ pub(crate) struct AvxKernel;
 impl Kernel for AvxKernel {
     const ISA: Isa = Isa::Avx;
     type Slabs = SlabsAvx;
-    type Lanes = AvxLanes;
+    const F64_LANES: bool = true;
 }
 
 /// The AVX2 + FMA kernel.
@@ -193,21 +191,11 @@ pub(crate) struct Avx2Kernel;
 impl Kernel for Avx2Kernel {
     const ISA: Isa = Isa::Avx2;
     type Slabs = SlabsAvx;
-    type Lanes = AvxLanes;
+    const F64_LANES: bool = true;
 }
 
-/// The leaf tests of the kernels packets are walked together in (the AVX
-/// ones: a packet walk on any other returns at once, unwalked), for the
-/// packets' leaf callbacks, which cannot name their kernel.
-#[cfg(target_arch = "x86_64")]
-pub(crate) type PacketLanes = AvxLanes;
-
-/// As above: no kernel walks packets together on this target.
-#[cfg(not(target_arch = "x86_64"))]
-pub(crate) type PacketLanes = OneByOne;
-
 /// Runs `f` out of line, compiled with the target features of the kernels
-/// packets are walked together in ([`PacketLanes`]), so that the four-lane
+/// packets are walked together in (AVX), so that the four-lane
 /// tests `f` inlines are compiled into it rather than called one by one
 /// (a packet's leaf callback, which cannot name its kernel, is compiled
 /// without them). Give `f` `#[inline(always)]`.

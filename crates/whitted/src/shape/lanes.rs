@@ -1,6 +1,6 @@
 //! Four primitives tested against one ray at once: what each kernel's
-//! backend offers for it ([`FourLanes`], chosen by the kernel's type in
-//! `accel/kernel.rs`). The portable backend offers nothing, and its
+//! backend offers for it ([`FourLanes`]; the world picks a kernel's, by
+//! whether it has `f64` lanes). The portable backend offers nothing, and its
 //! callers test one primitive at a time; the AVX backends test four
 //! triangles ([`watertight4`](super::watertight_avx::watertight4)) or cull
 //! four spheres ([`sphere_candidates4`](super::sphere_avx::sphere_candidates4))
@@ -133,6 +133,16 @@ impl FourLanes for OneByOne {
         match *rays {}
     }
 }
+
+/// The widest lanes this target has: [`AvxLanes`] on x86-64, none
+/// ([`OneByOne`]) elsewhere. The walks of packets, which run only in AVX
+/// kernels, use them.
+#[cfg(target_arch = "x86_64")]
+pub(crate) type WideLanes = AvxLanes;
+
+/// As above: no four-lane tests on this target.
+#[cfg(not(target_arch = "x86_64"))]
+pub(crate) type WideLanes = OneByOne;
 
 /// The AVX backends': four `f64` lanes.
 #[cfg(target_arch = "x86_64")]

@@ -53,12 +53,11 @@ pub use csg::{COINCIDENT, Csg, CsgChild, CsgError, CsgOperation, MAX_LEAVES};
 pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use implicit::{Expression, ExpressionError, Implicit, MIN_STEP, NAN_STEP};
-#[cfg(target_arch = "x86_64")]
+#[cfg(all(test, target_arch = "x86_64"))]
 pub(crate) use lanes::AvxLanes;
-pub(crate) use lanes::{FourLanes, Hits4, LANES, OneByOne};
+pub(crate) use lanes::{FourLanes, Hits4, LANES, OneByOne, WideLanes};
 pub use parallelogram::Parallelogram;
 pub use plane::Plane;
-#[cfg(target_arch = "x86_64")]
 pub(crate) use plane::plane_hit;
 pub use polygon::Polygon;
 pub use quadric::Quadric;

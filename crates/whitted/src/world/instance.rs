@@ -6,6 +6,7 @@
 //! walks the mesh's structure with the same watertight test, on the same
 //! corners, as a triangle placed directly: the same hits.
 
+use super::lanes::LanesOf;
 use rayon::prelude::*;
 
 use super::entry::{Entry, Query, leaf_hit, leaf_occludes};
@@ -136,7 +137,7 @@ impl ClosestLeaves for MeshLeaves<'_> {
     fn closest<K: Kernel>(&mut self, range: Range<u32>, t_max: f64) -> Option<f64> {
         let best = &mut *self.best;
         let number = best.map_or(u32::MAX, |(triangle, _)| triangle);
-        leaf_hit::<K::Lanes>(
+        leaf_hit::<LanesOf<K>>(
             self.entries,
             range,
             self.query,
@@ -150,7 +151,7 @@ impl ClosestLeaves for MeshLeaves<'_> {
 impl AnyLeaves for MeshLeaves<'_> {
     #[inline(always)]
     fn occludes<K: Kernel>(&mut self, range: Range<u32>) -> bool {
-        leaf_occludes::<K::Lanes>(self.entries, range, self.query, |_, _| false).is_some()
+        leaf_occludes::<LanesOf<K>>(self.entries, range, self.query, |_, _| false).is_some()
     }
 }
 

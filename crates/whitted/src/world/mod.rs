@@ -33,6 +33,7 @@ mod estimate;
 mod hit;
 mod instance;
 mod interiors;
+mod lanes;
 mod objects;
 mod packet;
 mod packet_any;

@@ -20,10 +20,11 @@
 //! triangles, under a pixel, seldom meet several lanes: the test across
 //! them was slower there (docs/performance-log.md).
 
+use crate::shape::WideLanes;
 use std::ops::Range;
 
 use crate::accel::bvh::PACKET_LANES;
-use crate::accel::kernel::{self, PacketLanes};
+use crate::accel::kernel;
 use crate::accel::{Accelerator, Backend, Bvh, QueryContext};
 use crate::math::Ray;
 use crate::shape::{FourLanes, LANES, RayShear, ShapeHit};
@@ -139,7 +140,7 @@ impl<'a> World<'a> {
         // Leaves of triangles alone are tested across the lanes when each
         // of the two sets of four lanes is sheared alike (`None` until a
         // leaf needs them, `Some(None)` when a set is not).
-        let mut across: Option<Option<[<PacketLanes as FourLanes>::Rays; 2]>> = None;
+        let mut across: Option<Option<[<WideLanes as FourLanes>::Rays; 2]>> = None;
         let backend = ctx.backend;
         let tied = bvh.intersect_packet_by_leaf(
             rays,
@@ -149,7 +150,7 @@ impl<'a> World<'a> {
                 let mut found = 0;
                 // The lanes left to test one by one.
                 let mut alone = lanes;
-                if PacketLanes::ANY
+                if WideLanes::ANY
                     && !self.big_meshes
                     && crowded_halves(lanes) != 0
                     && self.all_triangles(range.clone())
@@ -160,12 +161,12 @@ impl<'a> World<'a> {
                                 .get_or_insert_with(|| Query::new(ray, self.has_triangles));
                         }
                         // SAFETY: packets are walked together only in the
-                        // kernels whose lanes are `PacketLanes`, with their
+                        // kernels whose lanes are `WideLanes`, with their
                         // features.
                         unsafe {
                             kernel::with_packet_features(
                                 #[inline(always)]
-                                || ray_lanes::<PacketLanes>(rays, &queries),
+                                || ray_lanes::<WideLanes>(rays, &queries),
                             )
                         }
                     });
@@ -177,7 +178,7 @@ impl<'a> World<'a> {
                             kernel::with_packet_features(
                                 #[inline(always)]
                                 || {
-                                    self.triangles_across::<PacketLanes>(
+                                    self.triangles_across::<WideLanes>(
                                         range, together, t_max, across, hits,
                                     )
                                 },
@@ -193,7 +194,7 @@ impl<'a> World<'a> {
                     let query = queries[lane]
                         .get_or_insert_with(|| Query::new(&rays[lane], self.has_triangles));
                     let number = hits[lane].map_or(u32::MAX, |h| h.primitive.0);
-                    let closest = leaf_hit::<PacketLanes>(
+                    let closest = leaf_hit::<WideLanes>(
                         &self.entries,
                         range.clone(),
                         query,
@@ -600,8 +601,8 @@ pub(super) mod tests {
             let sheared_alike = |rays: &Vec<Ray>| {
                 let queries =
                     std::array::from_fn(|lane| rays.get(lane).map(|ray| Query::new(ray, true)));
-                // SAFETY: the processor has AVX, which `PacketLanes` need.
-                unsafe { ray_lanes::<PacketLanes>(rays, &queries) }.is_some()
+                // SAFETY: the processor has AVX, which `WideLanes` need.
+                unsafe { ray_lanes::<WideLanes>(rays, &queries) }.is_some()
             };
             let alike = packets.iter().filter(|rays| sheared_alike(rays)).count();
             assert!(alike > 800 && alike < packets.len(), "{alike}");
@@ -623,8 +624,8 @@ pub(super) mod tests {
         let (mut leaves, mut lanes_hit) = (0, 0);
         for rays in camera_packets(&mut rng, 300, 0.01) {
             let queries = std::array::from_fn(|lane| rays.get(lane).map(|r| Query::new(r, true)));
-            // SAFETY: the processor has AVX, which `PacketLanes` need.
-            let Some(across) = (unsafe { ray_lanes::<PacketLanes>(&rays, &queries) }) else {
+            // SAFETY: the processor has AVX, which `WideLanes` need.
+            let Some(across) = (unsafe { ray_lanes::<WideLanes>(&rays, &queries) }) else {
                 continue;
             };
             let mut counters = crate::accel::TraversalCounters::default();
@@ -642,7 +643,7 @@ pub(super) mod tests {
                     let mut hits = [None; PACKET_SIZE];
                     // SAFETY: as above.
                     let found = unsafe {
-                        world.triangles_across::<PacketLanes>(
+                        world.triangles_across::<WideLanes>(
                             range.clone(),
                             chosen,
                             &mut t_max,

@@ -9,9 +9,9 @@
 //! world or a packet that cannot be walked together is answered one ray at
 //! a time.
 
-use crate::accel::kernel::PacketLanes;
 use crate::accel::{Accelerator, Bvh, QueryContext};
 use crate::math::Ray;
+use crate::shape::WideLanes;
 
 use super::World;
 use super::entry::{Query, Rest, leaf_occludes};
@@ -74,7 +74,7 @@ impl World<'_> {
                     bits &= bits - 1;
                     let query = queries[lane]
                         .get_or_insert_with(|| Query::new(&rays[lane], self.has_triangles));
-                    let meets = leaf_occludes::<PacketLanes>(
+                    let meets = leaf_occludes::<WideLanes>(
                         &self.entries,
                         range.clone(),
                         query,

@@ -8,6 +8,7 @@
 //! met ([`PassedEntries`]): each step of that walk then tests those alone
 //! instead of walking the whole structure again.
 
+use super::lanes::LanesOf;
 use std::ops::Range;
 
 use crate::accel::kernel::{self, Kernel, KernelTask};
@@ -552,7 +553,7 @@ impl AnyLeaves for PassingLeaves<'_, '_> {
     fn occludes<K: Kernel>(&mut self, range: Range<u32>) -> bool {
         let (world, query, opaque) = (self.world, self.query, self.opaque);
         let passed = &mut *self.passed;
-        let blocker = leaf_meets::<K::Lanes>(
+        let blocker = leaf_meets::<LanesOf<K>>(
             &world.entries,
             range,
             query,

@@ -5,6 +5,7 @@
 //! features. What is left to the world's tables (a shape's whole test, an
 //! instance's own walk) stays a call.
 
+use super::lanes::LanesOf;
 use std::ops::Range;
 
 use super::entry::{Query, leaf_hit, leaf_occludes};
@@ -174,7 +175,7 @@ impl ClosestLeaves for ClosestInLeaves<'_, '_> {
         let inner = &mut *self.inner;
         let best = &mut *self.best;
         let number = best.map_or(u32::MAX, |h| h.primitive.0);
-        leaf_hit::<K::Lanes>(
+        leaf_hit::<LanesOf<K>>(
             &world.entries,
             range,
             query,
@@ -207,7 +208,7 @@ impl<const INSTANCES: bool> AnyLeaves for AnyInLeaves<'_, '_, INSTANCES> {
     fn occludes<K: Kernel>(&mut self, range: Range<u32>) -> bool {
         let (world, definitions, query) = (self.world, self.definitions, self.query);
         let inner = &mut *self.inner;
-        let found = leaf_occludes::<K::Lanes>(&world.entries, range, query, |e, rest| {
+        let found = leaf_occludes::<LanesOf<K>>(&world.entries, range, query, |e, rest| {
             if INSTANCES {
                 world.other_occludes(definitions, e, (query, rest), inner)
             } else {
