@@ -10,31 +10,55 @@
 //! files of images being encoded are removed, a message says what
 //! happened and what to do, and the process exits with status 1.
 //!
-//! The process's allocator ([`Noting`]) is the system's, noting the size
-//! of any request it refuses; a `SIGABRT` handler then tells an abort that
-//! follows a refusal from any other. Another abort still aborts, once its
-//! partial files are removed.
+//! The process's allocator ([`Noting`]) is the system's, noting on each
+//! thread the size of a request it refuses, forgotten as the thread goes
+//! on; a `SIGABRT` handler then tells an abort that follows a refusal from
+//! any other. Another abort, or a `SIGABRT` sent from outside,
+//! still aborts, once the partial files are removed.
 
 use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
 use std::fmt::Write as _;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use libc::c_int;
 use whitted::limits::ByteSize;
 
-/// The size of the last request the system refused, 0 when none was.
-static REFUSED: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    /// On each thread, the size of a request the system refused and how
+    /// many requests were granted since; forgotten once [`FORGOTTEN_AFTER`]
+    /// were. The standard library answers a refusal it cannot hand back by
+    /// aborting on the thread that asked, after a few small requests of its
+    /// own (to print its message), so an abort that finds a note here
+    /// follows a refusal; a refusal the caller handled (a fallible
+    /// reservation) is forgotten as the thread goes on.
+    static REFUSED: Cell<(usize, u32)> = const { Cell::new((0, 0)) };
+}
 
-/// The system's allocator, noting the size of each request it refuses in
-/// [`REFUSED`]; it gives the same answers.
+/// Requests granted after a refusal before it is forgotten.
+const FORGOTTEN_AFTER: u32 = 64;
+
+/// The system's allocator, noting in [`REFUSED`] whether the thread's last
+/// request was refused; it gives the same answers.
 pub struct Noting;
 
-/// `pointer`, after noting `size` when it is null.
+/// `pointer`, after noting on this thread `size` when it is null, or
+/// counting a granted request towards forgetting a refusal.
 #[inline]
 fn noted(pointer: *mut u8, size: usize) -> *mut u8 {
-    if pointer.is_null() {
-        REFUSED.store(size.max(1), Ordering::Relaxed);
-    }
+    // A thread being torn down no longer has its note: nothing to say then.
+    let _ = REFUSED.try_with(|note| {
+        let (refused, since) = note.get();
+        if pointer.is_null() {
+            note.set((size.max(1), 0));
+        } else if refused != 0 {
+            let since = since + 1;
+            note.set(if since > FORGOTTEN_AFTER {
+                (0, 0)
+            } else {
+                (refused, since)
+            });
+        }
+    });
     pointer
 }
 
@@ -93,9 +117,15 @@ pub fn end_refusals_as_errors() -> Result<(), String> {
 /// safe here.
 extern "C" fn on_abort(_signal: c_int) {
     let _ = whitted::image::remove_partial_files_now();
-    let refused = REFUSED.load(Ordering::Relaxed);
+    let refused = REFUSED
+        .try_with(Cell::get)
+        .map_or(0, |(refused, _)| refused);
     if refused == 0 {
-        // Not a refusal: returning lets the abort end the process.
+        // Not a refusal (an abort of another kind, or SIGABRT sent from
+        // outside): the default action, restored by `SA_RESETHAND`, ends
+        // the process when the signal is raised again.
+        // SAFETY: raising a signal is what a handler may do.
+        unsafe { libc::raise(libc::SIGABRT) };
         return;
     }
     let mut message = StackText::new();
@@ -155,6 +185,27 @@ impl std::fmt::Write for StackText {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_refusal_is_noted_on_its_thread_and_forgotten_as_it_goes_on() {
+        std::thread::spawn(|| {
+            let granted = std::ptr::NonNull::<u8>::dangling().as_ptr();
+            let note = || REFUSED.with(Cell::get).0;
+            noted(std::ptr::null_mut(), 1 << 30);
+            assert_eq!(note(), 1 << 30);
+            assert_eq!(std::thread::spawn(|| REFUSED.with(Cell::get).0).join().unwrap(), 0);
+            // Noted afresh: spawning took requests of this thread's.
+            noted(std::ptr::null_mut(), 3 << 30);
+            for _ in 0..FORGOTTEN_AFTER {
+                noted(granted, 8);
+            }
+            assert_eq!(note(), 3 << 30, "the abort's own requests keep it");
+            noted(granted, 8);
+            assert_eq!(note(), 0, "forgotten as the thread goes on");
+        })
+        .join()
+        .unwrap();
+    }
 
     #[test]
     fn text_past_the_buffer_is_cut_not_overflowed() {

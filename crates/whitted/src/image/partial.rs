@@ -14,7 +14,39 @@ use std::sync::{Mutex, MutexGuard, PoisonError};
 
 /// A list of partial files that exist now.
 #[derive(Debug)]
-pub(crate) struct Registry(Mutex<Vec<PathBuf>>);
+pub(crate) struct Registry(Mutex<Vec<Listed>>);
+
+/// A listed partial file.
+#[derive(Debug)]
+struct Listed {
+    path: PathBuf,
+    /// The same path as the system takes it, made when it was listed, so
+    /// that a process being aborted removes it without allocating.
+    #[cfg(unix)]
+    c_path: std::ffi::CString,
+}
+
+impl Listed {
+    fn new(path: &Path) -> io::Result<Self> {
+        Ok(Self {
+            path: path.to_path_buf(),
+            #[cfg(unix)]
+            c_path: std::ffi::CString::new(std::os::unix::ffi::OsStrExt::as_bytes(
+                path.as_os_str(),
+            ))?,
+        })
+    }
+
+    /// Removes the file, allocating nothing on Unix.
+    fn remove(&self) {
+        // Already gone is as good as removed; nothing else can be done
+        // about a file that cannot be removed by a process that is ending.
+        #[cfg(unix)]
+        let _ = rustix::fs::unlink(self.c_path.as_c_str());
+        #[cfg(not(unix))]
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
 
 impl Registry {
     /// An empty list.
@@ -22,34 +54,30 @@ impl Registry {
         Self(Mutex::new(Vec::new()))
     }
 
-    fn lock(&self) -> MutexGuard<'_, Vec<PathBuf>> {
+    fn lock(&self) -> MutexGuard<'_, Vec<Listed>> {
         // The list stays valid whatever panicked while holding it: every
         // change to it is one push or one removal.
         self.0.lock().unwrap_or_else(PoisonError::into_inner)
     }
 
     /// Removes every listed file and keeps the list locked.
-    fn remove_all(&self) -> MutexGuard<'_, Vec<PathBuf>> {
+    fn remove_all(&self) -> MutexGuard<'_, Vec<Listed>> {
         let mut list = self.lock();
-        for path in list.drain(..) {
-            // Already gone is as good as removed; nothing else can be done
-            // about a file that cannot be removed by a process that is
-            // ending.
-            let _ = std::fs::remove_file(path);
+        for listed in list.drain(..) {
+            listed.remove();
         }
         list
     }
 
     /// Removes every listed file when the list is not locked, without
-    /// waiting for it and without allocating (each path is passed to the
-    /// system from the stack when shorter than a few hundred bytes, as
-    /// `std::fs` does). Returns whether the list could be read.
+    /// waiting for it and, on Unix, without allocating. Returns whether
+    /// the list could be read.
     fn remove_all_now(&self) -> bool {
         let Ok(list) = self.0.try_lock() else {
             return false;
         };
-        for path in list.iter() {
-            let _ = std::fs::remove_file(path);
+        for listed in list.iter() {
+            listed.remove();
         }
         true
     }
@@ -78,7 +106,7 @@ impl PartialFile {
         builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
         let mut list = registry.lock();
         let temp = builder.tempfile_in(folder)?;
-        list.push(temp.path().to_path_buf());
+        list.push(Listed::new(temp.path())?);
         Ok(Self {
             temp: Some(temp),
             registry,
@@ -104,7 +132,7 @@ impl PartialFile {
         // On failure the file comes back with the error and is removed
         // here, with the registry still locked.
         let result = temp.persist(target).map(drop).map_err(|e| e.error);
-        list.retain(|p| *p != path);
+        list.retain(|l| l.path != path);
         result
     }
 }
@@ -115,7 +143,7 @@ impl Drop for PartialFile {
             let mut list = self.registry.lock();
             let path = temp.path().to_path_buf();
             drop(temp);
-            list.retain(|p| *p != path);
+            list.retain(|l| l.path != path);
         }
     }
 }
@@ -124,7 +152,7 @@ impl Drop for PartialFile {
 /// file can be created, renamed or removed by another thread.
 #[must_use = "hold it until the process exits, so that no new partial file appears"]
 pub struct PartialFilesRemoved {
-    _list: MutexGuard<'static, Vec<PathBuf>>,
+    _list: MutexGuard<'static, Vec<Listed>>,
 }
 
 /// Removes every partial file this process has on disk, for a process
@@ -138,12 +166,11 @@ pub fn remove_partial_files() -> PartialFilesRemoved {
 }
 
 /// Removes every partial file this process has on disk, for a process
-/// being aborted (in a `SIGABRT` handler, after an allocation the system
-/// refused): it neither waits for the registry's lock nor allocates
-/// memory for the paths of usual length. Returns false, removing nothing,
-/// when another thread held the registry at that moment (one creating,
-/// renaming or removing a partial file: its file is then being dealt
-/// with).
+/// being aborted (in a `SIGABRT` handler): it neither waits for the
+/// registry's lock nor, on Unix, allocates. Returns false, removing
+/// nothing, when a thread held the registry at that moment (one creating,
+/// renaming or removing a partial file, possibly the one aborting): the
+/// files are then left behind.
 pub fn remove_partial_files_now() -> bool {
     IN_FLIGHT.remove_all_now()
 }
@@ -161,7 +188,7 @@ mod tests {
 
     /// The files `registry` lists.
     fn listed(registry: &Registry) -> Vec<PathBuf> {
-        registry.lock().clone()
+        registry.lock().iter().map(|l| l.path.clone()).collect()
     }
 
     #[test]
