@@ -860,8 +860,8 @@ fn a_texture_the_system_refuses_is_an_error_at_its_place() {
     assert_eq!(p.code(), Some(1), "{}", p.stderr);
     assert!(
         p.stderr.contains(
-            "s.toml:9:21: error: cannot decode the image `big.png`: the system refused the \
-             25.7 MiB its texels need; free memory, raise the process's limit (ulimit -v), or \
+            "s.toml:9:21: error: cannot decode the image `big.png`: the system refused \
+             25.7 MiB for its texels; free memory, raise the process's limit (ulimit -v), or \
              use a smaller image"
         ),
         "{}",

@@ -187,7 +187,7 @@ fn decode_png(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
     };
     let (charge, decoding_charge) =
         charge_texel_memory(width, height, size as u64, 3 * sample_bytes)?;
-    let mut buffer = reserved::<u8>(size)?;
+    let mut buffer = reserved::<u8>(size, "the decoder's buffer")?;
     buffer.resize(size, 0);
     let info = reader.next_frame(&mut buffer).map_err(|e| e.to_string())?;
     let channels = match info.color_type {
@@ -218,14 +218,14 @@ fn decode_png(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
             .flat_map(|row| row.chunks_exact(channels * sample_bytes).take(width))
     };
     let texels = if wide {
-        let mut words = reserved(width * height)?;
+        let mut words = reserved(width * height, "its texels")?;
         words.extend(pixels().map(|p| samples(p, &|at| u16::from_be_bytes([at[0], at[1]]))));
         let table: Arc<[f32]> = (0..=u16::MAX)
             .map(|v| texel_value(f32::from(v) / 65535.0, decoding))
             .collect();
         Texels::Words(words, table)
     } else {
-        let mut bytes = reserved(width * height)?;
+        let mut bytes = reserved(width * height, "its texels")?;
         bytes.extend(pixels().map(|p| samples(p, &|at| u16::from(at[0])).map(|v| v as u8)));
         Texels::Bytes(bytes, Arc::new(eight_bit_table(decoding)))
     };
@@ -237,14 +237,14 @@ fn decode_png(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
 
 /// An empty vector with room for `count` items, or the message for the
 /// system's refusal of that memory (which the budget allowed: a budget
-/// given above what the process may use), so that a server reading a new
-/// scene stays up.
-fn reserved<T>(count: usize) -> Result<Vec<T>, String> {
+/// given above what the process may use), naming it as `what`, so that a
+/// server reading a new scene stays up.
+fn reserved<T>(count: usize, what: &str) -> Result<Vec<T>, String> {
     let mut items = Vec::new();
     items.try_reserve_exact(count).map_err(|_| {
         let bytes = (count as u64).saturating_mul(std::mem::size_of::<T>() as u64);
         format!(
-            "the system refused the {} its texels need; free memory, raise the process's \
+            "the system refused {} for {what}; free memory, raise the process's \
              limit (ulimit -v), or use a smaller image",
             crate::limits::format_bytes(bytes)
         )
@@ -329,9 +329,16 @@ fn decode_jpeg(bytes: &[u8], decoding: Decoding) -> Result<ImageData, String> {
     }
     let (charge, decoding_charge) =
         charge_texel_memory(width as u32, height as u32, claimed * 3, 3)?;
-    let pixels = decoder.decode().map_err(|e| e.to_string())?;
+    let size = decoder
+        .output_buffer_size()
+        .ok_or("the image is too large")?;
+    let mut pixels = reserved::<u8>(size, "the decoder's buffer")?;
+    pixels.resize(size, 0);
+    decoder
+        .decode_into(&mut pixels)
+        .map_err(|e| e.to_string())?;
     let (width, height) = decoder.dimensions().ok_or("no image size")?;
-    let mut texels = reserved(pixels.len() / 3)?;
+    let mut texels = reserved(pixels.len() / 3, "its texels")?;
     texels.extend(pixels.chunks_exact(3).map(|p| [p[0], p[1], p[2]]));
     drop((pixels, decoding_charge));
     let texels = Texels::Bytes(texels, Arc::new(eight_bit_table(decoding)));
