@@ -193,7 +193,12 @@ mod tests {
             let note = || REFUSED.with(Cell::get).0;
             noted(std::ptr::null_mut(), 1 << 30);
             assert_eq!(note(), 1 << 30);
-            assert_eq!(std::thread::spawn(|| REFUSED.with(Cell::get).0).join().unwrap(), 0);
+            assert_eq!(
+                std::thread::spawn(|| REFUSED.with(Cell::get).0)
+                    .join()
+                    .unwrap(),
+                0
+            );
             // Noted afresh: spawning took requests of this thread's.
             noted(std::ptr::null_mut(), 3 << 30);
             for _ in 0..FORGOTTEN_AFTER {
