@@ -95,6 +95,10 @@ impl Bvh {
         hit: impl FnMut(u32, Range<u32>, &mut [f64; PACKET_LANES]) -> u32,
     ) -> Option<u32> {
         /// The walk as a kernel's task.
+        #[cfg_attr(
+            not(target_arch = "x86_64"),
+            expect(dead_code, reason = "packets are walked together on x86-64 only")
+        )]
         struct Packet<'q, L> {
             bvh: &'q Bvh,
             rays: &'q [Ray],

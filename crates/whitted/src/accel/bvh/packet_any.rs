@@ -40,6 +40,10 @@ impl Bvh {
         occludes: impl FnMut(u32, Range<u32>) -> u32,
     ) -> Option<u32> {
         /// The walk as a kernel's task.
+        #[cfg_attr(
+            not(target_arch = "x86_64"),
+            expect(dead_code, reason = "packets are walked together on x86-64 only")
+        )]
         struct Packet<'q, L> {
             bvh: &'q Bvh,
             rays: &'q [Ray],
