@@ -435,6 +435,11 @@ class Server:
             [binary, "serve", "--port", "0", "--bind", bind, "--width", "64", "--height", "48"],
             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, text=True)
         line = self.proc.stdout.readline()
+        # Nothing more is read from it: the server prints only this line.
+        self.proc.stdout.close()
+        if "http://" not in line:
+            self.proc.kill()
+            raise RuntimeError(f"whitted serve printed no address: {line!r}")
         address = line.split("http://", 1)[1].split("/", 1)[0]
         self.host, port = address.rsplit(":", 1)
         self.port = int(port)

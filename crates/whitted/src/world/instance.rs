@@ -104,24 +104,29 @@ impl MeshStructure {
             query: &query,
             best: &mut None,
         };
-        kernel::run(ctx.backend, Walk::<_, true>(&self.accel, ray, ctx, leaves)).is_some()
+        kernel::run(ctx.backend, Walk::<_, true>(&self.accel, ray, ctx, leaves))
     }
 }
 
-/// A mesh's walk as a kernel's task: any hit with `ANY` (answering
-/// `Some` for one), the closest otherwise.
+/// A mesh's walk as a kernel's task: any hit with `ANY`, the closest
+/// otherwise.
 struct Walk<'q, L, const ANY: bool>(&'q Accelerator, &'q Ray, &'q mut QueryContext, L);
 
-impl<L: ClosestLeaves + AnyLeaves, const ANY: bool> KernelTask for Walk<'_, L, ANY> {
+impl<L: ClosestLeaves> KernelTask for Walk<'_, L, false> {
     type Output = Option<f64>;
     #[inline(always)]
     fn run<K: Kernel>(self) -> Option<f64> {
         let Walk(accel, ray, ctx, leaves) = self;
-        if ANY {
-            accel.any_with::<K>(ray, ctx, leaves).then_some(0.0)
-        } else {
-            accel.closest_with::<K>(ray, ctx, leaves)
-        }
+        accel.closest_with::<K>(ray, ctx, leaves)
+    }
+}
+
+impl<L: AnyLeaves> KernelTask for Walk<'_, L, true> {
+    type Output = bool;
+    #[inline(always)]
+    fn run<K: Kernel>(self) -> bool {
+        let Walk(accel, ray, ctx, leaves) = self;
+        accel.any_with::<K>(ray, ctx, leaves)
     }
 }
 
