@@ -730,24 +730,6 @@ fn a_slow_implicit_surface_is_warned_of_before_the_render() {
     assert!(!p.stderr.contains("warning"), "{}", p.stderr);
 }
 
-/// An OBJ grid of `n` x `n` vertices: 2(n - 1)² triangles.
-fn grid_obj(n: usize) -> String {
-    let mut text = String::new();
-    for i in 0..n {
-        for j in 0..n {
-            text.push_str(&format!("v {i} {j} {}\n", (i * j) % 3));
-        }
-    }
-    for i in 0..n - 1 {
-        for j in 0..n - 1 {
-            let a = i * n + j + 1;
-            text.push_str(&format!("f {a} {} {}\n", a + 1, a + n));
-            text.push_str(&format!("f {} {} {}\n", a + 1, a + n + 1, a + n));
-        }
-    }
-    text
-}
-
 /// Item 5's rule for geometry: the world (its meshes, entries and
 /// structures, as estimated) is charged before it is built, so a model
 /// whose kd-tree would not fit is refused with what it needs before the
@@ -756,7 +738,7 @@ fn grid_obj(n: usize) -> String {
 fn geometry_and_structures_beyond_the_budget_are_refused_before_they_are_built() {
     let dir = tempfile::tempdir().unwrap();
     // 64,082 triangles.
-    write(dir.path(), "grid.obj", grid_obj(180));
+    write_grid_obj(&dir.path().join("grid.obj"), 180);
     let small = ["--width", "8", "--height", "8", "--max-memory", "32M"];
     let render = |accel: &str| {
         let mut args = vec!["render", "grid.obj", "-o", "out.png", "--accel", accel];
@@ -877,7 +859,7 @@ fn a_texture_the_system_refuses_is_an_error_at_its_place() {
 #[test]
 fn a_model_past_the_budget_is_refused_where_reading_passes_it() {
     let dir = tempfile::tempdir().unwrap();
-    write_grid_obj(&dir.path().join("grid.obj"));
+    write_grid_obj(&dir.path().join("grid.obj"), 600);
     let render = |budget: &str| {
         let args = ["render", "grid.obj", "--max-memory", budget, "--width", "8"];
         probe(
@@ -938,12 +920,11 @@ fn bench_stops_reading_a_model_where_it_passes_the_budget() {
     assert!(p.peak_bytes < 100 * MIB, "{}", p.peak_bytes);
 }
 
-/// Writes a model of 717,602 triangles (about 20 MB) to `path`, a line at
-/// a time so that this process stays small (a child's peak counts its
-/// parent's).
-fn write_grid_obj(path: &Path) {
+/// Writes an OBJ grid of `n` x `n` vertices, 2(n - 1)² triangles, to
+/// `path` (600: 717,602 triangles, about 20 MB), a line at a time so that
+/// this process stays small (a child's peak counts its parent's).
+fn write_grid_obj(path: &Path, n: usize) {
     use std::io::Write;
-    let n = 600;
     let mut out = std::io::BufWriter::new(fs::File::create(path).unwrap());
     for i in 0..n {
         for j in 0..n {
@@ -968,7 +949,7 @@ fn write_grid_obj(path: &Path) {
 #[test]
 fn any_memory_the_system_refuses_ends_the_run_as_an_error() {
     let dir = tempfile::tempdir().unwrap();
-    write_grid_obj(&dir.path().join("grid.obj"));
+    write_grid_obj(&dir.path().join("grid.obj"), 600);
     let args = [
         "render",
         "grid.obj",
